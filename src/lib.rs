@@ -1,0 +1,3 @@
+//! primm: PR-IMM multi-object tracking for automotive radar.
+
+pub mod measurement;
