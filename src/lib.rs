@@ -1,3 +1,9 @@
 //! primm: PR-IMM multi-object tracking for automotive radar.
 
 pub mod measurement;
+pub mod gaussian;
+pub mod mode;
+pub mod config;
+pub mod motion;
+pub mod predictor;
+pub mod imm;

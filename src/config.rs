@@ -1,0 +1,383 @@
+//! All tracker parameters in one validated structure, loaded from TOML.
+//!
+//! Units are part of every key's name. The defaults live in `config/primm.toml`, which is
+//! embedded in the library, so the documented file and [`Config::default`] cannot drift apart.
+//! [`Config::validate`] checks every value and names the offending key.
+
+use crate::measurement::ObjectClass;
+use crate::mode::{ModeSet, MODE_COUNT};
+use nalgebra::Matrix2;
+use serde::{Deserialize, Serialize};
+
+/// The default configuration file, embedded.
+pub const DEFAULT_CONFIG_TOML: &str = include_str!("../config/primm.toml");
+
+/// A 2×2 covariance as written in TOML (`[[xx, xy], [yx, yy]]`), m².
+pub type Covariance2 = [[f64; 2]; 2];
+
+/// Complete tracker configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// Mode set, transition matrix and mode-probability settings.
+    pub imm: ImmConfig,
+    /// Association cost settings (`eq:association_cost`).
+    pub association: AssociationConfig,
+    /// Frame validation and track lifecycle.
+    pub tracker: TrackerConfig,
+    /// Per-class parameters.
+    pub classes: ClassTable,
+}
+
+/// IMM settings (paper, Sections III-D and III-F).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImmConfig {
+    /// Active modes.
+    pub modes: ModeSet,
+    /// Mode-transition probabilities `π[i][j]`, order PR, CV, CA, CT; rows sum to 1.
+    pub transition: [[f64; MODE_COUNT]; MODE_COUNT],
+    /// Mode probabilities of a new track (renormalised over the active modes).
+    pub initial_mode_probabilities: [f64; MODE_COUNT],
+    /// Exponent `τ` on the likelihoods in `eq:mode_update`; must be > 0.
+    pub likelihood_temperature: f64,
+    /// Lower bound on every active mode's probability; in `[0, 1/modes)`.
+    pub mode_probability_floor: f64,
+}
+
+/// Association cost settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AssociationConfig {
+    /// `λ_v`, metres of cost per m/s of radial-velocity difference (i.e. seconds).
+    pub velocity_weight_s: f64,
+    /// `v_max`, cap on the radial-velocity difference, m/s.
+    pub velocity_cap_mps: f64,
+}
+
+/// Frame validation and track lifecycle settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackerConfig {
+    /// Largest accepted time between consecutive frames, s.
+    pub max_frame_interval_s: f64,
+    /// Hits that confirm a tentative track.
+    pub confirmation_hits: u32,
+    /// Consecutive misses after which a tentative track is deleted.
+    pub tentative_max_misses: u32,
+    /// Consecutive misses after which a confirmed track is deleted.
+    pub confirmed_max_misses: u32,
+    /// Longest time a track may coast without an update before it is deleted, s.
+    pub max_coast_s: f64,
+}
+
+/// Per-class parameter sections.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClassTable {
+    /// Cars (and large vehicles).
+    pub car: ClassConfig,
+    /// Pedestrians (and groups).
+    pub pedestrian: ClassConfig,
+    /// Two-wheelers.
+    pub two_wheeler: ClassConfig,
+}
+
+impl ClassTable {
+    /// The section of `class`.
+    pub fn get(&self, class: ObjectClass) -> &ClassConfig {
+        match class {
+            ObjectClass::Car => &self.car,
+            ObjectClass::Pedestrian => &self.pedestrian,
+            ObjectClass::TwoWheeler => &self.two_wheeler,
+        }
+    }
+}
+
+/// Parameters of one object class.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClassConfig {
+    /// Association gate on the cost of `eq:association_cost`, m.
+    pub gate_m: f64,
+    /// Measurement noise covariance `R` of the CV, CA and CT modes, m².
+    pub measurement_noise_covariance_m2: Covariance2,
+    /// Standard deviation of the measured radial velocity, m/s.
+    pub radial_velocity_std_mps: f64,
+    /// Standard deviation of the velocity across the line of sight at initiation, m/s.
+    pub initial_tangential_speed_std_mps: f64,
+    /// Constant-velocity mode.
+    pub constant_velocity: ConstantVelocityConfig,
+    /// Constant-acceleration mode.
+    pub constant_acceleration: ConstantAccelerationConfig,
+    /// Coordinated-turn mode.
+    pub coordinated_turn: CoordinatedTurnConfig,
+    /// Learned-predictor (PR) mode.
+    pub learned: LearnedConfig,
+}
+
+/// Constant-velocity noise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantVelocityConfig {
+    /// Power spectral density of the continuous white-noise acceleration, m²/s³.
+    pub acceleration_psd_m2_per_s3: f64,
+}
+
+/// Constant-acceleration noise and initiation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantAccelerationConfig {
+    /// Power spectral density of the continuous white-noise jerk, m²/s⁵.
+    pub jerk_psd_m2_per_s5: f64,
+    /// Standard deviation of the initial acceleration, m/s².
+    pub initial_acceleration_std_mps2: f64,
+}
+
+/// Coordinated-turn noise and initiation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoordinatedTurnConfig {
+    /// Power spectral density of the continuous white-noise acceleration, m²/s³.
+    pub acceleration_psd_m2_per_s3: f64,
+    /// Power spectral density of the turn-rate random walk, rad²/s³.
+    pub turn_rate_psd_rad2_per_s3: f64,
+    /// Standard deviation of the initial turn rate, rad/s.
+    pub initial_turn_rate_std_radps: f64,
+}
+
+/// Learned-predictor (PR) noise (`eq:pr_cov`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LearnedConfig {
+    /// `Q_PR`, added to the PR covariance at every prediction, m².
+    pub process_noise_covariance_m2: Covariance2,
+    /// `R_PR`, measurement noise covariance of the PR mode, m².
+    pub measurement_noise_covariance_m2: Covariance2,
+}
+
+/// A configuration that could not be read or is invalid.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The configuration file could not be read.
+    #[error("cannot read configuration file {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The TOML is malformed, a key is unknown or a value has the wrong type.
+    #[error("configuration is not valid TOML for primm: {0}")]
+    Parse(#[from] toml::de::Error),
+    /// A value is out of its valid range.
+    #[error("configuration key `{key}` is invalid: {reason}")]
+    Invalid {
+        /// Dotted path of the key, e.g. `classes.car.gate_m`.
+        key: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config::from_toml_str(DEFAULT_CONFIG_TOML).expect("the embedded default configuration is valid")
+    }
+}
+
+fn invalid(key: impl Into<String>, reason: impl Into<String>) -> ConfigError {
+    ConfigError::Invalid { key: key.into(), reason: reason.into() }
+}
+
+fn positive(key: &str, value: f64) -> Result<(), ConfigError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(key, format!("must be a finite number > 0, got {value}")))
+    }
+}
+
+/// Checks that a 2×2 covariance is finite, symmetric and positive definite.
+fn covariance(key: &str, value: &Covariance2) -> Result<(), ConfigError> {
+    let m = to_matrix(value);
+    if m.iter().any(|v| !v.is_finite()) {
+        return Err(invalid(key, "entries must be finite"));
+    }
+    if (m[(0, 1)] - m[(1, 0)]).abs() > 1e-12 * m.abs().max().max(1.0) {
+        return Err(invalid(key, "must be symmetric"));
+    }
+    if m[(0, 0)] <= 0.0 || m.determinant() <= 0.0 {
+        return Err(invalid(key, "must be positive definite"));
+    }
+    Ok(())
+}
+
+/// A TOML covariance as a nalgebra matrix.
+pub fn to_matrix(value: &Covariance2) -> Matrix2<f64> {
+    Matrix2::new(value[0][0], value[0][1], value[1][0], value[1][1])
+}
+
+impl Config {
+    /// Parses and validates a TOML document.
+    pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
+        let config: Config = toml::from_str(text)?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Reads, parses and validates a TOML file.
+    pub fn from_file(path: &std::path::Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Io { path: path.display().to_string(), source })?;
+        Self::from_toml_str(&text)
+    }
+
+    /// This configuration with another set of active modes.
+    pub fn with_modes(mut self, modes: ModeSet) -> Self {
+        self.imm.modes = modes;
+        self
+    }
+
+    /// Checks every value; the error names the first offending key.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let imm = &self.imm;
+        if imm.modes.is_empty() {
+            return Err(invalid("imm.modes", "at least one mode must be active"));
+        }
+        for (i, row) in imm.transition.iter().enumerate() {
+            for (j, &p) in row.iter().enumerate() {
+                if !(0.0..=1.0).contains(&p) {
+                    return Err(invalid(format!("imm.transition[{i}][{j}]"), format!("must be a probability in [0, 1], got {p}")));
+                }
+            }
+            let sum: f64 = row.iter().sum();
+            if (sum - 1.0).abs() > 1e-9 {
+                return Err(invalid(format!("imm.transition[{i}]"), format!("row must sum to 1, sums to {sum}")));
+            }
+        }
+        for mode in imm.modes.iter() {
+            let i = mode.index();
+            let active_sum: f64 = imm.modes.iter().map(|to| imm.transition[i][to.index()]).sum();
+            if active_sum <= 0.0 {
+                return Err(invalid(format!("imm.transition[{i}]"), "row has no probability mass on the active modes"));
+            }
+        }
+        for (i, &p) in imm.initial_mode_probabilities.iter().enumerate() {
+            if !(0.0..=1.0).contains(&p) {
+                return Err(invalid(format!("imm.initial_mode_probabilities[{i}]"), format!("must be a probability in [0, 1], got {p}")));
+            }
+        }
+        if imm.modes.iter().map(|m| imm.initial_mode_probabilities[m.index()]).sum::<f64>() <= 0.0 {
+            return Err(invalid("imm.initial_mode_probabilities", "no probability mass on the active modes"));
+        }
+        positive("imm.likelihood_temperature", imm.likelihood_temperature)?;
+        let floor = imm.mode_probability_floor;
+        if !(floor >= 0.0 && floor < 1.0 / imm.modes.len() as f64) {
+            return Err(invalid("imm.mode_probability_floor", format!("must be in [0, 1/number of active modes), got {floor}")));
+        }
+        if !(self.association.velocity_weight_s.is_finite() && self.association.velocity_weight_s >= 0.0) {
+            return Err(invalid("association.velocity_weight_s", "must be a finite number >= 0"));
+        }
+        if !(self.association.velocity_cap_mps.is_finite() && self.association.velocity_cap_mps >= 0.0) {
+            return Err(invalid("association.velocity_cap_mps", "must be a finite number >= 0"));
+        }
+        let tracker = &self.tracker;
+        positive("tracker.max_frame_interval_s", tracker.max_frame_interval_s)?;
+        positive("tracker.max_coast_s", tracker.max_coast_s)?;
+        if tracker.confirmation_hits == 0 {
+            return Err(invalid("tracker.confirmation_hits", "must be at least 1"));
+        }
+        for class in ObjectClass::ALL {
+            let section = self.classes.get(class);
+            let key = |name: &str| format!("classes.{}.{}", class.name(), name);
+            positive(&key("gate_m"), section.gate_m)?;
+            covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
+            positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
+            positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
+            positive(&key("constant_velocity.acceleration_psd_m2_per_s3"), section.constant_velocity.acceleration_psd_m2_per_s3)?;
+            positive(&key("constant_acceleration.jerk_psd_m2_per_s5"), section.constant_acceleration.jerk_psd_m2_per_s5)?;
+            positive(&key("constant_acceleration.initial_acceleration_std_mps2"), section.constant_acceleration.initial_acceleration_std_mps2)?;
+            positive(&key("coordinated_turn.acceleration_psd_m2_per_s3"), section.coordinated_turn.acceleration_psd_m2_per_s3)?;
+            positive(&key("coordinated_turn.turn_rate_psd_rad2_per_s3"), section.coordinated_turn.turn_rate_psd_rad2_per_s3)?;
+            positive(&key("coordinated_turn.initial_turn_rate_std_radps"), section.coordinated_turn.initial_turn_rate_std_radps)?;
+            covariance(&key("learned.process_noise_covariance_m2"), &section.learned.process_noise_covariance_m2)?;
+            covariance(&key("learned.measurement_noise_covariance_m2"), &section.learned.measurement_noise_covariance_m2)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn invalid_key(text: &str) -> String {
+        match Config::from_toml_str(text) {
+            Err(ConfigError::Invalid { key, .. }) => key,
+            other => panic!("expected an invalid-key error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn the_embedded_default_configuration_is_valid() {
+        Config::default().validate().unwrap();
+    }
+
+    #[test]
+    fn a_transition_row_that_does_not_sum_to_one_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replace("[0.03, 0.91, 0.03, 0.03]", "[0.03, 0.90, 0.03, 0.03]");
+        assert_eq!(invalid_key(&text), "imm.transition[1]");
+    }
+
+    #[test]
+    fn a_negative_probability_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replace("[0.91, 0.03, 0.03, 0.03]", "[1.03, -0.03, 0.0, 0.0]");
+        assert_eq!(invalid_key(&text), "imm.transition[0][0]");
+    }
+
+    #[test]
+    fn a_non_positive_temperature_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replace("likelihood_temperature = 0.1", "likelihood_temperature = 0.0");
+        assert_eq!(invalid_key(&text), "imm.likelihood_temperature");
+    }
+
+    #[test]
+    fn an_asymmetric_covariance_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replacen(
+            "measurement_noise_covariance_m2 = [[0.09, 0.0], [0.0, 0.09]]",
+            "measurement_noise_covariance_m2 = [[0.09, 0.01], [0.0, 0.09]]",
+            1,
+        );
+        assert_eq!(invalid_key(&text), "classes.pedestrian.measurement_noise_covariance_m2");
+    }
+
+    #[test]
+    fn an_indefinite_covariance_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replacen(
+            "process_noise_covariance_m2 = [[0.09, 0.0], [0.0, 0.09]]",
+            "process_noise_covariance_m2 = [[0.09, 0.5], [0.5, 0.09]]",
+            1,
+        );
+        assert_eq!(invalid_key(&text), "classes.car.learned.process_noise_covariance_m2");
+    }
+
+    #[test]
+    fn a_floor_too_high_for_the_mode_count_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replace("mode_probability_floor = 0.001", "mode_probability_floor = 0.3");
+        assert_eq!(invalid_key(&text), "imm.mode_probability_floor");
+    }
+
+    #[test]
+    fn an_unknown_key_is_a_parse_error_that_names_it() {
+        let text = DEFAULT_CONFIG_TOML.replace("gate_m = 6.0", "gate_m = 6.0\ngate_meters = 1.0");
+        let error = Config::from_toml_str(&text).unwrap_err().to_string();
+        assert!(error.contains("gate_meters"), "{error}");
+    }
+
+    #[test]
+    fn an_empty_mode_set_is_rejected() {
+        let text = DEFAULT_CONFIG_TOML.replace(r#"modes = ["pr", "cv", "ca", "ct"]"#, "modes = []");
+        assert_eq!(invalid_key(&text), "imm.modes");
+    }
+}

@@ -1,0 +1,192 @@
+//! The four IMM modes, sets of active modes, and the six methods of the paper's tables.
+
+use serde::{Deserialize, Serialize};
+
+/// Number of modes primm knows.
+pub const MODE_COUNT: usize = 4;
+
+/// One IMM mode. The order (`PR, CV, CA, CT`) is the order of every per-mode vector and matrix
+/// in primm: configuration, mode probabilities and output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Mode {
+    /// PR: the learned displacement predictor (paper, Section III-C), state `[x, y]`.
+    #[serde(rename = "pr")]
+    Learned = 0,
+    /// CV: constant velocity (`eq:cv_F`), state `[x, y, vx, vy]`.
+    #[serde(rename = "cv")]
+    ConstantVelocity = 1,
+    /// CA: constant acceleration (`eq:ca_F`), state `[x, y, vx, vy, ax, ay]`.
+    #[serde(rename = "ca")]
+    ConstantAcceleration = 2,
+    /// CT: coordinated turn (`eq:ct_x` … `eq:ct_vy`), state `[x, y, vx, vy, ω]`.
+    #[serde(rename = "ct")]
+    CoordinatedTurn = 3,
+}
+
+impl Mode {
+    /// All modes in primm's order.
+    pub const ALL: [Mode; MODE_COUNT] =
+        [Mode::Learned, Mode::ConstantVelocity, Mode::ConstantAcceleration, Mode::CoordinatedTurn];
+
+    /// Index of the mode in per-mode arrays.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Short id used in configuration and output (`pr`, `cv`, `ca`, `ct`).
+    pub fn id(self) -> &'static str {
+        match self {
+            Mode::Learned => "pr",
+            Mode::ConstantVelocity => "cv",
+            Mode::ConstantAcceleration => "ca",
+            Mode::CoordinatedTurn => "ct",
+        }
+    }
+}
+
+/// A set of modes, as a bit mask indexed by [`Mode::index`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct ModeSet(u8);
+
+impl ModeSet {
+    /// No mode.
+    pub const EMPTY: ModeSet = ModeSet(0);
+    /// All four modes (PR-IMM).
+    pub const ALL: ModeSet = ModeSet(0b1111);
+
+    /// The set of the given modes.
+    pub fn of(modes: &[Mode]) -> Self {
+        modes.iter().fold(Self::EMPTY, |set, &mode| set.with(mode))
+    }
+
+    /// This set plus `mode`.
+    pub fn with(self, mode: Mode) -> Self {
+        ModeSet(self.0 | (1 << mode.index()))
+    }
+
+    /// This set without `mode`.
+    pub fn without(self, mode: Mode) -> Self {
+        ModeSet(self.0 & !(1 << mode.index()))
+    }
+
+    /// Whether `mode` is in the set.
+    pub fn contains(self, mode: Mode) -> bool {
+        self.0 & (1 << mode.index()) != 0
+    }
+
+    /// Number of modes in the set.
+    pub fn len(self) -> usize {
+        self.0.count_ones() as usize
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The modes of the set in primm's order.
+    pub fn iter(self) -> impl Iterator<Item = Mode> {
+        Mode::ALL.into_iter().filter(move |&mode| self.contains(mode))
+    }
+}
+
+impl Serialize for ModeSet {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.iter())
+    }
+}
+
+impl<'de> Deserialize<'de> for ModeSet {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let modes = Vec::<Mode>::deserialize(deserializer)?;
+        Ok(ModeSet::of(&modes))
+    }
+}
+
+/// The six methods compared in the paper's Section IV, each a set of active modes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Method {
+    /// Constant-velocity Kalman filter.
+    #[serde(rename = "cv")]
+    ConstantVelocity,
+    /// Constant-acceleration Kalman filter.
+    #[serde(rename = "ca")]
+    ConstantAcceleration,
+    /// Coordinated-turn extended Kalman filter.
+    #[serde(rename = "ct")]
+    CoordinatedTurn,
+    /// The learned predictor alone.
+    #[serde(rename = "pr")]
+    Learned,
+    /// IMM of CV, CA and CT.
+    #[serde(rename = "imm")]
+    Imm,
+    /// IMM of PR, CV, CA and CT.
+    #[serde(rename = "pr-imm")]
+    PrImm,
+}
+
+impl Method {
+    /// All methods in the order of the paper's tables.
+    pub const ALL: [Method; 6] = [
+        Method::ConstantVelocity,
+        Method::ConstantAcceleration,
+        Method::CoordinatedTurn,
+        Method::Learned,
+        Method::Imm,
+        Method::PrImm,
+    ];
+
+    /// The active modes of the method.
+    pub fn modes(self) -> ModeSet {
+        match self {
+            Method::ConstantVelocity => ModeSet::of(&[Mode::ConstantVelocity]),
+            Method::ConstantAcceleration => ModeSet::of(&[Mode::ConstantAcceleration]),
+            Method::CoordinatedTurn => ModeSet::of(&[Mode::CoordinatedTurn]),
+            Method::Learned => ModeSet::of(&[Mode::Learned]),
+            Method::Imm => ModeSet::of(&[
+                Mode::ConstantVelocity,
+                Mode::ConstantAcceleration,
+                Mode::CoordinatedTurn,
+            ]),
+            Method::PrImm => ModeSet::ALL,
+        }
+    }
+
+    /// Short id used on the command line and in reports.
+    pub fn id(self) -> &'static str {
+        match self {
+            Method::ConstantVelocity => "cv",
+            Method::ConstantAcceleration => "ca",
+            Method::CoordinatedTurn => "ct",
+            Method::Learned => "pr",
+            Method::Imm => "imm",
+            Method::PrImm => "pr-imm",
+        }
+    }
+
+    /// Parses a short id.
+    pub fn from_id(id: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|method| method.id() == id)
+    }
+
+    /// Whether the method needs the learned predictor.
+    pub fn needs_predictor(self) -> bool {
+        self.modes().contains(Mode::Learned)
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.id())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::from_id(s).ok_or_else(|| {
+            format!("unknown method '{s}' (expected one of cv, ca, ct, pr, imm, pr-imm)")
+        })
+    }
+}

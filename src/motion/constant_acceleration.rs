@@ -1,0 +1,105 @@
+//! Constant-acceleration model (`eq:ca_F`), state `[x, y, vx, vy, ax, ay]`.
+
+use super::{InitialVelocity, MotionModel, PredictContext};
+use crate::gaussian::Gaussian;
+use crate::measurement::Measurement;
+use nalgebra::{Matrix2, Matrix6, Vector6};
+
+/// Named state indices.
+pub mod index {
+    /// x position, m.
+    pub const X: usize = 0;
+    /// y position, m.
+    pub const Y: usize = 1;
+    /// x velocity, m/s.
+    pub const VX: usize = 2;
+    /// y velocity, m/s.
+    pub const VY: usize = 3;
+    /// x acceleration, m/s².
+    pub const AX: usize = 4;
+    /// y acceleration, m/s².
+    pub const AY: usize = 5;
+}
+
+/// Constant acceleration with continuous white-noise jerk (Wiener-process acceleration).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConstantAcceleration {
+    /// Jerk power spectral density, m²/s⁵.
+    pub jerk_psd_m2_per_s5: f64,
+    /// Standard deviation of the initial acceleration, m/s².
+    pub initial_acceleration_std_mps2: f64,
+    /// Measurement noise covariance, m².
+    pub measurement_noise_m2: Matrix2<f64>,
+    /// Velocity initiation.
+    pub initial_velocity: InitialVelocity,
+}
+
+const AXES: [[usize; 3]; 2] = [[index::X, index::VX, index::AX], [index::Y, index::VY, index::AY]];
+
+impl ConstantAcceleration {
+    /// A model with the given noise.
+    pub fn new(
+        jerk_psd_m2_per_s5: f64,
+        initial_acceleration_std_mps2: f64,
+        measurement_noise_m2: Matrix2<f64>,
+        initial_velocity: InitialVelocity,
+    ) -> Self {
+        Self { jerk_psd_m2_per_s5, initial_acceleration_std_mps2, measurement_noise_m2, initial_velocity }
+    }
+
+    /// The transition matrix `F(Δt)` of `eq:ca_F` in position-first order.
+    pub fn transition(dt: f64) -> Matrix6<f64> {
+        let mut f = Matrix6::identity();
+        for [p, v, a] in AXES {
+            f[(p, v)] = dt;
+            f[(p, a)] = 0.5 * dt * dt;
+            f[(v, a)] = dt;
+        }
+        f
+    }
+
+    /// The process noise `Q(Δt)`.
+    pub fn process_noise(&self, dt: f64) -> Matrix6<f64> {
+        let q = self.jerk_psd_m2_per_s5;
+        let (dt2, dt3) = (dt * dt, dt * dt * dt);
+        let block = [
+            [dt3 * dt2 / 20.0, dt2 * dt2 / 8.0, dt3 / 6.0],
+            [dt2 * dt2 / 8.0, dt3 / 3.0, dt2 / 2.0],
+            [dt3 / 6.0, dt2 / 2.0, dt],
+        ];
+        let mut m = Matrix6::zeros();
+        for axis in AXES {
+            for (r, &row) in axis.iter().enumerate() {
+                for (c, &col) in axis.iter().enumerate() {
+                    m[(row, col)] = q * block[r][c];
+                }
+            }
+        }
+        m
+    }
+}
+
+impl MotionModel<6> for ConstantAcceleration {
+    fn initiate(&self, measurement: &Measurement) -> Gaussian<6> {
+        let (velocity, velocity_covariance) = self.initial_velocity.estimate(measurement);
+        let mut covariance = Matrix6::zeros();
+        covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&self.measurement_noise_m2);
+        covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
+        let acceleration_variance = self.initial_acceleration_std_mps2.powi(2);
+        covariance[(index::AX, index::AX)] = acceleration_variance;
+        covariance[(index::AY, index::AY)] = acceleration_variance;
+        let mean = Vector6::new(measurement.x_m, measurement.y_m, velocity.x, velocity.y, 0.0, 0.0);
+        Gaussian::new(mean, covariance)
+    }
+
+    fn predict(&self, posterior: &Gaussian<6>, context: &PredictContext) -> Gaussian<6> {
+        let f = Self::transition(context.dt_s);
+        let mut covariance = f * posterior.covariance * f.transpose() + self.process_noise(context.dt_s);
+        crate::gaussian::symmetrize(&mut covariance);
+        Gaussian::new(f * posterior.mean, covariance)
+    }
+
+    fn measurement_noise(&self) -> Matrix2<f64> {
+        self.measurement_noise_m2
+    }
+}

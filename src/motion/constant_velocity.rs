@@ -1,0 +1,79 @@
+//! Constant-velocity model (`eq:cv_F`), state `[x, y, vx, vy]`.
+
+use super::{white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
+use crate::gaussian::Gaussian;
+use crate::measurement::Measurement;
+use nalgebra::{Matrix2, Matrix4, Vector4};
+
+/// Named state indices.
+pub mod index {
+    /// x position, m.
+    pub const X: usize = 0;
+    /// y position, m.
+    pub const Y: usize = 1;
+    /// x velocity, m/s.
+    pub const VX: usize = 2;
+    /// y velocity, m/s.
+    pub const VY: usize = 3;
+}
+
+/// Constant velocity with continuous white-noise acceleration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConstantVelocity {
+    /// Acceleration power spectral density, m²/s³.
+    pub acceleration_psd_m2_per_s3: f64,
+    /// Measurement noise covariance, m².
+    pub measurement_noise_m2: Matrix2<f64>,
+    /// Velocity initiation.
+    pub initial_velocity: InitialVelocity,
+}
+
+impl ConstantVelocity {
+    /// A model with the given noise.
+    pub fn new(acceleration_psd_m2_per_s3: f64, measurement_noise_m2: Matrix2<f64>, initial_velocity: InitialVelocity) -> Self {
+        Self { acceleration_psd_m2_per_s3, measurement_noise_m2, initial_velocity }
+    }
+
+    /// The transition matrix `F(Δt)` of `eq:cv_F` in position-first order.
+    pub fn transition(dt: f64) -> Matrix4<f64> {
+        let mut f = Matrix4::identity();
+        f[(index::X, index::VX)] = dt;
+        f[(index::Y, index::VY)] = dt;
+        f
+    }
+
+    /// The process noise `Q(Δt)`.
+    pub fn process_noise(&self, dt: f64) -> Matrix4<f64> {
+        let block = white_acceleration_block(dt);
+        let q = self.acceleration_psd_m2_per_s3;
+        let mut m = Matrix4::zeros();
+        for (position, velocity) in [(index::X, index::VX), (index::Y, index::VY)] {
+            m[(position, position)] = q * block[0][0];
+            m[(position, velocity)] = q * block[0][1];
+            m[(velocity, position)] = q * block[1][0];
+            m[(velocity, velocity)] = q * block[1][1];
+        }
+        m
+    }
+}
+
+impl MotionModel<4> for ConstantVelocity {
+    fn initiate(&self, measurement: &Measurement) -> Gaussian<4> {
+        let (velocity, velocity_covariance) = self.initial_velocity.estimate(measurement);
+        let mut covariance = Matrix4::zeros();
+        covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&self.measurement_noise_m2);
+        covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
+        Gaussian::new(Vector4::new(measurement.x_m, measurement.y_m, velocity.x, velocity.y), covariance)
+    }
+
+    fn predict(&self, posterior: &Gaussian<4>, context: &PredictContext) -> Gaussian<4> {
+        let f = Self::transition(context.dt_s);
+        let mut covariance = f * posterior.covariance * f.transpose() + self.process_noise(context.dt_s);
+        crate::gaussian::symmetrize(&mut covariance);
+        Gaussian::new(f * posterior.mean, covariance)
+    }
+
+    fn measurement_noise(&self) -> Matrix2<f64> {
+        self.measurement_noise_m2
+    }
+}

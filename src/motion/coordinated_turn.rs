@@ -1,0 +1,176 @@
+//! Coordinated-turn model (`eq:ct_x` … `eq:ct_vy`), state `[x, y, vx, vy, ω]`, propagated as an
+//! extended Kalman filter with the analytic Jacobian.
+//!
+//! With `φ = ωΔt` the transition is written through two smooth functions,
+//! `s(φ) = sin φ / φ` and `g(φ) = (1 − cos φ) / φ`:
+//! `x⁺ = x + Δt (s vx − g vy)`, `y⁺ = y + Δt (g vx + s vy)`, `vx⁺ = cos φ vx − sin φ vy`,
+//! `vy⁺ = sin φ vx + cos φ vy`, `ω⁺ = ω`. This is exactly the paper's form for `ω ≠ 0`
+//! (`sin φ / ω = Δt s(φ)`), and for `|φ| <` [`TAYLOR_THRESHOLD`] `s`, `g` and their derivatives
+//! come from Taylor series whose truncation error (`< φ⁶/5040`) is far below double precision,
+//! so the switch has no visible discontinuity and nothing divides by a vanishing `ω`.
+
+use super::{white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
+use crate::gaussian::Gaussian;
+use crate::measurement::Measurement;
+use nalgebra::{Matrix2, SMatrix, SVector};
+
+/// 5×5 matrix.
+pub type Matrix5 = SMatrix<f64, 5, 5>;
+/// 5-vector.
+pub type Vector5 = SVector<f64, 5>;
+
+/// Named state indices.
+pub mod index {
+    /// x position, m.
+    pub const X: usize = 0;
+    /// y position, m.
+    pub const Y: usize = 1;
+    /// x velocity, m/s.
+    pub const VX: usize = 2;
+    /// y velocity, m/s.
+    pub const VY: usize = 3;
+    /// Turn rate, rad/s (positive counter-clockwise).
+    pub const OMEGA: usize = 4;
+}
+
+/// Below this `|ωΔt|` (rad) the Taylor series replace the closed forms.
+pub const TAYLOR_THRESHOLD: f64 = 1e-3;
+
+/// Coordinated turn with white-noise acceleration and a random-walk turn rate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoordinatedTurn {
+    /// Acceleration power spectral density, m²/s³.
+    pub acceleration_psd_m2_per_s3: f64,
+    /// Turn-rate power spectral density, rad²/s³.
+    pub turn_rate_psd_rad2_per_s3: f64,
+    /// Standard deviation of the initial turn rate, rad/s.
+    pub initial_turn_rate_std_radps: f64,
+    /// Measurement noise covariance, m².
+    pub measurement_noise_m2: Matrix2<f64>,
+    /// Velocity initiation.
+    pub initial_velocity: InitialVelocity,
+}
+
+/// `s(φ) = sin φ/φ`, `g(φ) = (1 − cos φ)/φ` and their derivatives `s'`, `g'`, choosing the
+/// series below [`TAYLOR_THRESHOLD`] and the closed forms above it.
+pub fn turn_functions(phi: f64) -> (f64, f64, f64, f64) {
+    if phi.abs() < TAYLOR_THRESHOLD {
+        turn_functions_series(phi)
+    } else {
+        turn_functions_closed_form(phi)
+    }
+}
+
+/// Taylor series of [`turn_functions`] around `φ = 0` (exact to `O(φ⁶)`).
+pub fn turn_functions_series(phi: f64) -> (f64, f64, f64, f64) {
+    let p2 = phi * phi;
+    let s = 1.0 - p2 / 6.0 + p2 * p2 / 120.0;
+    let g = phi * (0.5 - p2 / 24.0 + p2 * p2 / 720.0);
+    let ds = phi * (-1.0 / 3.0 + p2 / 30.0);
+    let dg = 0.5 - p2 / 8.0 + p2 * p2 / 144.0;
+    (s, g, ds, dg)
+}
+
+/// Closed forms of [`turn_functions`]; undefined at `φ = 0`.
+pub fn turn_functions_closed_form(phi: f64) -> (f64, f64, f64, f64) {
+    let (sin, cos) = phi.sin_cos();
+    let s = sin / phi;
+    let g = (1.0 - cos) / phi;
+    let ds = (phi * cos - sin) / (phi * phi);
+    let dg = (phi * sin - (1.0 - cos)) / (phi * phi);
+    (s, g, ds, dg)
+}
+
+impl CoordinatedTurn {
+    /// A model with the given noise.
+    pub fn new(
+        acceleration_psd_m2_per_s3: f64,
+        turn_rate_psd_rad2_per_s3: f64,
+        initial_turn_rate_std_radps: f64,
+        measurement_noise_m2: Matrix2<f64>,
+        initial_velocity: InitialVelocity,
+    ) -> Self {
+        Self {
+            acceleration_psd_m2_per_s3,
+            turn_rate_psd_rad2_per_s3,
+            initial_turn_rate_std_radps,
+            measurement_noise_m2,
+            initial_velocity,
+        }
+    }
+
+    /// The transition `f(x, Δt)`.
+    pub fn transition(state: &Vector5, dt: f64) -> Vector5 {
+        let (vx, vy, omega) = (state[index::VX], state[index::VY], state[index::OMEGA]);
+        let phi = omega * dt;
+        let (s, g, _, _) = turn_functions(phi);
+        let (sin, cos) = phi.sin_cos();
+        Vector5::new(
+            state[index::X] + dt * (s * vx - g * vy),
+            state[index::Y] + dt * (g * vx + s * vy),
+            cos * vx - sin * vy,
+            sin * vx + cos * vy,
+            omega,
+        )
+    }
+
+    /// The Jacobian `∂f/∂x` at `state`.
+    pub fn jacobian(state: &Vector5, dt: f64) -> Matrix5 {
+        let (vx, vy, omega) = (state[index::VX], state[index::VY], state[index::OMEGA]);
+        let phi = omega * dt;
+        let (s, g, ds, dg) = turn_functions(phi);
+        let (sin, cos) = phi.sin_cos();
+        let mut j = Matrix5::identity();
+        j[(index::X, index::VX)] = dt * s;
+        j[(index::X, index::VY)] = -dt * g;
+        j[(index::X, index::OMEGA)] = dt * dt * (ds * vx - dg * vy);
+        j[(index::Y, index::VX)] = dt * g;
+        j[(index::Y, index::VY)] = dt * s;
+        j[(index::Y, index::OMEGA)] = dt * dt * (dg * vx + ds * vy);
+        j[(index::VX, index::VX)] = cos;
+        j[(index::VX, index::VY)] = -sin;
+        j[(index::VX, index::OMEGA)] = dt * (-sin * vx - cos * vy);
+        j[(index::VY, index::VX)] = sin;
+        j[(index::VY, index::VY)] = cos;
+        j[(index::VY, index::OMEGA)] = dt * (cos * vx - sin * vy);
+        j
+    }
+
+    /// The process noise `Q(Δt)`.
+    pub fn process_noise(&self, dt: f64) -> Matrix5 {
+        let block = white_acceleration_block(dt);
+        let q = self.acceleration_psd_m2_per_s3;
+        let mut m = Matrix5::zeros();
+        for (position, velocity) in [(index::X, index::VX), (index::Y, index::VY)] {
+            m[(position, position)] = q * block[0][0];
+            m[(position, velocity)] = q * block[0][1];
+            m[(velocity, position)] = q * block[1][0];
+            m[(velocity, velocity)] = q * block[1][1];
+        }
+        m[(index::OMEGA, index::OMEGA)] = self.turn_rate_psd_rad2_per_s3 * dt;
+        m
+    }
+}
+
+impl MotionModel<5> for CoordinatedTurn {
+    fn initiate(&self, measurement: &Measurement) -> Gaussian<5> {
+        let (velocity, velocity_covariance) = self.initial_velocity.estimate(measurement);
+        let mut covariance = Matrix5::zeros();
+        covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&self.measurement_noise_m2);
+        covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
+        covariance[(index::OMEGA, index::OMEGA)] = self.initial_turn_rate_std_radps.powi(2);
+        Gaussian::new(Vector5::new(measurement.x_m, measurement.y_m, velocity.x, velocity.y, 0.0), covariance)
+    }
+
+    fn predict(&self, posterior: &Gaussian<5>, context: &PredictContext) -> Gaussian<5> {
+        let dt = context.dt_s;
+        let f = Self::jacobian(&posterior.mean, dt);
+        let mut covariance = f * posterior.covariance * f.transpose() + self.process_noise(dt);
+        crate::gaussian::symmetrize(&mut covariance);
+        Gaussian::new(Self::transition(&posterior.mean, dt), covariance)
+    }
+
+    fn measurement_noise(&self) -> Matrix2<f64> {
+        self.measurement_noise_m2
+    }
+}

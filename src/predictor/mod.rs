@@ -1,0 +1,83 @@
+//! The learned displacement predictor behind a small trait (paper, Section III-C).
+//!
+//! The tracker builds one [`PredictionRequest`] per live track and frame: the track's last
+//! `L ≤ 5` associated measurements laid out as `eq:pr_input` (positions relative to the latest
+//! measurement, radial velocity, RCS, time relative to the prediction time). A
+//! [`DisplacementPredictor`] answers a whole batch at once; `None` for a request means "no
+//! prediction this frame" and the PR mode sits the frame out for that track.
+
+use glam::DVec2;
+
+/// Longest history the predictor reads (`L` in `eq:pr_input`).
+pub const MAX_HISTORY: usize = 5;
+/// Features per history step: `[x − x_{k−1}, y − y_{k−1}, v_r, RCS, t − t_k]`.
+pub const FEATURES: usize = 5;
+
+/// One associated measurement in a track's history, absolute values.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HistoryEntry {
+    /// x position, m.
+    pub x_m: f64,
+    /// y position, m.
+    pub y_m: f64,
+    /// Radial velocity, m/s.
+    pub radial_velocity_mps: f64,
+    /// Radar cross section, dBsm.
+    pub rcs_dbsm: f64,
+    /// Measurement time, s.
+    pub timestamp_s: f64,
+}
+
+/// A track's prediction input, laid out as `eq:pr_input`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PredictionRequest {
+    /// Rows `0..len` hold the history oldest first; rows `len..` are zero padding.
+    pub features: [[f32; FEATURES]; MAX_HISTORY],
+    /// Number of valid rows (1..=5).
+    pub len: usize,
+    /// The latest measured position `z_{k−1}` in absolute coordinates, m (not a model input;
+    /// lets an oracle or a diagnostic relate the request to the scene).
+    pub anchor_m: DVec2,
+    /// Prediction time `t_k`, s (not a model input).
+    pub prediction_time_s: f64,
+}
+
+impl PredictionRequest {
+    /// Builds the request from a history (oldest first, at least one entry, at most
+    /// [`MAX_HISTORY`] used: the latest ones) and the prediction time.
+    pub fn from_history(history: &[HistoryEntry], prediction_time_s: f64) -> Self {
+        let start = history.len().saturating_sub(MAX_HISTORY);
+        let history = &history[start..];
+        let mut request = PredictionRequest { len: history.len(), prediction_time_s, ..Default::default() };
+        if let Some(latest) = history.last() {
+            request.anchor_m = DVec2::new(latest.x_m, latest.y_m);
+            for (row, entry) in request.features.iter_mut().zip(history) {
+                *row = [
+                    (entry.x_m - latest.x_m) as f32,
+                    (entry.y_m - latest.y_m) as f32,
+                    entry.radial_velocity_mps as f32,
+                    entry.rcs_dbsm as f32,
+                    (entry.timestamp_s - prediction_time_s) as f32,
+                ];
+            }
+        }
+        request
+    }
+}
+
+/// Predicts the next displacement of many tracks at once.
+pub trait DisplacementPredictor {
+    /// Fills `displacements[i]` for `requests[i]` (`displacements.len() == requests.len()`);
+    /// `None` where no prediction is available.
+    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]);
+}
+
+/// A predictor that never predicts: the PR mode sits out every frame.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoPredictor;
+
+impl DisplacementPredictor for NoPredictor {
+    fn predict(&mut self, _requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+        displacements.fill(None);
+    }
+}
