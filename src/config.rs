@@ -326,13 +326,13 @@ mod tests {
 
     #[test]
     fn a_transition_row_that_does_not_sum_to_one_is_named() {
-        let text = DEFAULT_CONFIG_TOML.replace("[0.03, 0.91, 0.03, 0.03]", "[0.03, 0.90, 0.03, 0.03]");
+        let text = DEFAULT_CONFIG_TOML.replace("[0.01, 0.97, 0.01, 0.01]", "[0.01, 0.96, 0.01, 0.01]");
         assert_eq!(invalid_key(&text), "imm.transition[1]");
     }
 
     #[test]
     fn a_negative_probability_is_named() {
-        let text = DEFAULT_CONFIG_TOML.replace("[0.91, 0.03, 0.03, 0.03]", "[1.03, -0.03, 0.0, 0.0]");
+        let text = DEFAULT_CONFIG_TOML.replace("[0.97, 0.01, 0.01, 0.01]", "[1.01, -0.01, 0.0, 0.0]");
         assert_eq!(invalid_key(&text), "imm.transition[0][0]");
     }
 
