@@ -1,5 +1,6 @@
 //! primm: PR-IMM multi-object tracking for automotive radar.
 
+pub mod association;
 pub mod measurement;
 pub mod gaussian;
 pub mod mode;

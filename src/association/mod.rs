@@ -1,0 +1,3 @@
+//! Data association: matching predicted tracks to measurements.
+
+pub mod assignment;
