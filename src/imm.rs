@@ -83,6 +83,13 @@ pub struct ImmPrior {
     pub fused: PositionEstimate,
 }
 
+/// The IMM between [`Imm::predict_physics`] and [`Imm::complete_prior`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PendingPrior {
+    state: ImmState,
+    dt_s: f64,
+}
+
 /// The IMM's configuration, prepared once: stateless and shared by all tracks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Imm {
@@ -203,42 +210,68 @@ impl Imm {
         beta
     }
 
-    /// Mixing, per-mode prediction and prior fusion.
+    /// Mixing, per-mode prediction and prior fusion in one call: [`Imm::predict_physics`]
+    /// followed by [`Imm::complete_prior`].
     pub fn predict(&self, models: &ModeModels, posterior: &ImmState, context: &PredictContext) -> ImmPrior {
+        let pending = self.predict_physics(models, posterior, context.dt_s);
+        self.complete_prior(models, &pending, context.displacement_m)
+    }
+
+    /// First half of the prediction, which needs no learned displacement: prior mode
+    /// probabilities, mixing of every mode, and the CV, CA and CT predictions. The PR mode is
+    /// left at its mixed starting point. Lets the caller predict the physics modes while the
+    /// learned predictor is still running.
+    pub fn predict_physics(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64) -> PendingPrior {
         let c = self.prior_probabilities(&posterior.probabilities);
         let mixed = |mode: Mode| {
             let beta = self.mixing_probabilities(&posterior.probabilities, &c, mode);
             mix_positions(posterior, self.modes, &beta)
         };
+        let context = PredictContext { dt_s, displacement_m: None };
         let mut state = *posterior;
         state.probabilities = c;
         for mode in self.modes.iter() {
             let start = mixed(mode);
             match mode {
                 Mode::Learned => {
-                    state.learned = mix_and_predict(&models.learned, &posterior.learned, &start, context);
-                    if let Some(displacement) = context.displacement_m {
-                        state.learned_velocity_mps = displacement / context.dt_s;
+                    if state.learned.position() != start {
+                        replace_position(&mut state.learned, &start);
                     }
                 }
                 Mode::ConstantVelocity => {
                     state.constant_velocity =
-                        mix_and_predict(&models.constant_velocity, &posterior.constant_velocity, &start, context)
+                        mix_and_predict(&models.constant_velocity, &posterior.constant_velocity, &start, &context)
                 }
                 Mode::ConstantAcceleration => {
                     state.constant_acceleration =
-                        mix_and_predict(&models.constant_acceleration, &posterior.constant_acceleration, &start, context)
+                        mix_and_predict(&models.constant_acceleration, &posterior.constant_acceleration, &start, &context)
                 }
                 Mode::CoordinatedTurn => {
                     state.coordinated_turn =
-                        mix_and_predict(&models.coordinated_turn, &posterior.coordinated_turn, &start, context)
+                        mix_and_predict(&models.coordinated_turn, &posterior.coordinated_turn, &start, &context)
                 }
             }
         }
+        PendingPrior { state, dt_s }
+    }
+
+    /// Second half of the prediction: the PR prior from the learned displacement
+    /// (`eq:pr_prior`, `eq:pr_cov`) and the fused prior (`eq:prior_fusion`). Without a
+    /// displacement the PR mode sits the step out (see the module documentation).
+    pub fn complete_prior(&self, models: &ModeModels, pending: &PendingPrior, displacement_m: Option<DVec2>) -> ImmPrior {
+        let mut state = pending.state;
+        if self.modes.contains(Mode::Learned) {
+            let context = PredictContext { dt_s: pending.dt_s, displacement_m };
+            state.learned = models.learned.predict(&state.learned, &context);
+            if let Some(displacement) = displacement_m {
+                state.learned_velocity_mps = displacement / pending.dt_s;
+            }
+        }
         let mut available = self.modes;
-        if context.displacement_m.is_none() && self.modes.len() > 1 {
+        if displacement_m.is_none() && self.modes.len() > 1 {
             available = available.without(Mode::Learned);
         }
+        let c = state.probabilities;
         let fused = mix_positions(&state, available, &renormalised(&c, available));
         ImmPrior { state, available, fused }
     }

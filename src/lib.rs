@@ -8,3 +8,7 @@ pub mod config;
 pub mod motion;
 pub mod predictor;
 pub mod imm;
+pub mod track;
+pub mod track_table;
+pub mod tracker;
+pub mod validation;

@@ -1,3 +1,5 @@
 //! Data association: matching predicted tracks to measurements.
 
 pub mod assignment;
+pub mod associator;
+pub mod cost;

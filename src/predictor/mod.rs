@@ -65,11 +65,21 @@ impl PredictionRequest {
     }
 }
 
-/// Predicts the next displacement of many tracks at once.
+/// Predicts the next displacement of many tracks at once, in two steps so that an
+/// implementation may run the batch elsewhere (another thread) while the tracker predicts its
+/// physics modes.
 pub trait DisplacementPredictor {
-    /// Fills `displacements[i]` for `requests[i]` (`displacements.len() == requests.len()`);
-    /// `None` where no prediction is available.
-    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]);
+    /// Starts predicting one batch. May return before the work is done.
+    fn submit(&mut self, requests: &[PredictionRequest]);
+    /// Delivers the batch submitted last: fills `displacements[i]` for the `i`-th request
+    /// (`displacements.len()` equals the batch size); `None` where no prediction is available,
+    /// e.g. after a missed deadline.
+    fn collect(&mut self, displacements: &mut [Option<DVec2>]);
+    /// [`submit`](Self::submit) then [`collect`](Self::collect).
+    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+        self.submit(requests);
+        self.collect(displacements);
+    }
 }
 
 /// A predictor that never predicts: the PR mode sits out every frame.
@@ -77,7 +87,17 @@ pub trait DisplacementPredictor {
 pub struct NoPredictor;
 
 impl DisplacementPredictor for NoPredictor {
-    fn predict(&mut self, _requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+    fn submit(&mut self, _requests: &[PredictionRequest]) {}
+    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
         displacements.fill(None);
+    }
+}
+
+impl<P: DisplacementPredictor + ?Sized> DisplacementPredictor for Box<P> {
+    fn submit(&mut self, requests: &[PredictionRequest]) {
+        (**self).submit(requests)
+    }
+    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+        (**self).collect(displacements)
     }
 }

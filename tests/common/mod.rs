@@ -74,3 +74,86 @@ pub fn straight_turn_straight(dt: &[f64], speed: f64, turn_start_s: f64, turn_en
     }
     out
 }
+
+use primm::measurement::Frame;
+
+/// A moving object of a hand-built scene: constant velocity from `start`.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneObject {
+    pub id: u64,
+    pub class: ObjectClass,
+    pub start: [f64; 2],
+    pub velocity: [f64; 2],
+    /// Visible during [from, to) seconds.
+    pub visible: (f64, f64),
+}
+
+impl SceneObject {
+    pub fn position(&self, t: f64) -> [f64; 2] {
+        [self.start[0] + self.velocity[0] * t, self.start[1] + self.velocity[1] * t]
+    }
+}
+
+/// Frames of a scene at a fixed interval, with Gaussian position noise of `noise_std` m.
+pub fn scene_frames(objects: &[SceneObject], frames: usize, dt: f64, noise_std: f64, seed: u64) -> Vec<Frame> {
+    let mut rng = rng(seed);
+    (0..frames)
+        .map(|k| {
+            let t = k as f64 * dt;
+            let mut frame = Frame::new(t);
+            for object in objects.iter().filter(|o| t >= o.visible.0 && t < o.visible.1) {
+                let p = object.position(t);
+                frame.measurements.push(Measurement {
+                    x_m: p[0] + standard_normal(&mut rng) * noise_std,
+                    y_m: p[1] + standard_normal(&mut rng) * noise_std,
+                    radial_velocity_mps: radial_velocity(p, object.velocity) + standard_normal(&mut rng) * 0.1,
+                    rcs_dbsm: 10.0,
+                    class: object.class,
+                    sensor_id: Some(0),
+                    ground_truth_id: Some(object.id),
+                });
+            }
+            frame
+        })
+        .collect()
+}
+
+/// `count` objects on parallel lanes 4 m apart, alternating cars and pedestrians.
+pub fn lanes(count: usize) -> Vec<SceneObject> {
+    (0..count)
+        .map(|i| {
+            let class = if i % 2 == 0 { ObjectClass::Car } else { ObjectClass::Pedestrian };
+            let speed = if class == ObjectClass::Car { 8.0 + (i % 5) as f64 } else { 1.2 + 0.1 * (i % 4) as f64 };
+            SceneObject {
+                id: i as u64 + 1,
+                class,
+                start: [5.0 + (i % 3) as f64 * 10.0, -128.0 + 4.0 * i as f64],
+                velocity: [speed, 0.0],
+                visible: (0.0, f64::INFINITY),
+            }
+        })
+        .collect()
+}
+
+/// A predictor that knows the lane scene: it finds the object nearest to the request's anchor
+/// and returns its exact displacement over the step. Allocates nothing.
+pub struct LaneOracle {
+    pub objects: Vec<SceneObject>,
+}
+
+impl primm::predictor::DisplacementPredictor for LaneOracle {
+    fn submit(&mut self, _requests: &[primm::predictor::PredictionRequest]) {}
+    fn collect(&mut self, _displacements: &mut [Option<glam::DVec2>]) {}
+    fn predict(&mut self, requests: &[primm::predictor::PredictionRequest], displacements: &mut [Option<glam::DVec2>]) {
+        for (request, out) in requests.iter().zip(displacements.iter_mut()) {
+            let step = -f64::from(request.features[request.len - 1][4]);
+            let t = request.prediction_time_s - step;
+            let nearest = self.objects.iter().min_by(|a, b| {
+                let da = (glam::DVec2::from(a.position(t)) - request.anchor_m).length();
+                let db = (glam::DVec2::from(b.position(t)) - request.anchor_m).length();
+                da.total_cmp(&db)
+            });
+            *out = nearest.map(|o| glam::DVec2::from(o.velocity) * step);
+        }
+    }
+}

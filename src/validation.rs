@@ -1,0 +1,96 @@
+//! Checks on every frame and measurement before anything touches a track.
+//!
+//! A frame-level fault rejects the whole frame: [`FrameError`]. A fault confined to one
+//! measurement rejects only that measurement ([`MeasurementRejection`]) and the rest of the
+//! frame is tracked; this is safe because a measurement never affects another one except
+//! through association, which simply does not see the rejected one.
+
+use crate::config::TrackerConfig;
+use crate::measurement::{FrameView, Measurement, MAX_MEASUREMENTS_PER_FRAME};
+
+/// Largest accepted magnitude of a position, radial velocity or RCS value. Anything beyond is
+/// not a radar measurement and would overflow squared distances.
+pub const MAX_ABSOLUTE_VALUE: f64 = 1.0e6;
+
+/// Why a whole frame was rejected. The tracker is left exactly as before the frame.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum FrameError {
+    /// The timestamp is NaN or infinite.
+    #[error("frame timestamp {timestamp_s} is not finite")]
+    NonFiniteTimestamp {
+        /// The timestamp, s.
+        timestamp_s: f64,
+    },
+    /// The timestamp is not later than the previous accepted frame's.
+    #[error("frame timestamp {timestamp_s} s does not advance past the previous frame at {previous_s} s")]
+    TimestampNotIncreasing {
+        /// The timestamp, s.
+        timestamp_s: f64,
+        /// The previous accepted frame's timestamp, s.
+        previous_s: f64,
+    },
+    /// The time since the previous accepted frame exceeds `tracker.max_frame_interval_s`.
+    /// Tracks cannot be bridged over such a gap; the caller may [`reset`](crate::tracker::Tracker::reset)
+    /// the tracker and resubmit the frame.
+    #[error("frame interval {interval_s} s exceeds the maximum of {max_s} s")]
+    IntervalTooLong {
+        /// The interval, s.
+        interval_s: f64,
+        /// The configured maximum, s.
+        max_s: f64,
+    },
+    /// The frame claims more measurements than a frame may carry.
+    #[error("frame carries {count} measurements, more than the maximum of {MAX_MEASUREMENTS_PER_FRAME}")]
+    TooManyMeasurements {
+        /// The claimed count.
+        count: usize,
+    },
+}
+
+/// Why one measurement was left out of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MeasurementRejection {
+    /// Its class code names no known class.
+    UnknownClass,
+    /// A value is NaN or infinite.
+    NonFinite,
+    /// A value's magnitude exceeds [`MAX_ABSOLUTE_VALUE`].
+    OutOfRange,
+}
+
+/// Checks the frame-level fields; returns the interval since `previous_s` (0 for the first frame).
+pub fn validate_frame<F: FrameView + ?Sized>(
+    frame: &F,
+    previous_s: Option<f64>,
+    config: &TrackerConfig,
+) -> Result<f64, FrameError> {
+    let timestamp_s = frame.timestamp_s();
+    if !timestamp_s.is_finite() {
+        return Err(FrameError::NonFiniteTimestamp { timestamp_s });
+    }
+    if frame.len() > MAX_MEASUREMENTS_PER_FRAME {
+        return Err(FrameError::TooManyMeasurements { count: frame.len() });
+    }
+    let Some(previous_s) = previous_s else { return Ok(0.0) };
+    let interval_s = timestamp_s - previous_s;
+    if interval_s <= 0.0 {
+        return Err(FrameError::TimestampNotIncreasing { timestamp_s, previous_s });
+    }
+    if interval_s > config.max_frame_interval_s {
+        return Err(FrameError::IntervalTooLong { interval_s, max_s: config.max_frame_interval_s });
+    }
+    Ok(interval_s)
+}
+
+/// Decodes and checks measurement `index` of `frame`.
+pub fn validate_measurement<F: FrameView + ?Sized>(frame: &F, index: usize) -> Result<Measurement, MeasurementRejection> {
+    let measurement = frame.measurement(index).map_err(|_| MeasurementRejection::UnknownClass)?;
+    let values = [measurement.x_m, measurement.y_m, measurement.radial_velocity_mps, measurement.rcs_dbsm];
+    if values.iter().any(|v| !v.is_finite()) {
+        return Err(MeasurementRejection::NonFinite);
+    }
+    if values.iter().any(|v| v.abs() > MAX_ABSOLUTE_VALUE) {
+        return Err(MeasurementRejection::OutOfRange);
+    }
+    Ok(measurement)
+}
