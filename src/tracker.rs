@@ -146,6 +146,27 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Tracks one frame and returns the state of every live track.
     pub fn step<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<&[TrackOutput], StepError> {
+        self.advance(frame)?;
+        self.outputs.clear();
+        let outputs = &mut self.outputs;
+        report(&self.table, &self.rows[..], &self.imm, |output| outputs.push(*output));
+        Ok(&self.outputs)
+    }
+
+    /// Tracks one frame and hands every live track's output to `sink`, in table order, instead
+    /// of collecting them: lets a caller write them straight into their destination (e.g. a
+    /// loaned shared-memory sample). Returns the number of outputs.
+    pub fn step_into<F: FrameView + ?Sized>(
+        &mut self,
+        frame: &F,
+        sink: impl FnMut(&TrackOutput),
+    ) -> Result<usize, StepError> {
+        self.advance(frame)?;
+        Ok(report(&self.table, &self.rows[..], &self.imm, sink))
+    }
+
+    /// Everything but the report.
+    fn advance<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<(), StepError> {
         let dt_s = self.validate(frame)?;
         let t = frame.timestamp_s();
         self.request_learned_predictions(t);
@@ -156,10 +177,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.coast();
         self.initiate(frame, t);
         self.delete(t);
-        self.report();
         self.last_timestamp_s = Some(t);
         self.stats.frames_tracked += 1;
-        Ok(&self.outputs)
+        Ok(())
     }
 
     /// Frame checks, then per-measurement checks; counts every rejection.
@@ -339,29 +359,6 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.stats.tracks_deleted += deleted as u64;
     }
 
-    /// Writes the output record of every live track.
-    fn report(&mut self) {
-        self.outputs.clear();
-        for (track, row) in self.table.tracks().iter().zip(self.rows.iter()) {
-            let fused = self.imm.fuse_posterior(&track.estimate, row.available);
-            self.outputs.push(TrackOutput {
-                id: track.id,
-                class: track.class,
-                status: track.status,
-                position_m: fused.mean,
-                position_covariance_m2: fused.covariance,
-                velocity_mps: self.imm.fuse_velocity(&track.estimate, row.available),
-                prior_position_m: row.prior_position_m,
-                mode_probabilities: track.estimate.probabilities,
-                age_frames: track.age_frames,
-                hits: track.hits,
-                misses: track.misses,
-                ground_truth_id: row.measurement_index.and(track.ground_truth_id),
-                measurement_index: row.measurement_index,
-            });
-        }
-    }
-
     /// Removes every track and forgets the last timestamp, e.g. after a gap in the stream that
     /// [`FrameError::IntervalTooLong`] reported. Ids keep counting; statistics are kept.
     pub fn reset(&mut self) {
@@ -396,3 +393,25 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 }
 
+/// The output record of every live track, handed to `sink`; returns the count.
+fn report(table: &TrackTable, rows: &[RowRecord], imm: &Imm, mut sink: impl FnMut(&TrackOutput)) -> usize {
+    for (track, row) in table.tracks().iter().zip(rows.iter()) {
+        let fused = imm.fuse_posterior(&track.estimate, row.available);
+        sink(&TrackOutput {
+            id: track.id,
+            class: track.class,
+            status: track.status,
+            position_m: fused.mean,
+            position_covariance_m2: fused.covariance,
+            velocity_mps: imm.fuse_velocity(&track.estimate, row.available),
+            prior_position_m: row.prior_position_m,
+            mode_probabilities: track.estimate.probabilities,
+            age_frames: track.age_frames,
+            hits: track.hits,
+            misses: track.misses,
+            ground_truth_id: row.measurement_index.and(track.ground_truth_id),
+            measurement_index: row.measurement_index,
+        });
+    }
+    table.len()
+}
