@@ -664,7 +664,7 @@ impl ScenarioConfig {
         ped.mid_block_crossing_probability = 0.3;
         let radar = &mut config.radar;
         radar.phase_jitter_s = 0.003;
-        radar.scan_jitter_s = 0.0045;
+        radar.scan_jitter_s = 0.004;
         radar.range_noise_m = 0.25;
         radar.azimuth_noise_deg = 1.2;
         radar.doppler_noise_mps = 0.2;
@@ -742,19 +742,6 @@ impl ScenarioConfig {
         non_negative("traffic.spawn_fov_margin_deg", t.spawn_fov_margin_deg)?;
         non_negative("traffic.spawn_range_margin_m", t.spawn_range_margin_m)?;
 
-        let e = &self.ego;
-        positive("ego.length_m", e.length_m)?;
-        positive("ego.width_m", e.width_m)?;
-        if e.rear_axle_to_centre_m.abs() >= e.length_m / 2.0 {
-            return Err(ConfigError::new("ego.rear_axle_to_centre_m", "must lie inside the vehicle"));
-        }
-        interval("ego.desired_speed_mps", e.desired_speed_mps, true)?;
-        if e.desired_speed_mps[1] > self.car.max_speed_mps {
-            return Err(ConfigError::new("ego.desired_speed_mps", "must not exceed car.max_speed_mps"));
-        }
-        probability("ego.initial_standstill_probability", e.initial_standstill_probability)?;
-        interval("ego.start_distance_to_junction_m", e.start_distance_to_junction_m, false)?;
-
         let c = &self.car;
         interval("car.length_m", c.length_m, true)?;
         interval("car.width_m", c.width_m, true)?;
@@ -807,6 +794,19 @@ impl ScenarioConfig {
                 ));
             }
         }
+
+        let e = &self.ego;
+        positive("ego.length_m", e.length_m)?;
+        positive("ego.width_m", e.width_m)?;
+        if e.rear_axle_to_centre_m.abs() >= e.length_m / 2.0 {
+            return Err(ConfigError::new("ego.rear_axle_to_centre_m", "must lie inside the vehicle"));
+        }
+        interval("ego.desired_speed_mps", e.desired_speed_mps, true)?;
+        if e.desired_speed_mps[1] > self.car.max_speed_mps {
+            return Err(ConfigError::new("ego.desired_speed_mps", "must not exceed car.max_speed_mps"));
+        }
+        probability("ego.initial_standstill_probability", e.initial_standstill_probability)?;
+        interval("ego.start_distance_to_junction_m", e.start_distance_to_junction_m, false)?;
 
         let p = &self.pedestrian;
         interval("pedestrian.length_m", p.length_m, true)?;
