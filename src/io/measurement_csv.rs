@@ -603,3 +603,247 @@ pub fn dataset_files(dir: &Path) -> Result<Vec<PathBuf>, CsvError> {
 pub fn read_dataset_dir(dir: &Path) -> Result<Vec<Sequence>, CsvError> {
     dataset_files(dir)?.iter().map(|path| read_sequence_file(path)).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str = "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw\n";
+
+    fn measurement(class: ObjectClass, id: Option<u64>, x: f64) -> RecordedMeasurement {
+        RecordedMeasurement {
+            measurement: Measurement {
+                x_m: x,
+                y_m: -1.0 / 3.0,
+                radial_velocity_mps: -2.5e-7,
+                rcs_dbsm: 12.345678901234567,
+                class,
+                sensor_id: Some(3),
+                ground_truth_id: id,
+            },
+            true_position: id.map(|_| DVec2::new(x + 0.1, 0.7)),
+        }
+    }
+
+    fn sample() -> Sequence {
+        let mut sequence = Sequence::new("sample");
+        let pose = EgoPose { x_m: 1e-3, y_m: -12.5, yaw_rad: std::f64::consts::PI / 7.0 };
+        let mut f0 = RecordedFrame::new(0, 0.0071);
+        f0.sensor_id = Some(3);
+        f0.ego_pose = Some(pose);
+        f0.measurements = vec![measurement(ObjectClass::Car, Some(4), 10.1), measurement(ObjectClass::Pedestrian, None, -0.0)];
+        let mut f1 = RecordedFrame::new(1, 0.0213);
+        f1.sensor_id = Some(1);
+        f1.ego_pose = Some(pose);
+        let mut f3 = RecordedFrame::new(3, 0.05);
+        f3.measurements = vec![measurement(ObjectClass::Car, Some(u64::MAX - 1), 1e-300)];
+        for m in &mut f3.measurements {
+            m.measurement.sensor_id = None;
+        }
+        sequence.frames = vec![f0, f1, f3];
+        sequence
+    }
+
+    fn to_text(sequence: &Sequence) -> String {
+        let mut bytes = Vec::new();
+        write_sequence(&mut bytes, sequence).unwrap();
+        String::from_utf8(bytes).unwrap()
+    }
+
+    fn read_err(text: &str) -> CsvError {
+        read_sequence(text.as_bytes(), "bad").expect_err("should fail")
+    }
+
+    #[test]
+    fn round_trip_is_exact_including_empty_frames_and_gaps() {
+        let sequence = sample();
+        let text = to_text(&sequence);
+        assert!(text.starts_with(HEADER));
+        // The empty frame is one row with empty measurement fields.
+        assert!(text.lines().any(|l| l.starts_with("1,0.0213,,,,,,,,,1,")), "{text}");
+        let back = read_sequence(text.as_bytes(), "sample").unwrap();
+        assert_eq!(back, sequence);
+        assert!(back.frames[1].measurements.is_empty());
+        assert_eq!(back.frames[2].index, 3);
+        assert_eq!(back.frames[0].measurements[1].measurement.ground_truth_id, None);
+        let frame = back.frames[0].to_frame().unwrap();
+        assert_eq!(frame.measurements[0].ground_truth_id, Some(4));
+    }
+
+    #[test]
+    fn columns_are_found_by_name_and_extra_columns_ignored() {
+        let text = "t,frame,class,gt_id,x,y,vr,rcs,true_x,true_y,comment\n\
+                    0.5,0,car,7,1.5,2,-0.5,10,,,hello\n\
+                    0.5,0,pedestrian,-1,3,4,0.25,-5,3.1,4.2,world\n";
+        let sequence = read_sequence(text.as_bytes(), "x").unwrap();
+        assert_eq!(sequence.frames.len(), 1);
+        let frame = &sequence.frames[0];
+        assert_eq!(frame.sensor_id, None);
+        assert_eq!(frame.ego_pose, None);
+        assert_eq!(frame.measurements[0].measurement.ground_truth_id, Some(7));
+        assert_eq!(frame.measurements[0].true_position, None);
+        assert_eq!(frame.measurements[1].measurement.class, ObjectClass::Pedestrian);
+        assert_eq!(frame.measurements[1].true_position, Some(DVec2::new(3.1, 4.2)));
+    }
+
+    #[test]
+    fn comments_and_whitespace_are_accepted() {
+        let text = format!("# generated\n{HEADER}0, 0.1 ,3,car,1,2,3,4,,,2,,,\n");
+        let sequence = read_sequence(text.as_bytes(), "x").unwrap();
+        assert_eq!(sequence.frames[0].timestamp_s, 0.1);
+        assert_eq!(sequence.frames[0].sensor_id, Some(2));
+    }
+
+    #[test]
+    fn missing_header_column_is_reported() {
+        let err = read_err("frame,t,gt_id,class,x,y,vr,true_x,true_y\n0,0,1,car,1,2,3,,\n");
+        assert!(matches!(err.kind, CsvErrorKind::MissingColumn("rcs")));
+        assert_eq!(err.line, Some(1));
+        assert!(err.to_string().contains("missing header column `rcs`"), "{err}");
+    }
+
+    #[test]
+    fn duplicate_header_column_is_reported() {
+        let err = read_err("frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,x\n");
+        assert!(matches!(err.kind, CsvErrorKind::DuplicateColumn(ref c) if c == "x"));
+    }
+
+    #[test]
+    fn bad_number_names_line_and_column() {
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,,,,\n0,0,2,car,1,abc,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::BadNumber(ref v) if v == "abc"));
+        assert_eq!(err.line, Some(3));
+        assert_eq!(err.column.as_deref(), Some("y"));
+        assert_eq!(err.to_string(), "line 3, column `y`: invalid number `abc`");
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,NaN,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::BadNumber(_)));
+        assert_eq!(err.column.as_deref(), Some("vr"));
+    }
+
+    #[test]
+    fn bad_integers_are_reported() {
+        let err = read_err(&format!("{HEADER}0.5,0,1,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::BadInteger(_)));
+        assert_eq!(err.column.as_deref(), Some("frame"));
+        let err = read_err(&format!("{HEADER}0,0,-2,car,1,2,3,4,,,,,,\n"));
+        assert_eq!(err.column.as_deref(), Some("gt_id"));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,70000,,,\n"));
+        assert_eq!(err.column.as_deref(), Some("sensor_id"));
+    }
+
+    #[test]
+    fn unknown_class_is_reported() {
+        let err = read_err(&format!("{HEADER}0,0,1,truck,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::UnknownClass(ref c) if c == "truck"));
+        assert_eq!((err.line, err.column.as_deref()), (Some(2), Some("class")));
+    }
+
+    #[test]
+    fn missing_values_are_reported() {
+        let err = read_err(&format!("{HEADER}0,0,1,car,,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::MissingValue));
+        assert_eq!(err.column.as_deref(), Some("x"));
+        // An empty class with other measurement fields filled is not an empty-frame row.
+        let err = read_err(&format!("{HEADER}0,0,1,,1,2,3,4,,,,,,\n"));
+        assert_eq!(err.column.as_deref(), Some("class"));
+        let err = read_err(&format!("{HEADER},0,1,car,1,2,3,4,,,,,,\n"));
+        assert_eq!(err.column.as_deref(), Some("frame"));
+    }
+
+    #[test]
+    fn decreasing_frame_index_is_reported() {
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,,,,\n2,0.1,1,car,1,2,3,4,,,,,,\n1,0.2,1,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::FrameDecreasing { previous: 2, found: 1 }));
+        assert_eq!(err.line, Some(4));
+    }
+
+    #[test]
+    fn timestamp_mismatch_within_a_frame_is_reported() {
+        let err = read_err(&format!("{HEADER}0,0.1,1,car,1,2,3,4,,,,,,\n0,0.2,2,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::TimeMismatch { frame: 0, .. }));
+        assert_eq!((err.line, err.column.as_deref()), (Some(3), Some("t")));
+    }
+
+    #[test]
+    fn decreasing_time_between_frames_is_reported() {
+        let err = read_err(&format!("{HEADER}0,0.2,1,car,1,2,3,4,,,,,,\n1,0.1,2,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::TimeDecreasing { frame: 1, .. }));
+    }
+
+    #[test]
+    fn frame_level_field_mismatch_is_reported() {
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,1,,,\n0,0,2,car,1,2,3,4,,,2,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::FrameFieldMismatch { frame: 0, .. }));
+        assert_eq!(err.column.as_deref(), Some("sensor_id"));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,1,0,0,0\n0,0,2,car,1,2,3,4,,,1,0,0,0.5\n"));
+        assert!(matches!(err.kind, CsvErrorKind::FrameFieldMismatch { .. }));
+    }
+
+    #[test]
+    fn incomplete_groups_are_reported() {
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,1,5,,0\n"));
+        assert!(matches!(err.kind, CsvErrorKind::IncompleteGroup(_)));
+        assert_eq!(err.column.as_deref(), Some("ego_y"));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,1.5,,,,,\n"));
+        assert_eq!(err.column.as_deref(), Some("true_y"));
+    }
+
+    #[test]
+    fn empty_frame_row_must_be_alone() {
+        let err = read_err(&format!("{HEADER}0,0,,,,,,,,,,,,\n0,0,1,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::PlaceholderMixed { frame: 0 }));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,,,,\n0,0,,,,,,,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::PlaceholderMixed { frame: 0 }));
+    }
+
+    #[test]
+    fn too_many_measurements_in_a_frame_are_reported() {
+        let mut text = HEADER.to_owned();
+        for i in 0..=MAX_MEASUREMENTS_PER_FRAME {
+            text.push_str(&format!("0,0,{i},car,1,2,3,4,,,,,,\n"));
+        }
+        let err = read_err(&text);
+        assert!(matches!(err.kind, CsvErrorKind::TooManyMeasurements { frame: 0 }));
+        assert_eq!(err.line, Some(MAX_MEASUREMENTS_PER_FRAME as u64 + 2));
+    }
+
+    #[test]
+    fn ragged_rows_are_reported_with_their_line() {
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,,,,\n0,0,1,car\n"));
+        assert!(matches!(err.kind, CsvErrorKind::Csv(_)));
+        assert_eq!(err.line, Some(3));
+    }
+
+    #[test]
+    fn writer_rejects_unordered_frames_and_non_finite_values() {
+        let mut sequence = sample();
+        sequence.frames[2].index = 1;
+        let err = write_sequence(Vec::new(), &sequence).unwrap_err();
+        assert!(matches!(err.kind, CsvErrorKind::FrameOrder { previous: 1, found: 1 }));
+        let mut sequence = sample();
+        sequence.frames[0].measurements[0].measurement.x_m = f64::INFINITY;
+        let err = write_sequence(Vec::new(), &sequence).unwrap_err();
+        assert!(matches!(err.kind, CsvErrorKind::NonFinite(_)));
+    }
+
+    #[test]
+    fn dataset_directory_is_read_in_sorted_order() {
+        let dir = std::env::temp_dir().join(format!("primm-csv-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut b = sample();
+        b.name = "b_seq".into();
+        let mut a = sample();
+        a.name = "a_seq".into();
+        a.frames.truncate(1);
+        write_sequence_file(&dir.join("b_seq.csv"), &b).unwrap();
+        write_sequence_file(&dir.join("a_seq.csv"), &a).unwrap();
+        std::fs::write(dir.join("notes.txt"), "not a sequence").unwrap();
+        let sequences = read_dataset_dir(&dir).unwrap();
+        assert_eq!(sequences, vec![a, b]);
+        std::fs::write(dir.join("c_bad.csv"), format!("{HEADER}0,0,1,bus,1,2,3,4,,,,,,\n")).unwrap();
+        let err = read_dataset_dir(&dir).unwrap_err();
+        assert_eq!(err.path.as_deref(), Some(dir.join("c_bad.csv").as_path()));
+        assert!(err.to_string().contains("c_bad.csv:line 2, column `class`"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
