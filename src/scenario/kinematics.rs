@@ -41,7 +41,13 @@ pub(crate) fn wrap_angle(angle: f64) -> f64 {
 
 impl Kinematics {
     pub(crate) fn new(position: DVec2, heading: f64, speed: f64) -> Self {
-        Self { position, heading: wrap_angle(heading), speed, accel: 0.0, yaw_rate: 0.0 }
+        Self {
+            position,
+            heading: wrap_angle(heading),
+            speed,
+            accel: 0.0,
+            yaw_rate: 0.0,
+        }
     }
 
     /// Unit vector of the heading.
@@ -75,7 +81,11 @@ impl Kinematics {
         let mut moving_time = dt;
         if speed <= 0.0 {
             // Standstill within this step.
-            moving_time = if accel < 0.0 { (old_speed / -accel).min(dt) } else { dt };
+            moving_time = if accel < 0.0 {
+                (old_speed / -accel).min(dt)
+            } else {
+                dt
+            };
             speed = 0.0;
             accel_applied = 0.0;
         } else if speed > limits.max_speed {
@@ -128,17 +138,27 @@ mod tests {
         let dt = 0.015;
         let mut previous = k;
         for step in 0..2000 {
-            let (a, w) = if step < 800 { (10.0, 2.0) } else { (-10.0, -2.0) };
+            let (a, w) = if step < 800 {
+                (10.0, 2.0)
+            } else {
+                (-10.0, -2.0)
+            };
             k.step(a, w, dt, &l);
             assert!(k.speed >= 0.0 && k.speed <= l.max_speed + 1e-9);
             assert!(k.accel <= l.max_accel + 1e-9 && k.accel >= -l.max_decel - 1e-9);
             assert!(k.yaw_rate.abs() <= l.max_yaw_rate + 1e-9);
             assert!(k.speed * k.yaw_rate.abs() <= l.max_lateral_accel + 1e-6);
             if k.speed > 0.0 && previous.speed > 0.0 {
-                assert!((k.accel - previous.accel).abs() <= l.max_jerk * dt + 1e-9, "step {step}: {previous:?} -> {k:?}");
+                assert!(
+                    (k.accel - previous.accel).abs() <= l.max_jerk * dt + 1e-9,
+                    "step {step}: {previous:?} -> {k:?}"
+                );
             }
             let moved = k.position.distance(previous.position);
-            assert!((moved - 0.5 * (k.speed + previous.speed) * dt).abs() < 1e-6 + previous.speed * dt * 0.5);
+            assert!(
+                (moved - 0.5 * (k.speed + previous.speed) * dt).abs()
+                    < 1e-6 + previous.speed * dt * 0.5
+            );
             previous = k;
         }
         assert_eq!(k.speed, 0.0);
@@ -150,7 +170,10 @@ mod tests {
         for k in -20..20 {
             let a = wrap_angle(k as f64 * 0.9);
             assert!(a > -PI && a <= PI);
-            assert!(((k as f64 * 0.9 - a) / (2.0 * PI)).fract().abs() < 1e-9 || ((k as f64 * 0.9 - a) / (2.0 * PI)).fract().abs() > 1.0 - 1e-9);
+            assert!(
+                ((k as f64 * 0.9 - a) / (2.0 * PI)).fract().abs() < 1e-9
+                    || ((k as f64 * 0.9 - a) / (2.0 * PI)).fract().abs() > 1.0 - 1e-9
+            );
         }
     }
 }

@@ -47,8 +47,8 @@ pub use config::{
     ReflectionConfig, RoadConfig, ScenarioConfig, SequenceConfig, SplitConfig, TrafficConfig,
 };
 pub use events::{
-    count_events, EventCounts, CLOSE_PROXIMITY_DISTANCE_M, CROSSING_DISTANCE_M, CROSSING_MAX_HEADING_DIFF_DEG,
-    CROSSING_MIN_HEADING_DIFF_DEG, MOVING_SPEED_MPS,
+    count_events, EventCounts, CLOSE_PROXIMITY_DISTANCE_M, CROSSING_DISTANCE_M,
+    CROSSING_MAX_HEADING_DIFF_DEG, CROSSING_MIN_HEADING_DIFF_DEG, MOVING_SPEED_MPS,
 };
 pub use split::{format_table, Split, SplitSummary};
 
@@ -179,7 +179,11 @@ impl ScenarioGenerator {
             Split::Validation => SPLIT_SEED_STRIDE,
             Split::Evaluation => 2 * SPLIT_SEED_STRIDE,
         };
-        self.config.splits.seed_base.wrapping_add(offset).wrapping_add(u64::from(index))
+        self.config
+            .splits
+            .seed_base
+            .wrapping_add(offset)
+            .wrapping_add(u64::from(index))
     }
 
     /// Generates sequence `index` of `split`, named `<split>_<index:04>`.
@@ -204,7 +208,11 @@ impl ScenarioGenerator {
             rng
         };
         let mut world = world::World::new(cfg, rng_for(STREAM_WORLD));
-        let scans = radar::schedule(&cfg.radar, cfg.sequence.duration_s, &mut rng_for(STREAM_SCHEDULE));
+        let scans = radar::schedule(
+            &cfg.radar,
+            cfg.sequence.duration_s,
+            &mut rng_for(STREAM_SCHEDULE),
+        );
         let mut sensor_rng = rng_for(STREAM_SENSOR);
         let warmup = cfg.sequence.warmup_s;
         let mut sequence = Sequence::new(name);
@@ -245,6 +253,11 @@ impl ScenarioGenerator {
                     .collect(),
             });
         }
-        GeneratedSequence { split: None, seed, sequence, truth }
+        GeneratedSequence {
+            split: None,
+            seed,
+            sequence,
+            truth,
+        }
     }
 }

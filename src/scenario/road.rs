@@ -55,6 +55,7 @@ pub(crate) struct RoadGrid {
     pub left_turn_radius_m: f64,
     green_s: f64,
     clearance_s: f64,
+    signalised_fraction: f64,
     signal_seed: u64,
 }
 
@@ -82,6 +83,7 @@ impl RoadGrid {
             left_turn_radius_m: road.left_turn_radius_m,
             green_s: road.signal_green_s,
             clearance_s: road.signal_clearance_s,
+            signalised_fraction: road.signalised_junction_fraction,
             signal_seed,
         }
     }
@@ -98,7 +100,10 @@ impl RoadGrid {
 
     /// The junction nearest to `point`.
     pub(crate) fn nearest_junction(&self, point: DVec2) -> JunctionId {
-        ((point.x / self.block_m).round() as i64, (point.y / self.block_m).round() as i64)
+        (
+            (point.x / self.block_m).round() as i64,
+            (point.y / self.block_m).round() as i64,
+        )
     }
 
     /// Length of one signal cycle, seconds.
@@ -106,16 +111,32 @@ impl RoadGrid {
         2.0 * (self.green_s + self.clearance_s)
     }
 
+    /// Two independent uniform numbers in [0, 1) fixed per junction.
+    fn junction_draws(&self, id: JunctionId) -> (f64, f64) {
+        let h = mix64(self.signal_seed ^ mix64(id.0 as u64 ^ mix64(id.1 as u64 ^ 0x6a09_e667)));
+        let g = mix64(h);
+        let unit = |v: u64| (v >> 11) as f64 / (1u64 << 53) as f64;
+        (unit(h), unit(g))
+    }
+
+    /// Whether junction `id` has traffic signals.
+    pub(crate) fn is_signalised(&self, id: JunctionId) -> bool {
+        self.junction_draws(id).1 < self.signalised_fraction
+    }
+
     /// Time into the cycle of junction `id` at time `t`.
     fn cycle_time(&self, id: JunctionId, t: f64) -> f64 {
-        let h = mix64(self.signal_seed ^ mix64(id.0 as u64 ^ mix64(id.1 as u64 ^ 0x6a09_e667)));
-        let offset = (h >> 11) as f64 / (1u64 << 53) as f64 * self.cycle_s();
+        let offset = self.junction_draws(id).0 * self.cycle_s();
         (t + offset).rem_euclid(self.cycle_s())
     }
 
     /// Remaining green time for traffic along `axis` at junction `id`, seconds; 0 when the
-    /// signal shows red (or all-red clearance) for that axis.
+    /// signal shows red (or all-red clearance) for that axis; infinite at junctions without
+    /// signals.
     pub(crate) fn green_remaining(&self, id: JunctionId, axis: Axis, t: f64) -> f64 {
+        if !self.is_signalised(id) {
+            return f64::INFINITY;
+        }
         let c = self.cycle_time(id, t);
         let start = match axis {
             Axis::X => 0.0,
@@ -155,7 +176,12 @@ impl RoadGrid {
         let y0 = block.1 as f64 * self.block_m + self.sidewalk_m;
         let x1 = (block.0 + 1) as f64 * self.block_m - self.sidewalk_m;
         let y1 = (block.1 + 1) as f64 * self.block_m - self.sidewalk_m;
-        [DVec2::new(x0, y0), DVec2::new(x1, y0), DVec2::new(x1, y1), DVec2::new(x0, y1)]
+        [
+            DVec2::new(x0, y0),
+            DVec2::new(x1, y0),
+            DVec2::new(x1, y1),
+            DVec2::new(x0, y1),
+        ]
     }
 
     /// Perimeter of a ring, metres.
@@ -205,7 +231,10 @@ impl RoadGrid {
 
     /// The block whose ring is nearest to `point`.
     pub(crate) fn block_of(&self, point: DVec2) -> (i64, i64) {
-        ((point.x / self.block_m).floor() as i64, (point.y / self.block_m).floor() as i64)
+        (
+            (point.x / self.block_m).floor() as i64,
+            (point.y / self.block_m).floor() as i64,
+        )
     }
 }
 
@@ -233,7 +262,10 @@ mod tests {
     #[test]
     fn signals_alternate_and_never_both_green() {
         let g = grid();
-        let id = (1, 4);
+        let id = (-50..50)
+            .map(|i| (i, 4))
+            .find(|&id| g.is_signalised(id))
+            .expect("a signalised junction");
         let mut x_green = 0;
         let mut y_green = 0;
         for k in 0..4000 {
@@ -250,5 +282,21 @@ mod tests {
             let observed = count as f64 / 4000.0;
             assert!((observed - share).abs() < 0.03, "green share {observed}");
         }
+    }
+
+    #[test]
+    fn signalised_fraction_is_respected() {
+        let g = grid();
+        let signalised = (0..40)
+            .flat_map(|i| (0..40).map(move |j| (i, j)))
+            .filter(|&id| g.is_signalised(id))
+            .count();
+        let share = signalised as f64 / 1600.0;
+        assert!((share - 0.5).abs() < 0.05, "signalised share {share}");
+        let unsignalised = (0..40)
+            .map(|i| (i, 0))
+            .find(|&id| !g.is_signalised(id))
+            .unwrap();
+        assert!(g.is_green(unsignalised, Axis::X, 3.0) && g.is_green(unsignalised, Axis::Y, 3.0));
     }
 }

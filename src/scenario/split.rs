@@ -67,7 +67,14 @@ pub struct SplitSummary {
 impl SplitSummary {
     /// An empty summary of `split`.
     pub fn new(split: Split) -> Self {
-        Self { split, sequences: 0, frames: 0, car_object_frames: 0, pedestrian_object_frames: 0, events: None }
+        Self {
+            split,
+            sequences: 0,
+            frames: 0,
+            car_object_frames: 0,
+            pedestrian_object_frames: 0,
+            events: None,
+        }
     }
 
     /// Adds a recorded sequence (no ground truth: event counts unchanged).
@@ -109,11 +116,20 @@ pub fn format_table(summaries: &[SplitSummary]) -> String {
     let _ = writeln!(
         out,
         "{:<12} {:>10} {:>10} {:>18} {:>25} {:>16} {:>16}",
-        "Split", "Sequences", "Frames", "Car object frames", "Pedestrian object frames", "Close proximity", "Crossing"
+        "Split",
+        "Sequences",
+        "Frames",
+        "Car object frames",
+        "Pedestrian object frames",
+        "Close proximity",
+        "Crossing"
     );
     for s in summaries {
         let (close, crossing) = match s.events {
-            Some(e) => (thousands(e.close_proximity_frames), thousands(e.crossing_frames)),
+            Some(e) => (
+                thousands(e.close_proximity_frames),
+                thousands(e.crossing_frames),
+            ),
             None => ("-".to_owned(), "-".to_owned()),
         };
         let mut name = s.split.name().to_owned();
