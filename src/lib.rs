@@ -1,13 +1,16 @@
 //! primm: PR-IMM multi-object tracking for automotive radar.
 
 pub mod association;
-pub mod measurement;
-pub mod gaussian;
-pub mod mode;
+pub mod cli;
 pub mod config;
+pub mod gaussian;
+pub mod imm;
+pub mod io;
+pub mod measurement;
+pub mod mode;
 pub mod motion;
 pub mod predictor;
-pub mod imm;
+pub mod scenario;
 pub mod track;
 pub mod track_table;
 pub mod tracker;
