@@ -1,3 +1,4 @@
 //! primm: PR-IMM multi-object tracking for automotive radar.
 
+pub mod eval;
 pub mod measurement;
