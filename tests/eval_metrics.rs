@@ -76,7 +76,11 @@ fn assert_counts_match(name: &str, ours: &IdentityCounts, theirs: &Value) {
         "{name}: estimated frames"
     );
     let idf1 = theirs["idf1"].as_f64().expect("idf1");
-    assert!((ours.idf1().unwrap() - idf1).abs() < 1e-12, "{name}: IDF1 {:?} vs {idf1}", ours.idf1());
+    assert!(
+        (ours.idf1().unwrap() - idf1).abs() < 1e-12,
+        "{name}: IDF1 {:?} vs {idf1}",
+        ours.idf1()
+    );
 }
 
 #[test]

@@ -60,11 +60,7 @@ fn scene(
                 prior: (k > 0).then_some(estimate),
                 mode_probabilities: Some([0.35, 0.2, 0.3, 0.15]),
             });
-            posterior.push(TrajectoryPoint {
-                id: track,
-                frame: k,
-                position: estimate,
-            });
+            posterior.push(TrajectoryPoint { id: track, frame: k, position: estimate });
         }
     }
     (records, posterior)
@@ -76,11 +72,8 @@ fn count(haystack: &str, needle: &str) -> usize {
 
 #[test]
 fn trajectory_figure_has_one_panel_per_method_with_all_trajectories() {
-    let methods = [
-        (Method::Imm, 1.2, Some(35)),
-        (Method::Pr, 0.6, None),
-        (Method::PrImm, 0.3, None),
-    ];
+    let methods =
+        [(Method::Imm, 1.2, Some(35)), (Method::Pr, 0.6, None), (Method::PrImm, 0.3, None)];
     let mut ground_truth = Vec::new();
     let mut panels = Vec::new();
     for (index, (method, noise, switch)) in methods.into_iter().enumerate() {
@@ -92,10 +85,7 @@ fn trajectory_figure_has_one_panel_per_method_with_all_trajectories() {
             track_to_ground_truth: majority_ground_truth(&records),
         });
     }
-    assert_eq!(
-        panels[0].track_to_ground_truth,
-        BTreeMap::from([(1, 1), (2, 2), (3, 2)])
-    );
+    assert_eq!(panels[0].track_to_ground_truth, BTreeMap::from([(1, 1), (2, 2), (3, 2)]));
     let options = TrajectoryPlotOptions {
         title: Some("Synthetic crossing scene".into()),
         ..TrajectoryPlotOptions::default()
@@ -123,70 +113,34 @@ fn trajectory_figure_has_one_panel_per_method_with_all_trajectories() {
     assert_eq!(thin, 2 * (3 + 2 + 2) + 2);
     assert_eq!(count(&svg, "<circle"), 3 + 2 + 2 + 1);
     assert!(ground_truth_lines >= 3 * 2 + 3 + 2 + 2);
-    write_trajectory_svg(
-        output_dir().join("trajectories.svg"),
-        &ground_truth,
-        &panels,
-        &options,
-    )
-    .unwrap();
+    write_trajectory_svg(output_dir().join("trajectories.svg"), &ground_truth, &panels, &options)
+        .unwrap();
 }
 
 #[test]
 fn single_point_tracks_are_drawn_as_dots() {
     let ground_truth = vec![
-        TrajectoryPoint {
-            id: 1,
-            frame: 0,
-            position: DVec2::new(0.0, 0.0),
-        },
-        TrajectoryPoint {
-            id: 1,
-            frame: 1,
-            position: DVec2::new(1.0, 0.0),
-        },
+        TrajectoryPoint { id: 1, frame: 0, position: DVec2::new(0.0, 0.0) },
+        TrajectoryPoint { id: 1, frame: 1, position: DVec2::new(1.0, 0.0) },
     ];
     let panel = TrajectoryPanel {
         title: "CV".into(),
-        tracks: vec![TrajectoryPoint {
-            id: 5,
-            frame: 0,
-            position: DVec2::new(0.5, 0.2),
-        }],
+        tracks: vec![TrajectoryPoint { id: 5, frame: 0, position: DVec2::new(0.5, 0.2) }],
         track_to_ground_truth: BTreeMap::new(),
     };
     let svg = trajectory_svg(&ground_truth, &[panel], &TrajectoryPlotOptions::default()).unwrap();
     // One filled dot for the track; the legend's start marker is the only hollow circle.
-    let circles: Vec<&str> = svg
-        .split("<circle")
-        .skip(1)
-        .filter_map(|rest| rest.split('>').next())
-        .collect();
+    let circles: Vec<&str> =
+        svg.split("<circle").skip(1).filter_map(|rest| rest.split('>').next()).collect();
     assert_eq!(circles.len(), 2);
-    assert_eq!(
-        circles
-            .iter()
-            .filter(|c| c.contains("fill=\"none\""))
-            .count(),
-        1
-    );
+    assert_eq!(circles.iter().filter(|c| c.contains("fill=\"none\"")).count(), 1);
 }
 
 #[test]
 fn mode_probability_bars_show_values_and_labels() {
     let means = [0.348, 0.185, 0.304, 0.163];
     let svg = mode_probability_svg(means, 17_866).unwrap();
-    for text in [
-        "PR",
-        "CV",
-        "CA",
-        "CT",
-        "0.348",
-        "0.185",
-        "0.304",
-        "0.163",
-        "17,866 updates",
-    ] {
+    for text in ["PR", "CV", "CA", "CT", "0.348", "0.185", "0.304", "0.163", "17,866 updates"] {
         assert!(svg.contains(text), "missing text {text}");
     }
     assert!(svg.contains("mean posterior probability"));

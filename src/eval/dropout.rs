@@ -41,10 +41,7 @@ impl DropoutMask {
         for &index in &order[..dropped_count] {
             dropped[index] = true;
         }
-        Ok(Self {
-            dropped,
-            dropped_count,
-        })
+        Ok(Self { dropped, dropped_count })
     }
 
     /// Number of items the mask was built for.
@@ -182,10 +179,7 @@ mod tests {
         }
         assert!(matches!(
             mask.kept(&[1, 2, 3]),
-            Err(EvalError::LengthMismatch {
-                expected: 10,
-                actual: 3
-            })
+            Err(EvalError::LengthMismatch { expected: 10, actual: 3 })
         ));
     }
 
@@ -210,25 +204,13 @@ mod tests {
                 *hit += u32::from(mask.is_dropped(index));
             }
         }
-        assert!(
-            hits.iter().all(|&hit| (150..=250).contains(&hit)),
-            "{hits:?}"
-        );
+        assert!(hits.iter().all(|&hit| (150..=250).contains(&hit)), "{hits:?}");
     }
 
     #[test]
     fn sequence_seeds_differ_by_name_and_base() {
-        assert_eq!(
-            sequence_seed(1, "sequence_1"),
-            sequence_seed(1, "sequence_1")
-        );
-        assert_ne!(
-            sequence_seed(1, "sequence_1"),
-            sequence_seed(1, "sequence_2")
-        );
-        assert_ne!(
-            sequence_seed(1, "sequence_1"),
-            sequence_seed(2, "sequence_1")
-        );
+        assert_eq!(sequence_seed(1, "sequence_1"), sequence_seed(1, "sequence_1"));
+        assert_ne!(sequence_seed(1, "sequence_1"), sequence_seed(1, "sequence_2"));
+        assert_ne!(sequence_seed(1, "sequence_1"), sequence_seed(2, "sequence_1"));
     }
 }

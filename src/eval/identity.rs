@@ -101,18 +101,10 @@ pub fn identity_counts(records: &[AssociationRecord]) -> IdentityCounts {
 /// # Panics
 /// When `in_subset` does not have one flag per row.
 pub fn identity_counts_subset(records: &[AssociationRecord], in_subset: &[bool]) -> IdentityCounts {
-    assert_eq!(
-        records.len(),
-        in_subset.len(),
-        "one subset flag per row is required"
-    );
+    assert_eq!(records.len(), in_subset.len(), "one subset flag per row is required");
     let mut counts = IdentityCounts::default();
     let mut overlap: BTreeMap<(u64, u64), u64> = BTreeMap::new();
-    for (record, _) in records
-        .iter()
-        .zip(in_subset)
-        .filter(|(_, &selected)| selected)
-    {
+    for (record, _) in records.iter().zip(in_subset).filter(|(_, &selected)| selected) {
         if record.ground_truth_id.is_some() {
             counts.gt_object_frames += 1;
         }
@@ -126,10 +118,8 @@ pub fn identity_counts_subset(records: &[AssociationRecord], in_subset: &[bool])
     counts.idtp = max_total_overlap(&overlap);
     counts.idfp = counts.estimated_object_frames - counts.idtp;
     counts.idfn = counts.gt_object_frames - counts.idtp;
-    counts.idsw = id_switch_rows(records)
-        .into_iter()
-        .filter(|&index| in_subset[index])
-        .count() as u64;
+    counts.idsw =
+        id_switch_rows(records).into_iter().filter(|&index| in_subset[index]).count() as u64;
     counts
 }
 
@@ -175,10 +165,7 @@ pub fn max_total_overlap(overlap: &BTreeMap<(u64, u64), u64>) -> u64 {
             components.entry(root).or_default().push((gt, track, count));
         }
     }
-    components
-        .values()
-        .map(|entries| component_optimum(entries))
-        .sum()
+    components.values().map(|entries| component_optimum(entries)).sum()
 }
 
 /// Optimal assignment within one connected component of `(gt, track, overlap)` entries.
@@ -195,19 +182,13 @@ fn component_optimum(entries: &[(u64, u64, u64)]) -> u64 {
         tracks.entry(track).or_insert(next);
     }
     let transpose = gts.len() > tracks.len();
-    let (rows, columns) = if transpose {
-        (tracks.len(), gts.len())
-    } else {
-        (gts.len(), tracks.len())
-    };
+    let (rows, columns) =
+        if transpose { (tracks.len(), gts.len()) } else { (gts.len(), tracks.len()) };
     let mut weights = Matrix::new(rows, columns, 0i64);
     for &(gt, track, count) in entries {
         let weight = i64::try_from(count).expect("overlap count fits in i64");
-        let (row, column) = if transpose {
-            (tracks[&track], gts[&gt])
-        } else {
-            (gts[&gt], tracks[&track])
-        };
+        let (row, column) =
+            if transpose { (tracks[&track], gts[&gt]) } else { (gts[&gt], tracks[&track]) };
         weights[(row, column)] = weight;
     }
     let (total, _) = kuhn_munkres(&weights);
@@ -249,11 +230,8 @@ mod tests {
     #[test]
     fn idsw_follows_frames_not_input_order() {
         // Same object, frames given out of order: f0→7, f1→8, f2→7. Two switches.
-        let records = vec![
-            row(2, Some(1), Some(7)),
-            row(0, Some(1), Some(7)),
-            row(1, Some(1), Some(8)),
-        ];
+        let records =
+            vec![row(2, Some(1), Some(7)), row(0, Some(1), Some(7)), row(1, Some(1), Some(8))];
         assert_eq!(id_switches(&records), 2);
         // Index 2 (frame 1) and index 0 (frame 2), in time order.
         assert_eq!(id_switch_rows(&records), vec![2, 0]);
@@ -348,10 +326,7 @@ mod tests {
         // Subset = rows 0 and 3: no switch row selected; the two rows use different tracks,
         // one-to-one assignment keeps one of them → IDTP 1, IDFP 1, IDFN 1.
         let counts = identity_counts_subset(&records, &[true, false, false, true]);
-        assert_eq!(
-            (counts.idsw, counts.idtp, counts.idfp, counts.idfn),
-            (0, 1, 1, 1)
-        );
+        assert_eq!((counts.idsw, counts.idtp, counts.idfp, counts.idfn), (0, 1, 1, 1));
     }
 
     /// Exhaustive optimum over all injective maps from ground-truth rows to track columns.

@@ -64,14 +64,8 @@ impl InteractionRules {
         let values = [
             ("close_proximity_m", self.close_proximity_m),
             ("crossing_distance_m", self.crossing_distance_m),
-            (
-                "crossing_min_heading_diff_deg",
-                self.crossing_min_heading_diff_deg,
-            ),
-            (
-                "crossing_max_heading_diff_deg",
-                self.crossing_max_heading_diff_deg,
-            ),
+            ("crossing_min_heading_diff_deg", self.crossing_min_heading_diff_deg),
+            ("crossing_max_heading_diff_deg", self.crossing_max_heading_diff_deg),
             ("max_heading_gap_s", self.max_heading_gap_s),
             ("min_heading_speed_mps", self.min_heading_speed_mps),
         ];
@@ -134,10 +128,8 @@ pub fn interaction_flags(
                     }
                 }
             }
-            flags[a] = InteractionFlags {
-                close_proximity: nearest <= rules.close_proximity_m,
-                crossing,
-            };
+            flags[a] =
+                InteractionFlags { close_proximity: nearest <= rules.close_proximity_m, crossing };
         }
     }
     flags
@@ -179,10 +171,7 @@ mod tests {
     /// (object 1, object 2).
     fn pair(heading_deg: f64, offset: DVec2) -> (InteractionFlags, InteractionFlags) {
         let p1_end = DVec2::new(1.0, 0.0);
-        let direction = DVec2::new(
-            heading_deg.to_radians().cos(),
-            heading_deg.to_radians().sin(),
-        );
+        let direction = DVec2::new(heading_deg.to_radians().cos(), heading_deg.to_radians().sin());
         let p2_end = p1_end + offset;
         let records = vec![
             position_row(0, 0.0, 1, DVec2::ZERO),

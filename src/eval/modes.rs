@@ -79,10 +79,8 @@ mod tests {
         dropped.mode_probabilities = Some([1.0, 0.0, 0.0, 0.0]);
         let single_model = identity_row(3, Some(1), Some(1));
         let mut acc = ModeProbabilityAccumulator::new();
-        let added: Vec<bool> = [first, second, dropped, single_model]
-            .iter()
-            .map(|row| acc.push_record(row))
-            .collect();
+        let added: Vec<bool> =
+            [first, second, dropped, single_model].iter().map(|row| acc.push_record(row)).collect();
         assert_eq!(added, vec![true, true, false, false]);
         let mean = acc.mean().unwrap();
         for (got, want) in mean.iter().zip([0.3, 0.2, 0.4, 0.1]) {

@@ -100,11 +100,7 @@ pub fn majority_ground_truth(records: &[AssociationRecord]) -> BTreeMap<u64, u64
         .filter_map(|(track, counts)| {
             // Iteration is in ascending gt order and `max_by_key` keeps the last maximum, so
             // reverse to prefer the lowest id on ties.
-            counts
-                .into_iter()
-                .rev()
-                .max_by_key(|&(_, count)| count)
-                .map(|(gt, _)| (track, gt))
+            counts.into_iter().rev().max_by_key(|&(_, count)| count).map(|(gt, _)| (track, gt))
         })
         .collect()
 }
@@ -155,9 +151,7 @@ pub fn trajectory_svg(
     let width = options.panel_width_px * columns as u32;
     let height = title_px + options.panel_height_px * rows as u32 + LEGEND_PX;
 
-    let all_points = ground_truth
-        .iter()
-        .chain(panels.iter().flat_map(|panel| &panel.tracks));
+    let all_points = ground_truth.iter().chain(panels.iter().flat_map(|panel| &panel.tracks));
     let bounds = Bounds::of(all_points.map(|point| point.position))
         .ok_or_else(|| EvalError::Plot("no positions to draw".into()))?
         .padded(options.margin_m.max(0.0));
@@ -168,11 +162,8 @@ pub fn trajectory_svg(
         ids.dedup();
         ids
     };
-    let colour_index: HashMap<u64, usize> = gt_ids
-        .iter()
-        .enumerate()
-        .map(|(index, &id)| (id, index))
-        .collect();
+    let colour_index: HashMap<u64, usize> =
+        gt_ids.iter().enumerate().map(|(index, &id)| (id, index)).collect();
     let gt_lines = group_lines(ground_truth);
 
     let mut svg = String::new();
@@ -221,14 +212,8 @@ impl Bounds {
         let mut bounds: Option<Bounds> = None;
         for point in points.filter(|p| p.is_finite()) {
             bounds = Some(match bounds {
-                None => Bounds {
-                    min: point,
-                    max: point,
-                },
-                Some(b) => Bounds {
-                    min: b.min.min(point),
-                    max: b.max.max(point),
-                },
+                None => Bounds { min: point, max: point },
+                Some(b) => Bounds { min: b.min.min(point), max: b.max.max(point) },
             });
         }
         bounds
@@ -238,10 +223,7 @@ impl Bounds {
         // At least one metre of extent so that a single point still gives a usable view.
         let centre = 0.5 * (self.min + self.max);
         let half = (0.5 * (self.max - self.min)).max(DVec2::splat(0.5)) + DVec2::splat(margin);
-        Bounds {
-            min: centre - half,
-            max: centre + half,
-        }
+        Bounds { min: centre - half, max: centre + half }
     }
 
     /// Grows the shorter side so that metres per pixel agree on both axes of a
@@ -256,10 +238,7 @@ impl Bounds {
                 metres_per_px * f64::from(height_px.max(1)),
             );
         let centre = 0.5 * (self.min + self.max);
-        Bounds {
-            min: centre - half,
-            max: centre + half,
-        }
+        Bounds { min: centre - half, max: centre + half }
     }
 }
 
@@ -267,10 +246,7 @@ impl Bounds {
 fn group_lines(points: &[TrajectoryPoint]) -> BTreeMap<u64, Vec<(f64, f64)>> {
     let mut by_id: BTreeMap<u64, Vec<(u64, DVec2)>> = BTreeMap::new();
     for point in points.iter().filter(|point| point.position.is_finite()) {
-        by_id
-            .entry(point.id)
-            .or_default()
-            .push((point.frame, point.position));
+        by_id.entry(point.id).or_default().push((point.frame, point.position));
     }
     by_id
         .into_iter()
@@ -297,11 +273,7 @@ const PALETTE: [(u8, u8, u8); 10] = [
 
 fn blend(colour: (u8, u8, u8), towards: (u8, u8, u8), amount: f64) -> RGBColor {
     let mix = |a: u8, b: u8| (f64::from(a) + (f64::from(b) - f64::from(a)) * amount).round() as u8;
-    RGBColor(
-        mix(colour.0, towards.0),
-        mix(colour.1, towards.1),
-        mix(colour.2, towards.2),
-    )
+    RGBColor(mix(colour.0, towards.0), mix(colour.1, towards.1), mix(colour.2, towards.2))
 }
 
 fn light(index: usize) -> RGBColor {
@@ -324,18 +296,14 @@ fn draw_centred_text(
     size: u32,
 ) -> Result<(), EvalError> {
     let (width, height) = area.dim_in_pixel();
-    let style = TextStyle::from(("sans-serif", size).into_font())
-        .color(&BLACK)
-        .pos(plotters::style::text_anchor::Pos::new(
+    let style = TextStyle::from(("sans-serif", size).into_font()).color(&BLACK).pos(
+        plotters::style::text_anchor::Pos::new(
             plotters::style::text_anchor::HPos::Center,
             plotters::style::text_anchor::VPos::Center,
-        ));
-    area.draw(&Text::new(
-        text.to_string(),
-        (width as i32 / 2, height as i32 / 2),
-        style,
-    ))
-    .map_err(plot_error)
+        ),
+    );
+    area.draw(&Text::new(text.to_string(), (width as i32 / 2, height as i32 / 2), style))
+        .map_err(plot_error)
 }
 
 /// Label-area sizes and margin of a trajectory chart, pixels.
@@ -353,9 +321,8 @@ fn draw_trajectory_panel(
 ) -> Result<(Bounds, (u32, u32)), EvalError> {
     // Measure the plotting area first, then choose ranges with equal metres per pixel.
     let (plot_w, plot_h) = {
-        let probe = chart_builder(area)
-            .build_cartesian_2d(0.0..1.0, 0.0..1.0)
-            .map_err(plot_error)?;
+        let probe =
+            chart_builder(area).build_cartesian_2d(0.0..1.0, 0.0..1.0).map_err(plot_error)?;
         probe.plotting_area().dim_in_pixel()
     };
     let view = bounds.with_equal_aspect(plot_w, plot_h);
@@ -363,11 +330,7 @@ fn draw_trajectory_panel(
         .build_cartesian_2d(view.min.x..view.max.x, view.min.y..view.max.y)
         .map_err(plot_error)?;
     // Whole metres on the ticks unless the view is only a few metres wide.
-    let decimals = if (view.max - view.min).min_element() >= 8.0 {
-        0
-    } else {
-        1
-    };
+    let decimals = if (view.max - view.min).min_element() >= 8.0 { 0 } else { 1 };
     let tick = |value: &f64| format!("{value:.decimals$}");
     chart
         .configure_mesh()
@@ -400,11 +363,7 @@ fn draw_trajectory_panel(
         // A hollow marker where the track starts makes fragmentation and switches visible.
         if line.len() > 1 {
             chart
-                .draw_series(std::iter::once(Circle::new(
-                    line[0],
-                    START_MARKER_RADIUS,
-                    style,
-                )))
+                .draw_series(std::iter::once(Circle::new(line[0], START_MARKER_RADIUS, style)))
                 .map_err(plot_error)?;
         }
     }
@@ -421,10 +380,7 @@ fn chart_builder<'a, 'b>(
     area: &'a DrawingArea<SVGBackend<'b>, Shift>,
 ) -> ChartBuilder<'a, 'b, SVGBackend<'b>> {
     let mut builder = ChartBuilder::on(area);
-    builder
-        .margin(CHART_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA);
+    builder.margin(CHART_MARGIN).x_label_area_size(X_LABEL_AREA).y_label_area_size(Y_LABEL_AREA);
     builder
 }
 
@@ -438,11 +394,7 @@ fn draw_polyline(
     match line {
         [] => Ok(()),
         [point] => chart
-            .draw_series(std::iter::once(Circle::new(
-                *point,
-                dot_radius,
-                style.filled(),
-            )))
+            .draw_series(std::iter::once(Circle::new(*point, dot_radius, style.filled())))
             .map(|_| ())
             .map_err(plot_error),
         _ => chart
@@ -456,12 +408,12 @@ fn draw_trajectory_legend(area: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(
     let (width, height) = area.dim_in_pixel();
     let y = height as i32 / 2;
     let left = width as i32 / 2 - 330;
-    let text_style = TextStyle::from(("sans-serif", 16).into_font())
-        .color(&BLACK)
-        .pos(plotters::style::text_anchor::Pos::new(
+    let text_style = TextStyle::from(("sans-serif", 16).into_font()).color(&BLACK).pos(
+        plotters::style::text_anchor::Pos::new(
             plotters::style::text_anchor::HPos::Left,
             plotters::style::text_anchor::VPos::Center,
-        ));
+        ),
+    );
     let lines = [
         (left, light(0), GROUND_TRUTH_WIDTH, "ground truth"),
         (left + 230, dark(0), ESTIMATE_WIDTH, "estimated track"),
@@ -472,12 +424,8 @@ fn draw_trajectory_legend(area: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(
             ShapeStyle::from(&colour).stroke_width(stroke),
         ))
         .map_err(plot_error)?;
-        area.draw(&Text::new(
-            label.to_string(),
-            (x + 60, y),
-            text_style.clone(),
-        ))
-        .map_err(plot_error)?;
+        area.draw(&Text::new(label.to_string(), (x + 60, y), text_style.clone()))
+            .map_err(plot_error)?;
     }
     let x = left + 480;
     area.draw(&Circle::new(
@@ -486,12 +434,8 @@ fn draw_trajectory_legend(area: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(
         ShapeStyle::from(&dark(0)).stroke_width(ESTIMATE_WIDTH),
     ))
     .map_err(plot_error)?;
-    area.draw(&Text::new(
-        "track start".to_string(),
-        (x + 40, y),
-        text_style,
-    ))
-    .map_err(plot_error)?;
+    area.draw(&Text::new("track start".to_string(), (x + 40, y), text_style))
+        .map_err(plot_error)?;
     Ok(())
 }
 
@@ -508,10 +452,7 @@ pub fn write_mode_probability_svg(
 
 /// The mode-probability bar chart as SVG text.
 pub fn mode_probability_svg(means: [f64; 4], samples: u64) -> Result<String, EvalError> {
-    if means
-        .iter()
-        .any(|p| !p.is_finite() || *p < 0.0 || *p > 1.0 + 1e-9)
-    {
+    if means.iter().any(|p| !p.is_finite() || *p < 0.0 || *p > 1.0 + 1e-9) {
         return Err(EvalError::Plot(format!(
             "mode probabilities must lie in [0, 1], got {means:?}"
         )));
@@ -538,11 +479,9 @@ pub fn mode_probability_svg(means: [f64; 4], samples: u64) -> Result<String, Eva
             .x_desc("IMM mode")
             .y_desc("mean posterior probability")
             .x_label_formatter(&|value| match value {
-                SegmentValue::CenterOf(index) | SegmentValue::Exact(index) => MODE_NAMES
-                    .get(*index as usize)
-                    .copied()
-                    .unwrap_or("")
-                    .to_string(),
+                SegmentValue::CenterOf(index) | SegmentValue::Exact(index) => {
+                    MODE_NAMES.get(*index as usize).copied().unwrap_or("").to_string()
+                }
                 SegmentValue::Last => String::new(),
             })
             .label_style(("sans-serif", 15))
@@ -555,22 +494,17 @@ pub fn mode_probability_svg(means: [f64; 4], samples: u64) -> Result<String, Eva
             let index = index as u32;
             let colour = blend(PALETTE[index as usize], (0, 0, 0), 0.1);
             let mut bar = Rectangle::new(
-                [
-                    (SegmentValue::Exact(index), 0.0),
-                    (SegmentValue::Exact(index + 1), mean),
-                ],
+                [(SegmentValue::Exact(index), 0.0), (SegmentValue::Exact(index + 1), mean)],
                 colour.filled(),
             );
             bar.set_margin(0, 0, 18, 18);
-            chart
-                .draw_series(std::iter::once(bar))
-                .map_err(plot_error)?;
-            let label_style = TextStyle::from(("sans-serif", 16).into_font())
-                .color(&BLACK)
-                .pos(plotters::style::text_anchor::Pos::new(
+            chart.draw_series(std::iter::once(bar)).map_err(plot_error)?;
+            let label_style = TextStyle::from(("sans-serif", 16).into_font()).color(&BLACK).pos(
+                plotters::style::text_anchor::Pos::new(
                     plotters::style::text_anchor::HPos::Center,
                     plotters::style::text_anchor::VPos::Bottom,
-                ));
+                ),
+            );
             chart
                 .draw_series(std::iter::once(Text::new(
                     format!("{mean:.3}"),
@@ -608,10 +542,7 @@ mod tests {
     fn equal_aspect_bounds() {
         // 10 m × 2 m of data on a 400 × 200 px area: 10 m / 400 px = 0.025 m/px dominates,
         // so y grows to 0.025 · 200 = 5 m around its centre.
-        let bounds = Bounds {
-            min: DVec2::new(0.0, 0.0),
-            max: DVec2::new(10.0, 2.0),
-        };
+        let bounds = Bounds { min: DVec2::new(0.0, 0.0), max: DVec2::new(10.0, 2.0) };
         let view = bounds.with_equal_aspect(400, 200);
         assert!((view.max.x - view.min.x - 10.0).abs() < 1e-12);
         assert!((view.max.y - view.min.y - 5.0).abs() < 1e-12);
@@ -622,19 +553,10 @@ mod tests {
     fn drawn_panel_has_equal_metres_per_pixel() {
         // Render one panel of a wide scene onto a non-square area and check the final chart.
         let ground_truth: Vec<TrajectoryPoint> = (0..20)
-            .map(|k| TrajectoryPoint {
-                id: 1,
-                frame: k,
-                position: DVec2::new(k as f64 * 3.0, 1.0),
-            })
+            .map(|k| TrajectoryPoint { id: 1, frame: k, position: DVec2::new(k as f64 * 3.0, 1.0) })
             .collect();
-        let panel = TrajectoryPanel {
-            title: "CV".into(),
-            ..TrajectoryPanel::default()
-        };
-        let bounds = Bounds::of(ground_truth.iter().map(|p| p.position))
-            .unwrap()
-            .padded(2.0);
+        let panel = TrajectoryPanel { title: "CV".into(), ..TrajectoryPanel::default() };
+        let bounds = Bounds::of(ground_truth.iter().map(|p| p.position)).unwrap().padded(2.0);
         let mut svg = String::new();
         let root = SVGBackend::with_string(&mut svg, (700, 300)).into_drawing_area();
         let colours = HashMap::from([(1, 0)]);
@@ -658,10 +580,7 @@ mod tests {
     fn rejects_bad_input() {
         let options = TrajectoryPlotOptions::default();
         assert!(trajectory_svg(&[], &[], &options).is_err());
-        let empty_panel = TrajectoryPanel {
-            title: "CV".into(),
-            ..TrajectoryPanel::default()
-        };
+        let empty_panel = TrajectoryPanel { title: "CV".into(), ..TrajectoryPanel::default() };
         assert!(trajectory_svg(&[], &[empty_panel], &options).is_err());
         assert!(mode_probability_svg([0.5, 0.5, 1.5, 0.0], 1).is_err());
         assert!(mode_probability_svg([0.5, f64::NAN, 0.0, 0.0], 1).is_err());

@@ -25,14 +25,8 @@ pub enum Method {
 
 impl Method {
     /// All methods in the row order of the paper's tables.
-    pub const ALL: [Method; 6] = [
-        Method::Cv,
-        Method::Ca,
-        Method::Ct,
-        Method::Pr,
-        Method::Imm,
-        Method::PrImm,
-    ];
+    pub const ALL: [Method; 6] =
+        [Method::Cv, Method::Ca, Method::Ct, Method::Pr, Method::Imm, Method::PrImm];
 
     /// Machine key used in JSON and file names (`cv`, …, `pr_imm`).
     pub fn key(self) -> &'static str {

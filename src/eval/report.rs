@@ -78,10 +78,7 @@ impl MethodResult {
     /// # Panics
     /// When the methods differ.
     pub fn merge(&mut self, other: &MethodResult) {
-        assert_eq!(
-            self.method, other.method,
-            "cannot merge results of different methods"
-        );
+        assert_eq!(self.method, other.method, "cannot merge results of different methods");
         self.sequences += other.sequences;
         self.rmse.merge(&other.rmse);
         for (category, acc) in &other.scenario_rmse {
@@ -94,20 +91,14 @@ impl MethodResult {
         self.close_proximity.merge(&other.close_proximity);
         self.crossing.merge(&other.crossing);
         for (percent, counts) in &other.missed_detection {
-            self.missed_detection
-                .entry(*percent)
-                .or_default()
-                .merge(counts);
+            self.missed_detection.entry(*percent).or_default().merge(counts);
         }
         self.modes.merge(&other.modes);
     }
 
     /// RMSE accumulator of a motion scenario (empty if none was seen).
     pub fn scenario(&self, category: MotionCategory) -> RmseAccumulator {
-        self.scenario_rmse
-            .get(&category)
-            .copied()
-            .unwrap_or_default()
+        self.scenario_rmse.get(&category).copied().unwrap_or_default()
     }
 
     /// Ground-truth object frames of a motion scenario.
@@ -142,11 +133,7 @@ impl MethodEvaluator {
     ) -> Result<Self, EvalError> {
         scenario_rules.validate()?;
         interaction_rules.validate()?;
-        Ok(Self {
-            scenario_rules,
-            interaction_rules,
-            result: MethodResult::new(method),
-        })
+        Ok(Self { scenario_rules, interaction_rules, result: MethodResult::new(method) })
     }
 
     /// Adds the rows of one nominal sequence (all of its measurements).
@@ -159,23 +146,15 @@ impl MethodEvaluator {
             result.modes.push_record(record);
             if let Some(label) = label {
                 let category = label.category();
-                result
-                    .scenario_rmse
-                    .entry(category)
-                    .or_default()
-                    .push_record(record);
+                result.scenario_rmse.entry(category).or_default().push_record(record);
                 *result.scenario_gt_frames.entry(category).or_default() += 1;
             }
         }
         result.identity.merge(&identity_counts(records));
         let close: Vec<bool> = flags.iter().map(|flag| flag.close_proximity).collect();
-        result
-            .close_proximity
-            .merge(&identity_counts_subset(records, &close));
+        result.close_proximity.merge(&identity_counts_subset(records, &close));
         let crossing: Vec<bool> = flags.iter().map(|flag| flag.crossing).collect();
-        result
-            .crossing
-            .merge(&identity_counts_subset(records, &crossing));
+        result.crossing.merge(&identity_counts_subset(records, &crossing));
         result.sequences += 1;
     }
 
@@ -304,40 +283,26 @@ impl EvaluationReport {
             .map(|category| {
                 let values: Vec<Option<f64>> = Method::ALL
                     .iter()
-                    .map(|m| {
-                        self.result(*m)
-                            .and_then(|r| r.scenario(*category).rmse_xy())
-                    })
+                    .map(|m| self.result(*m).and_then(|r| r.scenario(*category).rmse_xy()))
                     .collect();
                 let count = self.common_count(|r| r.scenario_frames(*category));
                 let mut line = vec![format!("{} ({count})", category.label())];
-                line.extend(
-                    mark_best(&values, Better::Lower, 3)
-                        .iter()
-                        .map(Cell::to_string),
-                );
+                line.extend(mark_best(&values, Better::Lower, 3).iter().map(Cell::to_string));
                 line
             })
             .collect::<Vec<_>>();
-        let mut text = render_table(
-            "Table III. Scenario-wise prior prediction RMSE_xy [m]",
-            &header,
-            &rows,
-        );
+        let mut text =
+            render_table("Table III. Scenario-wise prior prediction RMSE_xy [m]", &header, &rows);
         self.append_notes(&mut text, "* lowest value in its row");
         text
     }
 
     /// Table IV: overall IDSW and IDF1 per method.
     pub fn table_overall_mot(&self) -> String {
-        let idsw: Vec<Option<f64>> = Method::ALL
-            .iter()
-            .map(|m| self.result(*m).map(|r| r.identity.idsw as f64))
-            .collect();
-        let idf1: Vec<Option<f64>> = Method::ALL
-            .iter()
-            .map(|m| self.result(*m).and_then(|r| r.identity.idf1()))
-            .collect();
+        let idsw: Vec<Option<f64>> =
+            Method::ALL.iter().map(|m| self.result(*m).map(|r| r.identity.idsw as f64)).collect();
+        let idf1: Vec<Option<f64>> =
+            Method::ALL.iter().map(|m| self.result(*m).and_then(|r| r.identity.idf1())).collect();
         let idsw = mark_best(&idsw, Better::Lower, 0);
         let idf1 = mark_best(&idf1, Better::Higher, 4);
         let header: Vec<String> = ["Model", "IDSW", "IDF1", "IDTP", "IDFP", "IDFN"]
@@ -373,40 +338,24 @@ impl EvaluationReport {
 
     /// Table V: IDSW and IDF1 per interaction or missed-detection scenario and method.
     pub fn table_scenario_mot(&self) -> String {
-        let mut header = vec![
-            "Scenario (GT object frames)".to_string(),
-            "Metric".to_string(),
-        ];
+        let mut header = vec!["Scenario (GT object frames)".to_string(), "Metric".to_string()];
         header.extend(Method::ALL.iter().map(|m| m.label().to_string()));
         let mut rows = Vec::new();
         for (label, select) in self.identity_scenarios() {
-            let counts: Vec<Option<IdentityCounts>> = Method::ALL
-                .iter()
-                .map(|m| self.result(*m).and_then(&select))
-                .collect();
+            let counts: Vec<Option<IdentityCounts>> =
+                Method::ALL.iter().map(|m| self.result(*m).and_then(&select)).collect();
             let frames = {
-                let present: Vec<u64> = counts
-                    .iter()
-                    .flatten()
-                    .map(|c| c.gt_object_frames)
-                    .collect();
+                let present: Vec<u64> =
+                    counts.iter().flatten().map(|c| c.gt_object_frames).collect();
                 count_text(&present)
             };
             let idsw: Vec<Option<f64>> = counts.iter().map(|c| c.map(|c| c.idsw as f64)).collect();
             let idf1: Vec<Option<f64>> = counts.iter().map(|c| c.and_then(|c| c.idf1())).collect();
             let mut line = vec![format!("{label} ({frames})"), "IDSW".to_string()];
-            line.extend(
-                mark_best(&idsw, Better::Lower, 0)
-                    .iter()
-                    .map(Cell::to_string),
-            );
+            line.extend(mark_best(&idsw, Better::Lower, 0).iter().map(Cell::to_string));
             rows.push(line);
             let mut line = vec![String::new(), "IDF1".to_string()];
-            line.extend(
-                mark_best(&idf1, Better::Higher, 4)
-                    .iter()
-                    .map(Cell::to_string),
-            );
+            line.extend(mark_best(&idf1, Better::Higher, 4).iter().map(Cell::to_string));
             rows.push(line);
         }
         let mut text = render_table_aligned(
@@ -423,13 +372,9 @@ impl EvaluationReport {
     pub fn mode_probability_table(&self) -> String {
         let modes = self.result(Method::PrImm).map(|r| r.modes);
         let mean = modes.and_then(|m| m.mean());
-        let samples = modes
-            .map(|m| group_thousands(m.count()))
-            .unwrap_or_else(|| "n/a".into());
-        let header: Vec<String> = ["Mode", "Mean probability", ""]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let samples = modes.map(|m| group_thousands(m.count())).unwrap_or_else(|| "n/a".into());
+        let header: Vec<String> =
+            ["Mode", "Mean probability", ""].iter().map(|s| s.to_string()).collect();
         let rows = MODE_NAMES
             .iter()
             .enumerate()
@@ -447,9 +392,7 @@ impl EvaluationReport {
         if mean.is_none() {
             let reason = match self.result(Method::PrImm) {
                 Some(_) => "no row carries mode probabilities",
-                None => self
-                    .unavailable_reason(Method::PrImm)
-                    .unwrap_or("not evaluated"),
+                None => self.unavailable_reason(Method::PrImm).unwrap_or("not evaluated"),
             };
             let _ = writeln!(text, "n/a PR-IMM: {reason}");
         }
@@ -494,10 +437,7 @@ impl EvaluationReport {
             };
             methods.insert(method.key().to_string(), value);
         }
-        let modes = self
-            .result(Method::PrImm)
-            .map(|r| r.modes)
-            .unwrap_or_default();
+        let modes = self.result(Method::PrImm).map(|r| r.modes).unwrap_or_default();
         let mean = modes.mean();
         let mut mode_probabilities = Map::new();
         mode_probabilities.insert("method".into(), json!(Method::PrImm.key()));
@@ -530,10 +470,9 @@ impl EvaluationReport {
                 }),
             );
         }
-        for (key, counts) in [
-            ("close_proximity", result.close_proximity),
-            ("crossing_motion", result.crossing),
-        ] {
+        for (key, counts) in
+            [("close_proximity", result.close_proximity), ("crossing_motion", result.crossing)]
+        {
             scenarios.insert(key.to_string(), identity_json(&counts));
         }
         for (percent, counts) in &result.missed_detection {
@@ -563,14 +502,8 @@ impl EvaluationReport {
     /// Table V scenarios: label and how to pick the counts from a result.
     fn identity_scenarios(&self) -> Vec<(String, CountsSelector)> {
         let mut scenarios: Vec<(String, CountsSelector)> = vec![
-            (
-                "Close Proximity".into(),
-                Box::new(|r: &MethodResult| Some(r.close_proximity)),
-            ),
-            (
-                "Crossing Motion".into(),
-                Box::new(|r: &MethodResult| Some(r.crossing)),
-            ),
+            ("Close Proximity".into(), Box::new(|r: &MethodResult| Some(r.close_proximity))),
+            ("Crossing Motion".into(), Box::new(|r: &MethodResult| Some(r.crossing))),
         ];
         for percent in self.miss_percents() {
             scenarios.push((
@@ -855,10 +788,7 @@ mod tests {
         assert_eq!(keys, expected);
         for key in ["rmse_x", "rmse_y", "rmse_xy", "idsw", "idf1", "scenarios"] {
             assert!(methods["cv"].get(key).is_some(), "missing {key}");
-            assert!(
-                methods["pr"].get(key).is_some(),
-                "missing {key} in unavailable entry"
-            );
+            assert!(methods["pr"].get(key).is_some(), "missing {key} in unavailable entry");
         }
         assert_eq!(methods["cv"]["rmse_x"].as_f64().unwrap(), 2.0);
         assert_eq!(methods["pr_imm"]["idsw"].as_u64().unwrap(), 1);
@@ -888,16 +818,23 @@ mod tests {
         // Miss run: 24 GT frames, 22 tracked; overlap (1,1)=11, (2,2)=5, (2,3)=6 → IDTP 17.
         assert_eq!(scenarios["miss_10"]["gt_object_frames"], json!(24));
         assert_eq!(scenarios["miss_10"]["idtp"], json!(17));
-        assert!(!methods["cv"]["scenarios"]
-            .as_object()
-            .unwrap()
-            .contains_key("miss_10"));
+        assert!(!methods["cv"]["scenarios"].as_object().unwrap().contains_key("miss_10"));
         let modes = &json["mode_probabilities"];
         assert_eq!(modes["method"], json!("pr_imm"));
         assert_eq!(modes["samples"], json!(24));
         for key in ["pr", "cv", "ca", "ct"] {
             assert!((modes[key].as_f64().unwrap() - 0.25).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn report_state_serialises_and_restores() {
+        // The additive state (not the rendered JSON) can be stored and merged later.
+        let report = report();
+        let text = serde_json::to_string(&report).unwrap();
+        let restored: EvaluationReport = serde_json::from_str(&text).unwrap();
+        assert_eq!(restored.to_json(), report.to_json());
+        assert_eq!(restored.unavailable_reason(Method::Pr), Some("no prediction model loaded"));
     }
 
     #[test]
@@ -926,19 +863,13 @@ mod tests {
         let report = report();
         let table = report.table_prior_rmse();
         assert_eq!(row(&table, "CV "), vec!["2.000", "0.000*", "2.000", "21"]);
-        assert_eq!(
-            row(&table, "PR-IMM"),
-            vec!["0.500*", "0.000*", "0.500*", "21"]
-        );
+        assert_eq!(row(&table, "PR-IMM"), vec!["0.500*", "0.000*", "0.500*", "21"]);
         assert_eq!(row(&table, "PR "), vec!["n/a", "n/a", "n/a", "n/a"]);
         assert!(table.contains("n/a PR: no prediction model loaded"));
         assert!(table.contains("n/a CT: not evaluated"));
         let table = report.table_overall_mot();
         assert!(table.contains("GT object frames = 24"));
-        assert_eq!(
-            row(&table, "IMM (CV+CA+CT)"),
-            vec!["1*", "0.7500*", "18", "6", "6"]
-        );
+        assert_eq!(row(&table, "IMM (CV+CA+CT)"), vec!["1*", "0.7500*", "18", "6", "6"]);
         let table = report.table_scenario_rmse();
         assert_eq!(
             row(&table, "Straight (6)"),
@@ -963,24 +894,14 @@ mod tests {
         assert!(table.contains("updates = 24"));
         assert_eq!(row(&table, "PR "), vec!["0.250", "##########"]);
         let text = report.to_text();
-        for title in [
-            "Table II",
-            "Table III",
-            "Table IV",
-            "Table V",
-            "Mean mode probability",
-        ] {
+        for title in ["Table II", "Table III", "Table IV", "Table V", "Mean mode probability"] {
             assert!(text.contains(title));
         }
     }
 
     #[test]
     fn best_marking_compares_displayed_values() {
-        let cells = mark_best(
-            &[Some(1.0004), Some(1.0001), None, Some(2.0)],
-            Better::Lower,
-            3,
-        );
+        let cells = mark_best(&[Some(1.0004), Some(1.0001), None, Some(2.0)], Better::Lower, 3);
         let text: Vec<String> = cells.iter().map(Cell::to_string).collect();
         assert_eq!(text, vec!["1.000*", "1.000*", "n/a", "2.000"]);
         let cells = mark_best(&[Some(954.0), Some(1245.0)], Better::Higher, 0);

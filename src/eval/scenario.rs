@@ -188,22 +188,13 @@ impl ScenarioRules {
             ("max_step_gap_s", self.max_step_gap_s),
             ("min_step_speed_mps", self.min_step_speed_mps),
             ("straight_max_net_turn_deg", self.straight_max_net_turn_deg),
-            (
-                "straight_max_total_turn_deg",
-                self.straight_max_total_turn_deg,
-            ),
+            ("straight_max_total_turn_deg", self.straight_max_total_turn_deg),
             ("steady_max_accel_mps2", self.steady_max_accel_mps2),
-            (
-                "ramp_min_speed_consistency",
-                self.ramp_min_speed_consistency,
-            ),
+            ("ramp_min_speed_consistency", self.ramp_min_speed_consistency),
             ("turn_min_net_turn_deg", self.turn_min_net_turn_deg),
             ("turn_min_consistency", self.turn_min_consistency),
             ("turn_max_accel_mps2", self.turn_max_accel_mps2),
-            (
-                "nonlinear_min_total_turn_deg",
-                self.nonlinear_min_total_turn_deg,
-            ),
+            ("nonlinear_min_total_turn_deg", self.nonlinear_min_total_turn_deg),
         ];
         for (name, value) in values {
             if !value.is_finite() || value < 0.0 {
@@ -213,9 +204,7 @@ impl ScenarioRules {
             }
         }
         if self.max_step_gap_s == 0.0 {
-            return Err(EvalError::InvalidRules(
-                "max_step_gap_s must be positive".into(),
-            ));
+            return Err(EvalError::InvalidRules("max_step_gap_s must be positive".into()));
         }
         Ok(())
     }
@@ -245,17 +234,11 @@ impl ScenarioRules {
             mid_times.push(0.5 * (times[i] + times[i - 1]));
             headings.push(displacement.y.atan2(displacement.x));
         }
-        let turns: Vec<f64> = headings
-            .windows(2)
-            .map(|pair| wrap_angle(pair[1] - pair[0]))
-            .collect();
+        let turns: Vec<f64> =
+            headings.windows(2).map(|pair| wrap_angle(pair[1] - pair[0])).collect();
         let net_turn: f64 = turns.iter().sum();
         let total_turn: f64 = turns.iter().map(|turn| turn.abs()).sum();
-        let turn_consistency = if total_turn > 0.0 {
-            net_turn.abs() / total_turn
-        } else {
-            1.0
-        };
+        let turn_consistency = if total_turn > 0.0 { net_turn.abs() / total_turn } else { 1.0 };
         let speed_changes: Vec<f64> = speeds.windows(2).map(|pair| pair[1] - pair[0]).collect();
         let net_speed_change: f64 = speed_changes.iter().sum();
         let total_speed_change: f64 = speed_changes.iter().map(|change| change.abs()).sum();
@@ -310,8 +293,7 @@ impl ScenarioRules {
 
     /// Label of a window of `times` and `positions`, oldest first.
     pub fn classify_window(&self, times: &[f64], positions: &[DVec2]) -> Option<MotionScenario> {
-        self.features(times, positions)
-            .and_then(|features| self.classify_features(&features))
+        self.features(times, positions).and_then(|features| self.classify_features(&features))
     }
 }
 
@@ -334,10 +316,8 @@ pub fn classify_sequence(
         }
         let window = &rows[rows.len() - rules.window_len..];
         let times: Vec<f64> = window.iter().map(|&row| records[row].timestamp_s).collect();
-        let positions: Vec<DVec2> = window
-            .iter()
-            .map(|&row| records[row].reference_position())
-            .collect();
+        let positions: Vec<DVec2> =
+            window.iter().map(|&row| records[row].reference_position()).collect();
         labels[index] = rules.classify_window(&times, &positions);
     }
     labels
@@ -405,10 +385,7 @@ mod tests {
         assert!(features.net_turn_deg.abs() < 1e-9);
         assert!(features.acceleration_mps2.abs() < 1e-9);
         assert!((features.mean_speed_mps - 10.0).abs() < 1e-9);
-        assert_eq!(
-            rules.classify_features(&features),
-            Some(MotionScenario::Straight)
-        );
+        assert_eq!(rules.classify_features(&features), Some(MotionScenario::Straight));
     }
 
     #[test]
@@ -416,19 +393,14 @@ mod tests {
         // x(t) = 10 t − t² (a = −2 m/s²) along a diagonal heading. The mean speed over a step
         // equals the speed at its mid-time, so the fitted slope is exactly −2 m/s².
         let direction = DVec2::new(1.0, 1.0).normalize();
-        let positions: Vec<DVec2> = times(10)
-            .iter()
-            .map(|&t| direction * (10.0 * t - t * t))
-            .collect();
+        let positions: Vec<DVec2> =
+            times(10).iter().map(|&t| direction * (10.0 * t - t * t)).collect();
         let rules = ScenarioRules::default();
         let features = rules.features(&times(10), &positions).unwrap();
         assert!((features.acceleration_mps2 + 2.0).abs() < 1e-9);
         assert!((features.speed_consistency - 1.0).abs() < 1e-12);
         assert!(features.total_turn_deg < 1e-6);
-        assert_eq!(
-            rules.classify_features(&features),
-            Some(MotionScenario::AccelDecel)
-        );
+        assert_eq!(rules.classify_features(&features), Some(MotionScenario::AccelDecel));
     }
 
     #[test]
@@ -440,16 +412,10 @@ mod tests {
         assert!((left.net_turn_deg - 0.48f64.to_degrees()).abs() < 1e-9);
         assert!((left.turn_consistency - 1.0).abs() < 1e-12);
         assert!(left.acceleration_mps2.abs() < 1e-9);
-        assert_eq!(
-            rules.classify_features(&left),
-            Some(MotionScenario::LeftTurn)
-        );
+        assert_eq!(rules.classify_features(&left), Some(MotionScenario::LeftTurn));
         let right = rules.features(&times(10), &arc(8.0, -0.6, 10)).unwrap();
         assert!((right.net_turn_deg + 0.48f64.to_degrees()).abs() < 1e-9);
-        assert_eq!(
-            rules.classify_features(&right),
-            Some(MotionScenario::RightTurn)
-        );
+        assert_eq!(rules.classify_features(&right), Some(MotionScenario::RightTurn));
         assert_eq!(MotionScenario::RightTurn.category(), MotionCategory::Turn);
     }
 
@@ -467,10 +433,7 @@ mod tests {
         let features = rules.features(&times(10), &positions).unwrap();
         assert!(features.net_turn_deg.abs() < 1e-9);
         assert!((features.total_turn_deg - 480.0).abs() < 1e-9);
-        assert_eq!(
-            rules.classify_features(&features),
-            Some(MotionScenario::Nonlinear)
-        );
+        assert_eq!(rules.classify_features(&features), Some(MotionScenario::Nonlinear));
     }
 
     #[test]
@@ -486,10 +449,7 @@ mod tests {
         let rules = ScenarioRules::default();
         let features = rules.features(&times(10), &positions).unwrap();
         assert!((features.acceleration_mps2 - 10.0).abs() < 1e-9);
-        assert_eq!(
-            rules.classify_features(&features),
-            Some(MotionScenario::Nonlinear)
-        );
+        assert_eq!(rules.classify_features(&features), Some(MotionScenario::Nonlinear));
     }
 
     #[test]
@@ -519,12 +479,7 @@ mod tests {
         for (k, position) in arc(10.0, 0.0, 12).into_iter().enumerate() {
             records.push(position_row(k as u64, k as f64 * DT, 1, position));
             if k % 2 == 0 {
-                records.push(position_row(
-                    k as u64,
-                    k as f64 * DT,
-                    2,
-                    position + DVec2::Y * 20.0,
-                ));
+                records.push(position_row(k as u64, k as f64 * DT, 2, position + DVec2::Y * 20.0));
             }
         }
         let labels = classify_sequence(&records, &ScenarioRules::default());
@@ -535,9 +490,7 @@ mod tests {
             .map(|(_, label)| *label)
             .collect();
         assert_eq!(object1.iter().filter(|label| label.is_none()).count(), 9);
-        assert!(object1[9..]
-            .iter()
-            .all(|label| *label == Some(MotionScenario::Straight)));
+        assert!(object1[9..].iter().all(|label| *label == Some(MotionScenario::Straight)));
         let object2_labelled = records
             .iter()
             .zip(&labels)
@@ -549,15 +502,9 @@ mod tests {
     #[test]
     fn rules_validation() {
         assert!(ScenarioRules::default().validate().is_ok());
-        let short = ScenarioRules {
-            window_len: 2,
-            ..ScenarioRules::default()
-        };
+        let short = ScenarioRules { window_len: 2, ..ScenarioRules::default() };
         assert!(short.validate().is_err());
-        let negative = ScenarioRules {
-            turn_min_net_turn_deg: -1.0,
-            ..ScenarioRules::default()
-        };
+        let negative = ScenarioRules { turn_min_net_turn_deg: -1.0, ..ScenarioRules::default() };
         assert!(negative.validate().is_err());
     }
 
