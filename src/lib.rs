@@ -3,6 +3,7 @@
 pub mod association;
 pub mod cli;
 pub mod config;
+pub mod eval;
 pub mod gaussian;
 pub mod imm;
 pub mod io;

@@ -170,6 +170,43 @@ impl Method {
         Self::ALL.into_iter().find(|method| method.id() == id)
     }
 
+    /// Key used in JSON reports and file names (`cv`, …, `pr_imm`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Method::PrImm => "pr_imm",
+            other => other.id(),
+        }
+    }
+
+    /// Display label (`CV`, …, `PR-IMM`).
+    pub fn label(self) -> &'static str {
+        match self {
+            Method::ConstantVelocity => "CV",
+            Method::ConstantAcceleration => "CA",
+            Method::CoordinatedTurn => "CT",
+            Method::Learned => "PR",
+            Method::Imm => "IMM",
+            Method::PrImm => "PR-IMM",
+        }
+    }
+
+    /// Row label of the overall tables, which spell out the IMM's modes.
+    pub fn row_label(self) -> &'static str {
+        match self {
+            Method::Imm => "IMM (CV+CA+CT)",
+            other => other.label(),
+        }
+    }
+
+    /// Parses an id, a key or a label, ignoring case.
+    pub fn parse(text: &str) -> Option<Method> {
+        Self::ALL.into_iter().find(|method| {
+            method.id().eq_ignore_ascii_case(text)
+                || method.key().eq_ignore_ascii_case(text)
+                || method.label().eq_ignore_ascii_case(text)
+        })
+    }
+
     /// Whether the method needs the learned predictor.
     pub fn needs_predictor(self) -> bool {
         self.modes().contains(Mode::Learned)
