@@ -9,6 +9,7 @@ pub mod imm;
 pub mod io;
 pub mod measurement;
 pub mod mode;
+pub mod offline;
 pub mod motion;
 pub mod predictor;
 pub mod scenario;

@@ -1,3 +1,5 @@
-//! Command-line subcommands of the `primm` binary.
+//! Command-line subcommands of the `primm` binary, one file each.
 
 pub mod generate;
+pub mod predictor;
+pub mod track;

@@ -5,6 +5,7 @@
 //! [`Frame`](crate::measurement::Frame).
 
 pub mod measurement_csv;
+pub mod track_csv;
 mod recording;
 
 pub use measurement_csv::{
