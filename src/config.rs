@@ -65,6 +65,8 @@ pub struct TrackerConfig {
     pub confirmation_hits: u32,
     /// Consecutive misses after which a tentative track is deleted.
     pub tentative_max_misses: u32,
+    /// Longest time a tentative track may coast without an update before it is deleted, s.
+    pub tentative_max_coast_s: f64,
     /// Consecutive misses after which a confirmed track is deleted.
     pub confirmed_max_misses: u32,
     /// Longest time a track may coast without an update before it is deleted, s.
@@ -285,6 +287,7 @@ impl Config {
         let tracker = &self.tracker;
         positive("tracker.max_frame_interval_s", tracker.max_frame_interval_s)?;
         positive("tracker.max_coast_s", tracker.max_coast_s)?;
+        positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
         if tracker.confirmation_hits == 0 {
             return Err(invalid("tracker.confirmation_hits", "must be at least 1"));
         }

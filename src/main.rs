@@ -12,6 +12,7 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    Eval(cli::eval::Args),
     Generate(cli::generate::Args),
     Track(cli::track::Args),
 }
@@ -19,6 +20,7 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::Eval(args) => cli::eval::run(args),
         Command::Generate(args) => cli::generate::run(args),
         Command::Track(args) => cli::track::run(args),
     };

@@ -337,18 +337,18 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Removes tentative tracks after `tentative_max_misses` misses, confirmed ones after
-    /// `confirmed_max_misses`, and any track that coasted longer than `max_coast_s`.
+    /// Removes tentative tracks after `tentative_max_misses` misses or `tentative_max_coast_s`
+    /// without update, confirmed ones after `confirmed_max_misses` or `max_coast_s`.
     fn delete(&mut self, t: f64) {
         let lifecycle = &self.config.tracker;
         let rows = &mut self.rows;
         let (mut read, mut write) = (0, 0);
         let deleted = self.table.retain(|track| {
-            let max_misses = match track.status {
-                TrackStatus::Tentative => lifecycle.tentative_max_misses,
-                TrackStatus::Confirmed => lifecycle.confirmed_max_misses,
+            let (max_misses, max_coast_s) = match track.status {
+                TrackStatus::Tentative => (lifecycle.tentative_max_misses, lifecycle.tentative_max_coast_s),
+                TrackStatus::Confirmed => (lifecycle.confirmed_max_misses, lifecycle.max_coast_s),
             };
-            let keep = track.misses <= max_misses && t - track.last_update_s <= lifecycle.max_coast_s;
+            let keep = track.misses <= max_misses && t - track.last_update_s <= max_coast_s;
             if keep {
                 rows[write] = rows[read];
                 write += 1;

@@ -1,0 +1,200 @@
+//! `primm eval`: every method on every sequence of a data set, printed as the paper's tables.
+
+use crate::cli::predictor::predictor_for;
+use crate::config::Config;
+use crate::eval::dropout::{sequence_seed, DropoutMask};
+use crate::eval::plots::{
+    ground_truth_points, majority_ground_truth, write_mode_probability_svg, write_trajectory_svg, TrajectoryPanel,
+    TrajectoryPlotOptions, TrajectoryPoint,
+};
+use crate::eval::record::AssociationRecord;
+use crate::eval::report::{EvaluationReport, MethodEvaluator, DEFAULT_MISS_PERCENTS};
+use crate::io::{read_dataset_dir, Sequence};
+use crate::mode::Method;
+use crate::offline::{association_records, track_sequence};
+use crate::predictor::DisplacementPredictor;
+use crate::tracker::Tracker;
+use clap::Args as ClapArgs;
+use std::path::{Path, PathBuf};
+
+/// Seed of the measurement removal for the missed-detection rows of Table V.
+pub const DEFAULT_MISS_SEED: u64 = 2024;
+
+/// Arguments of `primm eval`.
+#[derive(Debug, Clone, ClapArgs)]
+#[command(about = "Evaluate methods on a data set (a directory of measurement CSV files) and print the paper's tables")]
+pub struct Args {
+    /// Directory of measurement CSV files (one sequence per file).
+    #[arg(long, value_name = "DIR")]
+    pub data: PathBuf,
+    /// Methods to evaluate (comma separated); all six by default.
+    #[arg(long, value_delimiter = ',', default_values_t = Method::ALL.to_vec())]
+    pub methods: Vec<Method>,
+    /// Write the results as JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Write SVG figures (trajectories per method, mean mode probabilities) into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<PathBuf>,
+    /// Sequence drawn in the trajectory figure (file stem); the first one by default.
+    #[arg(long, value_name = "NAME")]
+    pub plot_sequence: Option<String>,
+    /// Tracker configuration (TOML); the built-in defaults otherwise.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// ONNX model of the learned predictor.
+    #[arg(long, value_name = "FILE")]
+    pub model: Option<PathBuf>,
+    /// Seed of the measurement removal for the missed-detection rows.
+    #[arg(long, default_value_t = DEFAULT_MISS_SEED)]
+    pub miss_seed: u64,
+}
+
+/// Runs `primm eval`.
+pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let base_config = match &args.config {
+        Some(path) => Config::from_file(path)?,
+        None => Config::default(),
+    };
+    let sequences = read_dataset_dir(&args.data)?;
+    if sequences.is_empty() {
+        return Err(format!("no measurement CSV files in {}", args.data.display()).into());
+    }
+    let measurements: usize = sequences.iter().map(Sequence::measurement_count).sum();
+    eprintln!("{} sequences, {} measurements from {}", sequences.len(), measurements, args.data.display());
+    let plot_sequence = match &args.plot_sequence {
+        Some(name) => sequences.iter().position(|s| &s.name == name).ok_or(format!("no sequence named {name}"))?,
+        None => 0,
+    };
+
+    let mut report = EvaluationReport::new();
+    let mut panels = Vec::new();
+    let mut ground_truth = Vec::new();
+    for &method in &args.methods {
+        let predictor = match predictor_for(method, args.model.as_deref()) {
+            Ok(predictor) => predictor,
+            Err(reason) => {
+                eprintln!("{method}: unavailable: {reason}");
+                report.mark_unavailable(method, reason);
+                continue;
+            }
+        };
+        let started = std::time::Instant::now();
+        let mut tracker = Tracker::with_predictor(base_config.clone().with_modes(method.modes()), predictor)?;
+        let mut evaluator = MethodEvaluator::new(method);
+        for (index, sequence) in sequences.iter().enumerate() {
+            let mut records = Vec::with_capacity(sequence.measurement_count());
+            let mut points = Vec::new();
+            track_sequence(&mut tracker, sequence, |recorded, outputs| {
+                association_records(recorded, outputs, method, &mut records);
+                if index == plot_sequence {
+                    points.extend(outputs.iter().filter(|o| o.measurement_index.is_some()).map(|o| TrajectoryPoint {
+                        id: o.id,
+                        frame: recorded.index,
+                        position: o.position_m,
+                    }));
+                }
+            })?;
+            evaluator.add_sequence(&records);
+            if index == plot_sequence {
+                ground_truth = ground_truth_points(&records);
+                panels.push(TrajectoryPanel {
+                    title: method.label().to_string(),
+                    tracks: points,
+                    track_to_ground_truth: majority_ground_truth(&records),
+                });
+            }
+            for percent in DEFAULT_MISS_PERCENTS {
+                let records = missed_detection_records(&mut tracker, sequence, method, percent, args.miss_seed)?;
+                evaluator.add_missed_detection_sequence(percent, &records);
+            }
+        }
+        report.insert(evaluator.finish());
+        eprintln!("{method}: {} sequences in {:.1} s", sequences.len(), started.elapsed().as_secs_f64());
+    }
+
+    println!("{}", report.to_text());
+    if let Some(path) = &args.json {
+        report.write_json(path)?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(dir) = &args.plots {
+        write_plots(dir, &report, &ground_truth, &panels, &sequences[plot_sequence].name)?;
+    }
+    Ok(())
+}
+
+/// Re-tracks `sequence` with `percent` % of its measurements removed (the same removal for every
+/// method) and returns one row per ORIGINAL measurement: a removed one is a ground-truth object
+/// frame without a track.
+fn missed_detection_records<P: DisplacementPredictor>(
+    tracker: &mut Tracker<P>,
+    sequence: &Sequence,
+    method: Method,
+    percent: u32,
+    seed: u64,
+) -> Result<Vec<AssociationRecord>, Box<dyn std::error::Error>> {
+    let mask = DropoutMask::new(sequence.measurement_count(), f64::from(percent) / 100.0, sequence_seed(seed, &sequence.name))?;
+    let mut reduced = sequence.clone();
+    let mut flat = 0;
+    for frame in &mut reduced.frames {
+        frame.measurements.retain(|_| {
+            let keep = !mask.is_dropped(flat);
+            flat += 1;
+            keep
+        });
+    }
+    let mut kept_records = Vec::with_capacity(sequence.measurement_count());
+    track_sequence(tracker, &reduced, |recorded, outputs| association_records(recorded, outputs, method, &mut kept_records))?;
+    let mut kept = kept_records.into_iter();
+    let mut records = Vec::with_capacity(sequence.measurement_count());
+    let mut flat = 0;
+    for frame in &sequence.frames {
+        for measurement in &frame.measurements {
+            if mask.is_dropped(flat) {
+                records.push(AssociationRecord {
+                    frame: frame.index,
+                    timestamp_s: frame.timestamp_s,
+                    ground_truth_id: measurement.measurement.ground_truth_id,
+                    class: measurement.measurement.class,
+                    measured: measurement.measurement.position(),
+                    true_position: measurement.true_position,
+                    track_id: None,
+                    prior: None,
+                    mode_probabilities: None,
+                });
+            } else {
+                records.push(kept.next().ok_or("missed-detection rows out of step")?);
+            }
+            flat += 1;
+        }
+    }
+    Ok(records)
+}
+
+fn write_plots(
+    dir: &Path,
+    report: &EvaluationReport,
+    ground_truth: &[TrajectoryPoint],
+    panels: &[TrajectoryPanel],
+    sequence: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
+    std::fs::create_dir_all(dir)?;
+    if !panels.is_empty() {
+        let path = dir.join("trajectories.svg");
+        let options = TrajectoryPlotOptions {
+            title: Some(format!("Ground truth (light, thick) and estimated tracks (dark, thin): {sequence}")),
+            ..TrajectoryPlotOptions::default()
+        };
+        write_trajectory_svg(&path, ground_truth, panels, &options)?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(result) = report.result(Method::PrImm) {
+        if let Some(means) = result.modes.mean() {
+            let path = dir.join("mode_probabilities.svg");
+            write_mode_probability_svg(&path, means, result.modes.count())?;
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
