@@ -70,22 +70,20 @@ pub fn to_nalgebra(m: &DMat2) -> Matrix2<f64> {
     Matrix2::new(m.x_axis.x, m.y_axis.x, m.x_axis.y, m.y_axis.y)
 }
 
-/// Moore–Penrose pseudo-inverse of a symmetric 2×2 matrix via its eigen-decomposition;
-/// eigenvalues below `PSEUDO_INVERSE_RELATIVE_TOLERANCE` × the largest magnitude count as zero.
-/// Equals the ordinary inverse when the matrix is well conditioned.
+/// Moore–Penrose pseudo-inverse of a symmetric positive semi-definite 2×2 matrix, in closed
+/// form. Full rank (the determinant above `PSEUDO_INVERSE_RELATIVE_TOLERANCE` × trace²): the
+/// ordinary inverse. Rank one (`M = λvvᵀ`, `λ` = trace): `M / λ²`. Zero: zero.
 pub fn symmetric_pseudo_inverse(m: &Matrix2<f64>) -> Matrix2<f64> {
-    let eigen = nalgebra::SymmetricEigen::new(*m);
-    let largest = eigen.eigenvalues.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-    let threshold = largest * PSEUDO_INVERSE_RELATIVE_TOLERANCE;
-    let mut result = Matrix2::zeros();
-    for i in 0..2 {
-        let value = eigen.eigenvalues[i];
-        if value.abs() > threshold && value != 0.0 {
-            let v = eigen.eigenvectors.column(i);
-            result += v * v.transpose() / value;
-        }
+    let (a, b, d) = (m[(0, 0)], 0.5 * (m[(0, 1)] + m[(1, 0)]), m[(1, 1)]);
+    let trace = a + d;
+    let determinant = a * d - b * b;
+    if determinant > PSEUDO_INVERSE_RELATIVE_TOLERANCE * trace * trace {
+        Matrix2::new(d, -b, -b, a) / determinant
+    } else if trace > 0.0 {
+        Matrix2::new(a, b, b, d) / (trace * trace)
+    } else {
+        Matrix2::zeros()
     }
-    result
 }
 
 /// Replaces a mode's position marginal by a mixed one (`eq:mixed_state`, `eq:B`, `eq:C`,
@@ -223,6 +221,24 @@ mod tests {
         let pinv = symmetric_pseudo_inverse(&m);
         assert!((m * pinv * m - m).abs().max() < 1e-12);
         assert!((pinv * m * pinv - pinv).abs().max() < 1e-12);
+    }
+
+    #[test]
+    fn closed_form_pseudo_inverse_matches_nalgebra_svd_on_full_rank_rank_one_and_zero_matrices() {
+        let mut cases = vec![Matrix2::zeros(), Matrix2::new(4.0, 0.0, 0.0, 0.0), Matrix2::new(0.0, 0.0, 0.0, 2.5)];
+        for i in 0..200 {
+            let angle = f64::from(i) * 0.37;
+            let v = Vector2::new(angle.cos(), angle.sin());
+            let w = Vector2::new(-angle.sin(), angle.cos());
+            let (large, small) = (0.1 + f64::from(i % 7), [0.0, 1e-3, 0.5][i as usize % 3]);
+            cases.push(v * v.transpose() * large + w * w.transpose() * small);
+        }
+        for m in cases {
+            let reference = m.pseudo_inverse(1e-12).unwrap();
+            let ours = symmetric_pseudo_inverse(&m);
+            let scale = reference.abs().max().max(1.0);
+            assert!((ours - reference).abs().max() < 1e-9 * scale, "{m} -> {ours} vs {reference}");
+        }
     }
 
     #[test]
