@@ -120,6 +120,13 @@ fn outer(a: DVec2, b: DVec2) -> DMat2 {
     DMat2::from_cols(a * b.x, a * b.y)
 }
 
+/// Kalman update of one mode's prior in place; returns its log-likelihood.
+fn update_mode<const N: usize, M: MotionModel<N>>(estimate: &mut Gaussian<N>, model: &M, z: DVec2) -> Result<f64, UpdateError> {
+    let update = kalman_update(estimate, z, &model.measurement_noise())?;
+    *estimate = update.posterior;
+    Ok(update.log_likelihood)
+}
+
 /// Mixes one mode's posterior and predicts it.
 fn mix_and_predict<const N: usize, M: MotionModel<N>>(
     model: &M,
@@ -282,30 +289,14 @@ impl Imm {
         let mut state = prior.state;
         let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
         for mode in self.modes.iter() {
-            let i = mode.index();
-            match mode {
-                Mode::Learned => {
-                    let update = kalman_update(&prior.state.learned, z, &models.learned.measurement_noise())?;
-                    state.learned = update.posterior;
-                    log_likelihood[i] = update.log_likelihood;
-                }
-                Mode::ConstantVelocity => {
-                    let update = kalman_update(&prior.state.constant_velocity, z, &models.constant_velocity.measurement_noise())?;
-                    state.constant_velocity = update.posterior;
-                    log_likelihood[i] = update.log_likelihood;
-                }
+            log_likelihood[mode.index()] = match mode {
+                Mode::Learned => update_mode(&mut state.learned, &models.learned, z)?,
+                Mode::ConstantVelocity => update_mode(&mut state.constant_velocity, &models.constant_velocity, z)?,
                 Mode::ConstantAcceleration => {
-                    let update =
-                        kalman_update(&prior.state.constant_acceleration, z, &models.constant_acceleration.measurement_noise())?;
-                    state.constant_acceleration = update.posterior;
-                    log_likelihood[i] = update.log_likelihood;
+                    update_mode(&mut state.constant_acceleration, &models.constant_acceleration, z)?
                 }
-                Mode::CoordinatedTurn => {
-                    let update = kalman_update(&prior.state.coordinated_turn, z, &models.coordinated_turn.measurement_noise())?;
-                    state.coordinated_turn = update.posterior;
-                    log_likelihood[i] = update.log_likelihood;
-                }
-            }
+                Mode::CoordinatedTurn => update_mode(&mut state.coordinated_turn, &models.coordinated_turn, z)?,
+            };
         }
         state.probabilities = self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
         Ok(state)

@@ -1,9 +1,9 @@
 //! Constant-acceleration model (`eq:ca_F`), state `[x, y, vx, vy, ax, ay]`.
 
-use super::{InitialVelocity, MotionModel, PredictContext};
+use super::{initiate_position_velocity, InitialVelocity, MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
-use nalgebra::{Matrix2, Matrix6, Vector6};
+use nalgebra::{Matrix2, Matrix6};
 
 /// Named state indices.
 pub mod index {
@@ -81,15 +81,11 @@ impl ConstantAcceleration {
 
 impl MotionModel<6> for ConstantAcceleration {
     fn initiate(&self, measurement: &Measurement) -> Gaussian<6> {
-        let (velocity, velocity_covariance) = self.initial_velocity.estimate(measurement);
-        let mut covariance = Matrix6::zeros();
-        covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&self.measurement_noise_m2);
-        covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
+        let mut gaussian = initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
         let acceleration_variance = self.initial_acceleration_std_mps2.powi(2);
-        covariance[(index::AX, index::AX)] = acceleration_variance;
-        covariance[(index::AY, index::AY)] = acceleration_variance;
-        let mean = Vector6::new(measurement.x_m, measurement.y_m, velocity.x, velocity.y, 0.0, 0.0);
-        Gaussian::new(mean, covariance)
+        gaussian.covariance[(index::AX, index::AX)] = acceleration_variance;
+        gaussian.covariance[(index::AY, index::AY)] = acceleration_variance;
+        gaussian
     }
 
     fn predict(&self, posterior: &Gaussian<6>, context: &PredictContext) -> Gaussian<6> {

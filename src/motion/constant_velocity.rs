@@ -1,9 +1,9 @@
 //! Constant-velocity model (`eq:cv_F`), state `[x, y, vx, vy]`.
 
-use super::{white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
+use super::{initiate_position_velocity, white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
-use nalgebra::{Matrix2, Matrix4, Vector4};
+use nalgebra::{Matrix2, Matrix4};
 
 /// Named state indices.
 pub mod index {
@@ -59,11 +59,7 @@ impl ConstantVelocity {
 
 impl MotionModel<4> for ConstantVelocity {
     fn initiate(&self, measurement: &Measurement) -> Gaussian<4> {
-        let (velocity, velocity_covariance) = self.initial_velocity.estimate(measurement);
-        let mut covariance = Matrix4::zeros();
-        covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&self.measurement_noise_m2);
-        covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
-        Gaussian::new(Vector4::new(measurement.x_m, measurement.y_m, velocity.x, velocity.y), covariance)
+        initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity)
     }
 
     fn predict(&self, posterior: &Gaussian<4>, context: &PredictContext) -> Gaussian<4> {

@@ -9,7 +9,7 @@
 //! come from Taylor series whose truncation error (`< φ⁶/5040`) is far below double precision,
 //! so the switch has no visible discontinuity and nothing divides by a vanishing `ω`.
 
-use super::{white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
+use super::{initiate_position_velocity, white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use nalgebra::{Matrix2, SMatrix, SVector};
@@ -154,12 +154,9 @@ impl CoordinatedTurn {
 
 impl MotionModel<5> for CoordinatedTurn {
     fn initiate(&self, measurement: &Measurement) -> Gaussian<5> {
-        let (velocity, velocity_covariance) = self.initial_velocity.estimate(measurement);
-        let mut covariance = Matrix5::zeros();
-        covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&self.measurement_noise_m2);
-        covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
-        covariance[(index::OMEGA, index::OMEGA)] = self.initial_turn_rate_std_radps.powi(2);
-        Gaussian::new(Vector5::new(measurement.x_m, measurement.y_m, velocity.x, velocity.y, 0.0), covariance)
+        let mut gaussian = initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
+        gaussian.covariance[(index::OMEGA, index::OMEGA)] = self.initial_turn_rate_std_radps.powi(2);
+        gaussian
     }
 
     fn predict(&self, posterior: &Gaussian<5>, context: &PredictContext) -> Gaussian<5> {

@@ -127,6 +127,24 @@ impl InitialVelocity {
     }
 }
 
+/// A state of size `N` with the measured position (covariance `R`) and the line-of-sight
+/// velocity of [`InitialVelocity`] in elements 2 and 3; every other element zero.
+pub(crate) fn initiate_position_velocity<const N: usize>(
+    measurement: &Measurement,
+    measurement_noise_m2: &Matrix2<f64>,
+    initial_velocity: &InitialVelocity,
+) -> Gaussian<N> {
+    let (velocity, velocity_covariance) = initial_velocity.estimate(measurement);
+    let mut gaussian: Gaussian<N> = Gaussian::new(nalgebra::SVector::zeros(), nalgebra::SMatrix::zeros());
+    gaussian.mean[0] = measurement.x_m;
+    gaussian.mean[1] = measurement.y_m;
+    gaussian.mean[2] = velocity.x;
+    gaussian.mean[3] = velocity.y;
+    gaussian.covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(measurement_noise_m2);
+    gaussian.covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
+    gaussian
+}
+
 /// Continuous white-noise acceleration covariance of one axis' `[position, velocity]`, per unit PSD.
 pub(crate) fn white_acceleration_block(dt: f64) -> [[f64; 2]; 2] {
     let dt2 = dt * dt;
