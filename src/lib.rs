@@ -1,6 +1,7 @@
 //! primm: PR-IMM multi-object tracking for automotive radar.
 
 pub mod association;
+pub mod eval;
 pub mod measurement;
 pub mod gaussian;
 pub mod mode;

@@ -1,0 +1,926 @@
+//! Aggregation of per-method results into the paper's result tables and JSON.
+//!
+//! [`MethodEvaluator`] consumes the rows of one method sequence by sequence; its
+//! [`MethodResult`] holds additive counters only, so results of separately evaluated sequences
+//! can be merged. [`EvaluationReport`] collects the results of all methods, prints
+//!
+//! * Table II (`tab:prior_rmse`): RMSE_x, RMSE_y, RMSE_xy per method,
+//! * Table III (`tab:scenario_rmse`): RMSE_xy per motion scenario (rows) and method (columns),
+//! * Table IV (`tab:overall_mot`): IDSW and IDF1 per method,
+//! * Table V (`tab:scenario_mot`): IDSW and IDF1 per interaction/missed-detection scenario
+//!   (rows) and method (columns),
+//! * the mean PR-IMM mode probabilities (`fig:mode_probability`),
+//!
+//! as aligned plain text, marking the best value of each comparison with `*`, and writes the same
+//! numbers as JSON. A method without results is printed as `n/a`, never estimated.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Map, Value};
+
+use super::identity::{identity_counts, identity_counts_subset, IdentityCounts};
+use super::interaction::{interaction_flags, InteractionRules};
+use super::modes::{ModeProbabilityAccumulator, MODE_NAMES};
+use super::record::{AssociationRecord, EvalError, Method};
+use super::rmse::RmseAccumulator;
+use super::scenario::{classify_sequence, MotionCategory, ScenarioRules};
+
+/// Drop rates, in percent, of the missed-detection rows printed even without data.
+pub const DEFAULT_MISS_PERCENTS: [u32; 2] = [10, 20];
+
+/// Everything measured for one method; all fields add up over sequences.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MethodResult {
+    /// The method.
+    pub method: Method,
+    /// Number of nominal sequences evaluated.
+    pub sequences: u64,
+    /// Prior RMSE over all rows with a prior.
+    pub rmse: RmseAccumulator,
+    /// Prior RMSE per motion scenario.
+    pub scenario_rmse: BTreeMap<MotionCategory, RmseAccumulator>,
+    /// Ground-truth object frames per motion scenario (with or without a prior).
+    pub scenario_gt_frames: BTreeMap<MotionCategory, u64>,
+    /// Identity counts of the nominal sequences.
+    pub identity: IdentityCounts,
+    /// Identity counts restricted to the close-proximity subset.
+    pub close_proximity: IdentityCounts,
+    /// Identity counts restricted to the crossing-motion subset.
+    pub crossing: IdentityCounts,
+    /// Identity counts of the missed-detection re-runs, keyed by drop rate in percent.
+    pub missed_detection: BTreeMap<u32, IdentityCounts>,
+    /// Posterior mode probabilities of all updates.
+    pub modes: ModeProbabilityAccumulator,
+}
+
+impl MethodResult {
+    /// An empty result.
+    pub fn new(method: Method) -> Self {
+        Self {
+            method,
+            sequences: 0,
+            rmse: RmseAccumulator::new(),
+            scenario_rmse: BTreeMap::new(),
+            scenario_gt_frames: BTreeMap::new(),
+            identity: IdentityCounts::default(),
+            close_proximity: IdentityCounts::default(),
+            crossing: IdentityCounts::default(),
+            missed_detection: BTreeMap::new(),
+            modes: ModeProbabilityAccumulator::new(),
+        }
+    }
+
+    /// Adds the counters of another result of the same method (other sequences).
+    ///
+    /// # Panics
+    /// When the methods differ.
+    pub fn merge(&mut self, other: &MethodResult) {
+        assert_eq!(self.method, other.method, "cannot merge results of different methods");
+        self.sequences += other.sequences;
+        self.rmse.merge(&other.rmse);
+        for (category, acc) in &other.scenario_rmse {
+            self.scenario_rmse.entry(*category).or_default().merge(acc);
+        }
+        for (category, count) in &other.scenario_gt_frames {
+            *self.scenario_gt_frames.entry(*category).or_default() += count;
+        }
+        self.identity.merge(&other.identity);
+        self.close_proximity.merge(&other.close_proximity);
+        self.crossing.merge(&other.crossing);
+        for (percent, counts) in &other.missed_detection {
+            self.missed_detection.entry(*percent).or_default().merge(counts);
+        }
+        self.modes.merge(&other.modes);
+    }
+
+    /// RMSE accumulator of a motion scenario (empty if none was seen).
+    pub fn scenario(&self, category: MotionCategory) -> RmseAccumulator {
+        self.scenario_rmse.get(&category).copied().unwrap_or_default()
+    }
+
+    /// Ground-truth object frames of a motion scenario.
+    pub fn scenario_frames(&self, category: MotionCategory) -> u64 {
+        self.scenario_gt_frames.get(&category).copied().unwrap_or(0)
+    }
+}
+
+/// Evaluates one method sequence by sequence.
+#[derive(Debug, Clone)]
+pub struct MethodEvaluator {
+    scenario_rules: ScenarioRules,
+    interaction_rules: InteractionRules,
+    result: MethodResult,
+}
+
+impl MethodEvaluator {
+    /// An evaluator with the default scenario and interaction rules.
+    pub fn new(method: Method) -> Self {
+        Self {
+            scenario_rules: ScenarioRules::default(),
+            interaction_rules: InteractionRules::default(),
+            result: MethodResult::new(method),
+        }
+    }
+
+    /// An evaluator with custom rules.
+    pub fn with_rules(
+        method: Method,
+        scenario_rules: ScenarioRules,
+        interaction_rules: InteractionRules,
+    ) -> Result<Self, EvalError> {
+        scenario_rules.validate()?;
+        interaction_rules.validate()?;
+        Ok(Self { scenario_rules, interaction_rules, result: MethodResult::new(method) })
+    }
+
+    /// Adds the rows of one nominal sequence (all of its measurements).
+    pub fn add_sequence(&mut self, records: &[AssociationRecord]) {
+        let labels = classify_sequence(records, &self.scenario_rules);
+        let flags = interaction_flags(records, &self.interaction_rules);
+        let result = &mut self.result;
+        for (record, label) in records.iter().zip(&labels) {
+            result.rmse.push_record(record);
+            result.modes.push_record(record);
+            if let Some(label) = label {
+                let category = label.category();
+                result.scenario_rmse.entry(category).or_default().push_record(record);
+                *result.scenario_gt_frames.entry(category).or_default() += 1;
+            }
+        }
+        result.identity.merge(&identity_counts(records));
+        let close: Vec<bool> = flags.iter().map(|flag| flag.close_proximity).collect();
+        result.close_proximity.merge(&identity_counts_subset(records, &close));
+        let crossing: Vec<bool> = flags.iter().map(|flag| flag.crossing).collect();
+        result.crossing.merge(&identity_counts_subset(records, &crossing));
+        result.sequences += 1;
+    }
+
+    /// Adds the rows of one sequence re-run with `drop_percent` % of its measurements removed
+    /// (see [`super::dropout`]); dropped measurements must be present as rows without a track.
+    pub fn add_missed_detection_sequence(
+        &mut self,
+        drop_percent: u32,
+        records: &[AssociationRecord],
+    ) {
+        self.result
+            .missed_detection
+            .entry(drop_percent)
+            .or_default()
+            .merge(&identity_counts(records));
+    }
+
+    /// The result so far.
+    pub fn result(&self) -> &MethodResult {
+        &self.result
+    }
+
+    /// The final result.
+    pub fn finish(self) -> MethodResult {
+        self.result
+    }
+}
+
+/// Results of all methods plus the reasons of those that could not be evaluated.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct EvaluationReport {
+    results: BTreeMap<Method, MethodResult>,
+    unavailable: BTreeMap<Method, String>,
+}
+
+impl EvaluationReport {
+    /// An empty report; every method is `n/a` until a result is inserted.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds (or merges into) the result of a method.
+    pub fn insert(&mut self, result: MethodResult) {
+        self.unavailable.remove(&result.method);
+        match self.results.get_mut(&result.method) {
+            Some(existing) => existing.merge(&result),
+            None => {
+                self.results.insert(result.method, result);
+            }
+        }
+    }
+
+    /// Records why a method has no result (e.g. no prediction model available). Ignored when the
+    /// method already has a result.
+    pub fn mark_unavailable(&mut self, method: Method, reason: impl Into<String>) {
+        if !self.results.contains_key(&method) {
+            self.unavailable.insert(method, reason.into());
+        }
+    }
+
+    /// The result of a method, if evaluated.
+    pub fn result(&self, method: Method) -> Option<&MethodResult> {
+        self.results.get(&method)
+    }
+
+    /// The recorded reason a method is unavailable.
+    pub fn unavailable_reason(&self, method: Method) -> Option<&str> {
+        self.unavailable.get(&method).map(String::as_str)
+    }
+
+    /// Missed-detection drop rates to show: the defaults plus any present in a result.
+    pub fn miss_percents(&self) -> Vec<u32> {
+        let mut percents: Vec<u32> = DEFAULT_MISS_PERCENTS.to_vec();
+        for result in self.results.values() {
+            percents.extend(result.missed_detection.keys().copied());
+        }
+        percents.sort_unstable();
+        percents.dedup();
+        percents
+    }
+
+    /// Table II: one-step prior RMSE per method.
+    pub fn table_prior_rmse(&self) -> String {
+        let metrics: [(&str, RmseMetric); 3] = [
+            ("RMSE_x [m]", RmseAccumulator::rmse_x),
+            ("RMSE_y [m]", RmseAccumulator::rmse_y),
+            ("RMSE_xy [m]", RmseAccumulator::rmse_xy),
+        ];
+        let mut header = vec!["Model".to_string()];
+        header.extend(metrics.iter().map(|(name, _)| name.to_string()));
+        header.push("N".into());
+        let columns: Vec<Vec<Cell>> = metrics
+            .iter()
+            .map(|(_, metric)| {
+                let values: Vec<Option<f64>> = Method::ALL
+                    .iter()
+                    .map(|m| self.result(*m).and_then(|r| metric(&r.rmse)))
+                    .collect();
+                mark_best(&values, Better::Lower, 3)
+            })
+            .collect();
+        let rows = Method::ALL
+            .iter()
+            .enumerate()
+            .map(|(row, method)| {
+                let mut line = vec![method.row_label().to_string()];
+                line.extend(columns.iter().map(|column| column[row].to_string()));
+                line.push(match self.result(*method) {
+                    Some(result) => group_thousands(result.rmse.count()),
+                    None => "n/a".into(),
+                });
+                line
+            })
+            .collect::<Vec<_>>();
+        let mut text = render_table("Table II. One-step prior prediction RMSE", &header, &rows);
+        self.append_notes(&mut text, "* lowest value in its column");
+        text
+    }
+
+    /// Table III: RMSE_xy per motion scenario (rows) and method (columns).
+    pub fn table_scenario_rmse(&self) -> String {
+        let mut header = vec!["Scenario (GT object frames)".to_string()];
+        header.extend(Method::ALL.iter().map(|m| m.label().to_string()));
+        let rows = MotionCategory::ALL
+            .iter()
+            .map(|category| {
+                let values: Vec<Option<f64>> = Method::ALL
+                    .iter()
+                    .map(|m| self.result(*m).and_then(|r| r.scenario(*category).rmse_xy()))
+                    .collect();
+                let count = self.common_count(|r| r.scenario_frames(*category));
+                let mut line = vec![format!("{} ({count})", category.label())];
+                line.extend(mark_best(&values, Better::Lower, 3).iter().map(Cell::to_string));
+                line
+            })
+            .collect::<Vec<_>>();
+        let mut text =
+            render_table("Table III. Scenario-wise prior prediction RMSE_xy [m]", &header, &rows);
+        self.append_notes(&mut text, "* lowest value in its row");
+        text
+    }
+
+    /// Table IV: overall IDSW and IDF1 per method.
+    pub fn table_overall_mot(&self) -> String {
+        let idsw: Vec<Option<f64>> =
+            Method::ALL.iter().map(|m| self.result(*m).map(|r| r.identity.idsw as f64)).collect();
+        let idf1: Vec<Option<f64>> =
+            Method::ALL.iter().map(|m| self.result(*m).and_then(|r| r.identity.idf1())).collect();
+        let idsw = mark_best(&idsw, Better::Lower, 0);
+        let idf1 = mark_best(&idf1, Better::Higher, 4);
+        let header: Vec<String> = ["Model", "IDSW", "IDF1", "IDTP", "IDFP", "IDFN"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let rows = Method::ALL
+            .iter()
+            .enumerate()
+            .map(|(row, method)| {
+                let mut line = vec![
+                    method.row_label().to_string(),
+                    idsw[row].to_string(),
+                    idf1[row].to_string(),
+                ];
+                match self.result(*method) {
+                    Some(r) => line.extend(
+                        [r.identity.idtp, r.identity.idfp, r.identity.idfn].map(group_thousands),
+                    ),
+                    None => line.extend(std::iter::repeat_n("n/a".to_string(), 3)),
+                }
+                line
+            })
+            .collect::<Vec<_>>();
+        let count = self.common_count(|r| r.identity.gt_object_frames);
+        let title = format!(
+            "Table IV. Overall multiple-object-tracking performance (GT object frames = {count})"
+        );
+        let mut text = render_table(&title, &header, &rows);
+        self.append_notes(&mut text, "* lowest IDSW / highest IDF1 in its column");
+        text
+    }
+
+    /// Table V: IDSW and IDF1 per interaction or missed-detection scenario and method.
+    pub fn table_scenario_mot(&self) -> String {
+        let mut header = vec!["Scenario (GT object frames)".to_string(), "Metric".to_string()];
+        header.extend(Method::ALL.iter().map(|m| m.label().to_string()));
+        let mut rows = Vec::new();
+        for (label, select) in self.identity_scenarios() {
+            let counts: Vec<Option<IdentityCounts>> =
+                Method::ALL.iter().map(|m| self.result(*m).and_then(&select)).collect();
+            let frames = {
+                let present: Vec<u64> =
+                    counts.iter().flatten().map(|c| c.gt_object_frames).collect();
+                count_text(&present)
+            };
+            let idsw: Vec<Option<f64>> = counts.iter().map(|c| c.map(|c| c.idsw as f64)).collect();
+            let idf1: Vec<Option<f64>> = counts.iter().map(|c| c.and_then(|c| c.idf1())).collect();
+            let mut line = vec![format!("{label} ({frames})"), "IDSW".to_string()];
+            line.extend(mark_best(&idsw, Better::Lower, 0).iter().map(Cell::to_string));
+            rows.push(line);
+            let mut line = vec![String::new(), "IDF1".to_string()];
+            line.extend(mark_best(&idf1, Better::Higher, 4).iter().map(Cell::to_string));
+            rows.push(line);
+        }
+        let mut text = render_table_aligned(
+            "Table V. Scenario-wise multiple-object-tracking performance",
+            &header,
+            &rows,
+            2,
+        );
+        self.append_notes(&mut text, "* lowest IDSW / highest IDF1 in its row");
+        text
+    }
+
+    /// Mean posterior mode probabilities of PR-IMM (`fig:mode_probability`) as a small table.
+    pub fn mode_probability_table(&self) -> String {
+        let modes = self.result(Method::PrImm).map(|r| r.modes);
+        let mean = modes.and_then(|m| m.mean());
+        let samples = modes.map(|m| group_thousands(m.count())).unwrap_or_else(|| "n/a".into());
+        let header: Vec<String> =
+            ["Mode", "Mean probability", ""].iter().map(|s| s.to_string()).collect();
+        let rows = MODE_NAMES
+            .iter()
+            .enumerate()
+            .map(|(index, name)| match mean {
+                Some(mean) => vec![
+                    name.to_string(),
+                    format!("{:.3}", mean[index]),
+                    "#".repeat((mean[index] * 40.0).round().clamp(0.0, 40.0) as usize),
+                ],
+                None => vec![name.to_string(), "n/a".into(), String::new()],
+            })
+            .collect::<Vec<_>>();
+        let title = format!("Mean mode probability of PR-IMM (updates = {samples})");
+        let mut text = render_table(&title, &header, &rows);
+        if mean.is_none() {
+            let reason = match self.result(Method::PrImm) {
+                Some(_) => "no row carries mode probabilities",
+                None => self.unavailable_reason(Method::PrImm).unwrap_or("not evaluated"),
+            };
+            let _ = writeln!(text, "n/a PR-IMM: {reason}");
+        }
+        text
+    }
+
+    /// All tables, separated by blank lines.
+    pub fn to_text(&self) -> String {
+        [
+            self.table_prior_rmse(),
+            self.table_scenario_rmse(),
+            self.table_overall_mot(),
+            self.table_scenario_mot(),
+            self.mode_probability_table(),
+        ]
+        .join("\n")
+    }
+
+    /// The report as JSON:
+    /// `{"methods": {"<key>": {"available", "rmse_x", "rmse_y", "rmse_xy", "idsw", "idf1",
+    /// "counts": {…}, "scenarios": {…}}}, "mode_probabilities": {…}}`.
+    ///
+    /// `scenarios` holds the Table III entries (`straight`, `accel_decel`, `left_right_turn`,
+    /// `nonlinear`: RMSE values, `rmse_samples`, `gt_object_frames`) and the Table V entries
+    /// (`close_proximity`, `crossing_motion`, `miss_<percent>`: `idsw`, `idf1`, IDTP/IDFP/IDFN and
+    /// frame counts). Unavailable methods have `"available": false`, a `reason`, `null` metrics and
+    /// empty `scenarios`. `mode_probabilities` holds PR-IMM's mean probabilities per mode and the
+    /// number of updates (`null` values without updates).
+    pub fn to_json(&self) -> Value {
+        let mut methods = Map::new();
+        for method in Method::ALL {
+            let value = match self.result(method) {
+                Some(result) => self.method_json(result),
+                None => json!({
+                    "available": false,
+                    "reason": self.unavailable_reason(method).unwrap_or("not evaluated"),
+                    "rmse_x": null, "rmse_y": null, "rmse_xy": null,
+                    "idsw": null, "idf1": null,
+                    "counts": null,
+                    "scenarios": {},
+                }),
+            };
+            methods.insert(method.key().to_string(), value);
+        }
+        let modes = self.result(Method::PrImm).map(|r| r.modes).unwrap_or_default();
+        let mean = modes.mean();
+        let mut mode_probabilities = Map::new();
+        mode_probabilities.insert("method".into(), json!(Method::PrImm.key()));
+        mode_probabilities.insert("samples".into(), json!(modes.count()));
+        for (index, name) in MODE_NAMES.iter().enumerate() {
+            mode_probabilities.insert(name.to_ascii_lowercase(), json!(mean.map(|m| m[index])));
+        }
+        json!({ "methods": methods, "mode_probabilities": mode_probabilities })
+    }
+
+    /// Writes [`EvaluationReport::to_json`] pretty-printed to `path`.
+    pub fn write_json(&self, path: impl AsRef<Path>) -> Result<(), EvalError> {
+        let text = serde_json::to_string_pretty(&self.to_json())?;
+        std::fs::write(path, text + "\n")?;
+        Ok(())
+    }
+
+    fn method_json(&self, result: &MethodResult) -> Value {
+        let mut scenarios = Map::new();
+        for category in MotionCategory::ALL {
+            let acc = result.scenario(category);
+            scenarios.insert(
+                category.key().to_string(),
+                json!({
+                    "rmse_x": acc.rmse_x(),
+                    "rmse_y": acc.rmse_y(),
+                    "rmse_xy": acc.rmse_xy(),
+                    "rmse_samples": acc.count(),
+                    "gt_object_frames": result.scenario_frames(category),
+                }),
+            );
+        }
+        for (key, counts) in
+            [("close_proximity", result.close_proximity), ("crossing_motion", result.crossing)]
+        {
+            scenarios.insert(key.to_string(), identity_json(&counts));
+        }
+        for (percent, counts) in &result.missed_detection {
+            scenarios.insert(format!("miss_{percent}"), identity_json(counts));
+        }
+        json!({
+            "available": true,
+            "rmse_x": result.rmse.rmse_x(),
+            "rmse_y": result.rmse.rmse_y(),
+            "rmse_xy": result.rmse.rmse_xy(),
+            "idsw": result.identity.idsw,
+            "idf1": result.identity.idf1(),
+            "counts": {
+                "sequences": result.sequences,
+                "rmse_samples": result.rmse.count(),
+                "gt_object_frames": result.identity.gt_object_frames,
+                "estimated_object_frames": result.identity.estimated_object_frames,
+                "idtp": result.identity.idtp,
+                "idfp": result.identity.idfp,
+                "idfn": result.identity.idfn,
+                "mode_probability_samples": result.modes.count(),
+            },
+            "scenarios": scenarios,
+        })
+    }
+
+    /// Table V scenarios: label and how to pick the counts from a result.
+    fn identity_scenarios(&self) -> Vec<(String, CountsSelector)> {
+        let mut scenarios: Vec<(String, CountsSelector)> = vec![
+            ("Close Proximity".into(), Box::new(|r: &MethodResult| Some(r.close_proximity))),
+            ("Crossing Motion".into(), Box::new(|r: &MethodResult| Some(r.crossing))),
+        ];
+        for percent in self.miss_percents() {
+            scenarios.push((
+                format!("{percent}% Miss"),
+                Box::new(move |r: &MethodResult| r.missed_detection.get(&percent).copied()),
+            ));
+        }
+        scenarios
+    }
+
+    /// A count that should be the same for every evaluated method, as text.
+    fn common_count(&self, count: impl Fn(&MethodResult) -> u64) -> String {
+        let present: Vec<u64> = self.results.values().map(count).collect();
+        count_text(&present)
+    }
+
+    fn append_notes(&self, text: &mut String, best_note: &str) {
+        let _ = writeln!(text, "{best_note}");
+        for method in Method::ALL {
+            if self.result(method).is_none() {
+                let reason = self.unavailable_reason(method).unwrap_or("not evaluated");
+                let _ = writeln!(text, "n/a {}: {reason}", method.label());
+            }
+        }
+    }
+}
+
+fn identity_json(counts: &IdentityCounts) -> Value {
+    json!({
+        "idsw": counts.idsw,
+        "idf1": counts.idf1(),
+        "idtp": counts.idtp,
+        "idfp": counts.idfp,
+        "idfn": counts.idfn,
+        "gt_object_frames": counts.gt_object_frames,
+        "estimated_object_frames": counts.estimated_object_frames,
+    })
+}
+
+/// Reads one RMSE value from an accumulator.
+type RmseMetric = fn(&RmseAccumulator) -> Option<f64>;
+
+/// Picks the identity counts of one Table V scenario from a result.
+type CountsSelector = Box<dyn Fn(&MethodResult) -> Option<IdentityCounts>>;
+
+/// Which direction is better.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Better {
+    Lower,
+    Higher,
+}
+
+/// A formatted table cell.
+#[derive(Debug, Clone, PartialEq)]
+enum Cell {
+    Missing,
+    Value { text: String, best: bool },
+}
+
+impl std::fmt::Display for Cell {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Cell::Missing => f.write_str("n/a"),
+            Cell::Value { text, best: true } => write!(f, "{text}*"),
+            Cell::Value { text, best: false } => f.write_str(text),
+        }
+    }
+}
+
+/// Formats values with `decimals` digits (integers grouped by thousands when `decimals == 0`)
+/// and marks the best ones. Values are compared as displayed, so ties at the shown precision are
+/// all marked; nothing is marked when fewer than two values are present.
+fn mark_best(values: &[Option<f64>], better: Better, decimals: usize) -> Vec<Cell> {
+    let shown: Vec<Option<f64>> = values
+        .iter()
+        .map(|value| value.map(|v| format!("{v:.decimals$}").parse::<f64>().unwrap_or(v)))
+        .collect();
+    let present: Vec<f64> = shown.iter().flatten().copied().collect();
+    let best = match better {
+        Better::Lower => present.iter().copied().fold(f64::INFINITY, f64::min),
+        Better::Higher => present.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    };
+    values
+        .iter()
+        .zip(&shown)
+        .map(|(value, shown)| match (value, shown) {
+            (Some(value), Some(shown)) => Cell::Value {
+                text: if decimals == 0 {
+                    group_thousands(value.round() as u64)
+                } else {
+                    format!("{value:.decimals$}")
+                },
+                best: present.len() >= 2 && *shown == best,
+            },
+            _ => Cell::Missing,
+        })
+        .collect()
+}
+
+/// `17866` → `17,866`.
+pub(crate) fn group_thousands(value: u64) -> String {
+    let digits = value.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (index, digit) in digits.chars().enumerate() {
+        if index > 0 && (digits.len() - index) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(digit);
+    }
+    out
+}
+
+/// The common value of counts that should agree, `n/a` without any, or the range when they differ.
+fn count_text(values: &[u64]) -> String {
+    match (values.iter().min(), values.iter().max()) {
+        (Some(min), Some(max)) if min == max => group_thousands(*min),
+        (Some(min), Some(max)) => format!("{}–{}", group_thousands(*min), group_thousands(*max)),
+        _ => "n/a".into(),
+    }
+}
+
+/// Renders a title, a header and rows; the first column is left-aligned, the others right-aligned.
+fn render_table(title: &str, header: &[String], rows: &[Vec<String>]) -> String {
+    render_table_aligned(title, header, rows, 1)
+}
+
+/// Renders a table whose first `left_columns` columns are left-aligned and the rest right-aligned.
+fn render_table_aligned(
+    title: &str,
+    header: &[String],
+    rows: &[Vec<String>],
+    left_columns: usize,
+) -> String {
+    let columns = header.len();
+    let mut widths: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for row in rows {
+        for (width, cell) in widths.iter_mut().zip(row) {
+            *width = (*width).max(cell.chars().count());
+        }
+    }
+    let format_row = |cells: &[String]| -> String {
+        let mut line = String::new();
+        for (index, width) in widths.iter().enumerate() {
+            let cell = cells.get(index).map(String::as_str).unwrap_or("");
+            let pad = width.saturating_sub(cell.chars().count());
+            if index > 0 {
+                line.push_str("  ");
+            }
+            if index < left_columns {
+                line.push_str(cell);
+                line.push_str(&" ".repeat(pad));
+            } else {
+                line.push_str(&" ".repeat(pad));
+                line.push_str(cell);
+            }
+        }
+        line.trim_end().to_string()
+    };
+    let total = widths.iter().sum::<usize>() + 2 * columns.saturating_sub(1);
+    let rule = "-".repeat(total);
+    let mut text = String::new();
+    let _ = writeln!(text, "{title}");
+    let _ = writeln!(text, "{rule}");
+    let _ = writeln!(text, "{}", format_row(header));
+    let _ = writeln!(text, "{rule}");
+    for row in rows {
+        let _ = writeln!(text, "{}", format_row(row));
+    }
+    let _ = writeln!(text, "{rule}");
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::record::test_support::position_row;
+    use glam::DVec2;
+
+    /// One sequence: object 1 drives straight along +x at 10 m/s for 12 frames (0.1 s apart);
+    /// object 2 drives parallel 3 m to the left. The tracker of `method` gives object 1 track 1
+    /// throughout and object 2 track 2 until frame 5, then track 3 (one switch). Every prior is
+    /// off by `error` metres in x, except each track's first row (no prior).
+    fn sequence(error: f64) -> Vec<AssociationRecord> {
+        let mut rows = Vec::new();
+        for k in 0..12u64 {
+            let t = k as f64 * 0.1;
+            let p1 = DVec2::new(10.0 * t, 0.0);
+            let mut r1 = position_row(k, t, 1, p1);
+            r1.track_id = Some(1);
+            r1.prior = (k > 0).then_some(p1 + DVec2::new(error, 0.0));
+            r1.mode_probabilities = Some([0.4, 0.3, 0.2, 0.1]);
+            rows.push(r1);
+            let p2 = DVec2::new(10.0 * t, 3.0);
+            let mut r2 = position_row(k, t, 2, p2);
+            r2.track_id = Some(if k <= 5 { 2 } else { 3 });
+            r2.prior = (k > 0 && k != 6).then_some(p2 + DVec2::new(error, 0.0));
+            r2.mode_probabilities = Some([0.1, 0.2, 0.3, 0.4]);
+            rows.push(r2);
+        }
+        rows
+    }
+
+    fn evaluate(method: Method, error: f64) -> MethodResult {
+        let mut evaluator = MethodEvaluator::new(method);
+        evaluator.add_sequence(&sequence(error));
+        evaluator.finish()
+    }
+
+    #[test]
+    fn evaluator_collects_all_metrics() {
+        let result = evaluate(Method::PrImm, 0.5);
+        // Priors: object 1 has 11, object 2 has 10 (frames 0 and 6 start tracks) → 21 samples.
+        assert_eq!(result.rmse.count(), 21);
+        assert!((result.rmse.rmse_x().unwrap() - 0.5).abs() < 1e-12);
+        assert_eq!(result.rmse.rmse_y(), Some(0.0));
+        // Identity: 24 GT frames, 24 estimated; overlap (1,1)=12, (2,2)=6, (2,3)=6 → IDTP 18.
+        assert_eq!(result.identity.idsw, 1);
+        assert_eq!(result.identity.idtp, 18);
+        assert_eq!((result.identity.idfp, result.identity.idfn), (6, 6));
+        // The objects are 3 m apart in every frame → every row is close proximity; parallel
+        // headings → no crossing.
+        assert_eq!(result.close_proximity.gt_object_frames, 24);
+        assert_eq!(result.close_proximity.idsw, 1);
+        assert_eq!(result.crossing.gt_object_frames, 0);
+        // Straight motion: rows of frames 9..=11 of both objects have ten positions → 6 rows.
+        assert_eq!(result.scenario_frames(MotionCategory::Straight), 6);
+        assert_eq!(result.scenario(MotionCategory::Straight).count(), 6);
+        assert_eq!(result.scenario_frames(MotionCategory::Turn), 0);
+        // Mode probabilities averaged over 24 updates: (0.25, 0.25, 0.25, 0.25).
+        let mean = result.modes.mean().unwrap();
+        assert!(mean.iter().all(|p| (p - 0.25).abs() < 1e-12));
+    }
+
+    #[test]
+    fn merged_results_equal_joint_evaluation() {
+        let mut joint = MethodEvaluator::new(Method::Cv);
+        joint.add_sequence(&sequence(1.0));
+        joint.add_sequence(&sequence(2.0));
+        let joint = joint.finish();
+        let mut merged = evaluate(Method::Cv, 1.0);
+        merged.merge(&evaluate(Method::Cv, 2.0));
+        // Sums of floating-point squares may differ in the last bit with the order of addition;
+        // all integer counters must agree exactly.
+        assert_eq!(merged.identity, joint.identity);
+        assert_eq!(merged.close_proximity, joint.close_proximity);
+        assert_eq!(merged.crossing, joint.crossing);
+        assert_eq!(merged.scenario_gt_frames, joint.scenario_gt_frames);
+        assert_eq!(merged.rmse.count(), joint.rmse.count());
+        assert!((merged.rmse.rmse_xy().unwrap() - joint.rmse.rmse_xy().unwrap()).abs() < 1e-12);
+        assert_eq!(merged.modes, joint.modes);
+        assert_eq!(merged.sequences, 2);
+        assert_eq!(merged.identity.idsw, 2);
+        // RMSE over both: sqrt((21·1 + 21·4) / 42) = sqrt(2.5).
+        assert!((merged.rmse.rmse_x().unwrap() - 2.5f64.sqrt()).abs() < 1e-12);
+    }
+
+    fn report() -> EvaluationReport {
+        let mut report = EvaluationReport::new();
+        report.insert(evaluate(Method::Cv, 2.0));
+        report.insert(evaluate(Method::Imm, 1.0));
+        let mut pr_imm = MethodEvaluator::new(Method::PrImm);
+        pr_imm.add_sequence(&sequence(0.5));
+        // A 10 % miss re-run where two measurements were dropped (rows without track).
+        let mut reduced = sequence(0.5);
+        reduced[4].track_id = None;
+        reduced[4].prior = None;
+        reduced[9].track_id = None;
+        reduced[9].prior = None;
+        pr_imm.add_missed_detection_sequence(10, &reduced);
+        report.insert(pr_imm.finish());
+        report.mark_unavailable(Method::Pr, "no prediction model loaded");
+        report
+    }
+
+    #[test]
+    fn json_shape() {
+        let json = report().to_json();
+        let methods = json["methods"].as_object().unwrap();
+        let keys: Vec<&str> = methods.keys().map(String::as_str).collect();
+        let mut expected: Vec<&str> = Method::ALL.iter().map(|m| m.key()).collect();
+        expected.sort_unstable();
+        assert_eq!(keys, expected);
+        for key in ["rmse_x", "rmse_y", "rmse_xy", "idsw", "idf1", "scenarios"] {
+            assert!(methods["cv"].get(key).is_some(), "missing {key}");
+            assert!(methods["pr"].get(key).is_some(), "missing {key} in unavailable entry");
+        }
+        assert_eq!(methods["cv"]["rmse_x"].as_f64().unwrap(), 2.0);
+        assert_eq!(methods["pr_imm"]["idsw"].as_u64().unwrap(), 1);
+        assert!((methods["pr_imm"]["idf1"].as_f64().unwrap() - 36.0 / 48.0).abs() < 1e-12);
+        // Unavailable and never-evaluated methods are null, not zero.
+        assert_eq!(methods["pr"]["available"], json!(false));
+        assert_eq!(methods["pr"]["reason"], json!("no prediction model loaded"));
+        assert!(methods["pr"]["rmse_xy"].is_null() && methods["pr"]["idf1"].is_null());
+        assert!(methods["ct"]["idsw"].is_null());
+        // Scenario entries.
+        let scenarios = methods["pr_imm"]["scenarios"].as_object().unwrap();
+        for key in [
+            "straight",
+            "accel_decel",
+            "left_right_turn",
+            "nonlinear",
+            "close_proximity",
+            "crossing_motion",
+            "miss_10",
+        ] {
+            assert!(scenarios.contains_key(key), "missing scenario {key}");
+        }
+        assert_eq!(scenarios["straight"]["gt_object_frames"], json!(6));
+        assert!(scenarios["accel_decel"]["rmse_xy"].is_null());
+        assert_eq!(scenarios["close_proximity"]["gt_object_frames"], json!(24));
+        assert_eq!(scenarios["crossing_motion"]["idf1"], Value::Null);
+        // Miss run: 24 GT frames, 22 tracked; overlap (1,1)=11, (2,2)=5, (2,3)=6 → IDTP 17.
+        assert_eq!(scenarios["miss_10"]["gt_object_frames"], json!(24));
+        assert_eq!(scenarios["miss_10"]["idtp"], json!(17));
+        assert!(!methods["cv"]["scenarios"].as_object().unwrap().contains_key("miss_10"));
+        let modes = &json["mode_probabilities"];
+        assert_eq!(modes["method"], json!("pr_imm"));
+        assert_eq!(modes["samples"], json!(24));
+        for key in ["pr", "cv", "ca", "ct"] {
+            assert!((modes[key].as_f64().unwrap() - 0.25).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn report_state_serialises_and_restores() {
+        // The additive state (not the rendered JSON) can be stored and merged later.
+        let report = report();
+        let text = serde_json::to_string(&report).unwrap();
+        let restored: EvaluationReport = serde_json::from_str(&text).unwrap();
+        assert_eq!(restored.to_json(), report.to_json());
+        assert_eq!(restored.unavailable_reason(Method::Pr), Some("no prediction model loaded"));
+    }
+
+    #[test]
+    fn json_round_trips_through_text() {
+        let dir = std::env::temp_dir().join(format!("primm-eval-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("report.json");
+        let report = report();
+        report.write_json(&path).unwrap();
+        let parsed: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        assert_eq!(parsed, report.to_json());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The line of `table` whose first cell is `label`, split into cells.
+    fn row<'a>(table: &'a str, label: &str) -> Vec<&'a str> {
+        let line = table
+            .lines()
+            .find(|line| line.starts_with(label))
+            .unwrap_or_else(|| panic!("no row {label} in\n{table}"));
+        line[label.len()..].split_whitespace().collect()
+    }
+
+    #[test]
+    fn tables_mark_best_and_print_na() {
+        let report = report();
+        let table = report.table_prior_rmse();
+        assert_eq!(row(&table, "CV "), vec!["2.000", "0.000*", "2.000", "21"]);
+        assert_eq!(row(&table, "PR-IMM"), vec!["0.500*", "0.000*", "0.500*", "21"]);
+        assert_eq!(row(&table, "PR "), vec!["n/a", "n/a", "n/a", "n/a"]);
+        assert!(table.contains("n/a PR: no prediction model loaded"));
+        assert!(table.contains("n/a CT: not evaluated"));
+        let table = report.table_overall_mot();
+        assert!(table.contains("GT object frames = 24"));
+        assert_eq!(row(&table, "IMM (CV+CA+CT)"), vec!["1*", "0.7500*", "18", "6", "6"]);
+        let table = report.table_scenario_rmse();
+        assert_eq!(
+            row(&table, "Straight (6)"),
+            vec!["2.000", "n/a", "n/a", "n/a", "1.000", "0.500*"]
+        );
+        assert_eq!(row(&table, "Left/Right Turn (0)"), vec!["n/a"; 6]);
+        let table = report.table_scenario_mot();
+        assert_eq!(
+            row(&table, "Close Proximity (24)"),
+            vec!["IDSW", "1*", "n/a", "n/a", "n/a", "1*", "1*"]
+        );
+        // Only PR-IMM has a 10 % run: a single value is not marked.
+        assert_eq!(
+            row(&table, "10% Miss (24)"),
+            vec!["IDSW", "n/a", "n/a", "n/a", "n/a", "n/a", "1"]
+        );
+        assert_eq!(
+            row(&table, "20% Miss (n/a)"),
+            vec!["IDSW", "n/a", "n/a", "n/a", "n/a", "n/a", "n/a"]
+        );
+        let table = report.mode_probability_table();
+        assert!(table.contains("updates = 24"));
+        assert_eq!(row(&table, "PR "), vec!["0.250", "##########"]);
+        let text = report.to_text();
+        for title in ["Table II", "Table III", "Table IV", "Table V", "Mean mode probability"] {
+            assert!(text.contains(title));
+        }
+    }
+
+    #[test]
+    fn best_marking_compares_displayed_values() {
+        let cells = mark_best(&[Some(1.0004), Some(1.0001), None, Some(2.0)], Better::Lower, 3);
+        let text: Vec<String> = cells.iter().map(Cell::to_string).collect();
+        assert_eq!(text, vec!["1.000*", "1.000*", "n/a", "2.000"]);
+        let cells = mark_best(&[Some(954.0), Some(1245.0)], Better::Higher, 0);
+        let text: Vec<String> = cells.iter().map(Cell::to_string).collect();
+        assert_eq!(text, vec!["954", "1,245*"]);
+        assert_eq!(group_thousands(17866), "17,866");
+        assert_eq!(group_thousands(999), "999");
+        assert_eq!(group_thousands(1_000_000), "1,000,000");
+    }
+
+    #[test]
+    fn inserting_twice_merges_and_clears_unavailable() {
+        let mut report = EvaluationReport::new();
+        report.mark_unavailable(Method::Cv, "later");
+        report.insert(evaluate(Method::Cv, 1.0));
+        report.insert(evaluate(Method::Cv, 1.0));
+        assert_eq!(report.unavailable_reason(Method::Cv), None);
+        assert_eq!(report.result(Method::Cv).unwrap().sequences, 2);
+        report.mark_unavailable(Method::Cv, "ignored");
+        assert_eq!(report.unavailable_reason(Method::Cv), None);
+    }
+}
