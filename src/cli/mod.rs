@@ -1,0 +1,3 @@
+//! Command-line subcommands of the `primm` binary.
+
+pub mod generate;
