@@ -1,1 +1,46 @@
-fn main() {}
+//! `primm`: command-line host of the PR-IMM tracker. Each subcommand lives in `src/cli/`.
+
+use clap::{Parser, Subcommand};
+use primm::cli;
+use std::process::ExitCode;
+
+/// PR-IMM multi-object tracking for automotive radar.
+#[derive(Debug, Parser)]
+#[command(name = "primm", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the tracker as a shared-memory service (iceoryx2).
+    Serve(cli::serve::Args),
+    /// Run tracker, publisher and subscriber on a built-in scenario and print accuracy and latency.
+    Demo(cli::demo::Args),
+    /// Replay measurement frames onto the service (same as `primm-publisher`).
+    Publish(cli::publish::Args),
+    /// Show or record the tracks of the service (same as `primm-subscriber`).
+    Subscribe(cli::subscribe::Args),
+    /// Generate simulated radar sequences as measurement CSV files.
+    Generate(cli::generate::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    cli::init_logging();
+    let result: Result<(), Box<dyn std::error::Error>> = match cli.command {
+        Command::Serve(args) => cli::serve::run(args).map_err(Into::into),
+        Command::Demo(args) => cli::demo::run(args).map_err(Into::into),
+        Command::Publish(args) => cli::publish::run(args).map_err(Into::into),
+        Command::Subscribe(args) => cli::subscribe::run(args).map_err(Into::into),
+        Command::Generate(args) => cli::generate::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error}");
+            ExitCode::FAILURE
+        }
+    }
+}

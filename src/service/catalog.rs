@@ -186,6 +186,10 @@ impl ServiceNames {
 /// [`crate::service::shutdown`]). Creating a node also removes the resources of nodes that died
 /// without cleaning up (e.g. after `kill -9`), so a restarted program starts clean.
 pub fn create_node(name: &str) -> Result<Node<Ipc>, ConnectError> {
+    // iceoryx2 logs to the console on its own; keep it to errors unless IOX2_LOG_LEVEL says
+    // otherwise (primm's own logs go through `tracing`).
+    static QUIET_ICEORYX2: std::sync::Once = std::sync::Once::new();
+    QUIET_ICEORYX2.call_once(|| set_log_level_from_env_or(LogLevel::Error));
     let mut builder = NodeBuilder::new().signal_handling_mode(SignalHandlingMode::Disabled);
     if let Ok(node_name) = NodeName::new(name) {
         builder = builder.name(&node_name);

@@ -86,13 +86,13 @@ pub fn format_table(rows: &[StageLatency]) -> String {
     let mut table = String::new();
     let _ = writeln!(
         table,
-        "{:<20} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "{:<24} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}",
         "stage", "count", "p50 µs", "p90 µs", "p99 µs", "p99.9 µs", "max µs", "mean µs"
     );
     for row in rows.iter().filter(|row| row.count > 0) {
         let _ = writeln!(
             table,
-            "{:<20} {:>9} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
+            "{:<24} {:>9} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
             row.name_str(),
             row.count,
             us(row.p50_ns),

@@ -13,11 +13,14 @@
 //! - [`shutdown`]: SIGINT/SIGTERM handling.
 //! - [`log_limit`]: bounded logging of repeated faults.
 
+pub mod accuracy;
 pub mod catalog;
 pub mod clock;
 pub mod latency;
 pub mod log_limit;
+pub mod replay;
 pub mod shutdown;
+pub mod track_csv;
 pub mod tracking;
 
 pub use catalog::{ConnectError, ServiceNames};

@@ -295,6 +295,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         }
         let mut header = TrackFrameHeader {
             input_sequence: frame.sequence,
+            source_frame: frame.source_frame,
             sensor_timestamp_s: frame.sensor_timestamp_s,
             input_publish_time_ns: frame.publish_time_ns,
             receive_time_ns: receive_ns,

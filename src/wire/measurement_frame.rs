@@ -96,7 +96,7 @@ impl WireMeasurement {
     }
 }
 
-/// One radar frame: 16 440 bytes, alignment 8.
+/// One radar frame: 16 448 bytes, alignment 8.
 ///
 /// `count` comes from another process and is not trusted: [`FrameView::len`] reports it as it
 /// is, so that a frame claiming more than [`MEASUREMENT_CAPACITY`] measurements is rejected by
@@ -108,6 +108,9 @@ impl WireMeasurement {
 pub struct MeasurementFrame {
     /// Publisher's frame counter, starting at 0 for each publisher.
     pub sequence: u64,
+    /// Index of the frame in its recording (the `frame` column of a measurement CSV file);
+    /// carried through to the track frame.
+    pub source_frame: u64,
     /// Sensor time of the frame, s (the only time the tracker reads).
     pub sensor_timestamp_s: f64,
     /// `CLOCK_MONOTONIC` time at which the publisher sent the frame, ns (0 if unknown).
@@ -213,15 +216,17 @@ impl<'a> MeasurementFrameWriter<'a> {
 
     /// Writes the header (with `count` set to the measurements written) and returns the count.
     /// The frame's header and first `count` measurements are then initialised.
-    pub fn finish(self, sequence: u64, sensor_timestamp_s: f64, publish_time_ns: u64, flags: u32, ego: Option<(f64, f64, f64)>) -> usize {
+    pub fn finish(self, header: &MeasurementFrameHeader) -> usize {
         let frame = self.frame.as_mut_ptr();
-        let (ego_x_m, ego_y_m, ego_yaw_rad) = ego.unwrap_or((0.0, 0.0, 0.0));
-        let flags = if ego.is_some() { flags | FRAME_FLAG_EGO_VALID } else { flags & !FRAME_FLAG_EGO_VALID };
+        let (ego_x_m, ego_y_m, ego_yaw_rad) = header.ego.unwrap_or((0.0, 0.0, 0.0));
+        let flags =
+            if header.ego.is_some() { header.flags | FRAME_FLAG_EGO_VALID } else { header.flags & !FRAME_FLAG_EGO_VALID };
         // SAFETY: as in `push`: raw field pointers into a live, aligned allocation.
         unsafe {
-            addr_of_mut!((*frame).sequence).write(sequence);
-            addr_of_mut!((*frame).sensor_timestamp_s).write(sensor_timestamp_s);
-            addr_of_mut!((*frame).publish_time_ns).write(publish_time_ns);
+            addr_of_mut!((*frame).sequence).write(header.sequence);
+            addr_of_mut!((*frame).source_frame).write(header.source_frame);
+            addr_of_mut!((*frame).sensor_timestamp_s).write(header.sensor_timestamp_s);
+            addr_of_mut!((*frame).publish_time_ns).write(header.publish_time_ns);
             addr_of_mut!((*frame).ego_x_m).write(ego_x_m);
             addr_of_mut!((*frame).ego_y_m).write(ego_y_m);
             addr_of_mut!((*frame).ego_yaw_rad).write(ego_yaw_rad);
@@ -230,4 +235,21 @@ impl<'a> MeasurementFrameWriter<'a> {
         }
         self.count
     }
+}
+
+/// The header fields of a [`MeasurementFrame`] other than `count`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MeasurementFrameHeader {
+    /// See [`MeasurementFrame::sequence`].
+    pub sequence: u64,
+    /// See [`MeasurementFrame::source_frame`].
+    pub source_frame: u64,
+    /// See [`MeasurementFrame::sensor_timestamp_s`].
+    pub sensor_timestamp_s: f64,
+    /// See [`MeasurementFrame::publish_time_ns`].
+    pub publish_time_ns: u64,
+    /// `FRAME_FLAG_*` bits; [`FRAME_FLAG_EGO_VALID`] follows `ego`.
+    pub flags: u32,
+    /// Ego pose `(x_m, y_m, yaw_rad)`, if known.
+    pub ego: Option<(f64, f64, f64)>,
 }

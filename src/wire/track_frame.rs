@@ -175,13 +175,15 @@ impl WireTrack {
     }
 }
 
-/// The tracker's output for one input frame: 77 880 bytes, alignment 8.
+/// The tracker's output for one input frame: 77 888 bytes, alignment 8.
 #[repr(C)]
 #[derive(Debug, ZeroCopySend)]
 #[type_name("primm::TrackFrame")]
 pub struct TrackFrame {
     /// `sequence` of the input measurement frame.
     pub input_sequence: u64,
+    /// `source_frame` of the input frame (its index in the recording).
+    pub source_frame: u64,
     /// Sensor time of the input frame, s.
     pub sensor_timestamp_s: f64,
     /// `publish_time_ns` of the input frame (publisher send time), `CLOCK_MONOTONIC` ns.
@@ -224,6 +226,8 @@ impl TrackFrame {
 pub struct TrackFrameHeader {
     /// See [`TrackFrame::input_sequence`].
     pub input_sequence: u64,
+    /// See [`TrackFrame::source_frame`].
+    pub source_frame: u64,
     /// See [`TrackFrame::sensor_timestamp_s`].
     pub sensor_timestamp_s: f64,
     /// See [`TrackFrame::input_publish_time_ns`].
@@ -303,6 +307,7 @@ impl<'a> TrackFrameWriter<'a> {
         // SAFETY: raw field pointers into a live, aligned allocation.
         unsafe {
             addr_of_mut!((*frame).input_sequence).write(header.input_sequence);
+            addr_of_mut!((*frame).source_frame).write(header.source_frame);
             addr_of_mut!((*frame).sensor_timestamp_s).write(header.sensor_timestamp_s);
             addr_of_mut!((*frame).input_publish_time_ns).write(header.input_publish_time_ns);
             addr_of_mut!((*frame).receive_time_ns).write(header.receive_time_ns);
