@@ -1,9 +1,11 @@
 //! The tracking loop: take a measurement sample, track it in place, write the tracks straight
 //! into a loaned track sample, send, notify; record latencies; report them every few frames.
 //!
-//! Nothing on this path allocates per frame (`tests/service_allocation.rs` counts it), with two
-//! deliberate exceptions off the normal path: a logged warning (bounded by [`LogLimiter`]) and
-//! the setup of a new connection when a port joins.
+//! primm's code on this path allocates nothing per frame (`tests/service_allocation.rs` counts
+//! it). What remains: iceoryx2 0.10's `Publisher::loan_uninit` allocates one 48-byte
+//! reference-counted handle per loaned sample (no public API avoids it), and, off the normal
+//! path, a logged warning (bounded by [`LogLimiter`]) and the setup of a connection when a port
+//! joins.
 //!
 //! The loop waits on the measurement stream's iceoryx2 listener (event-driven, the default) or
 //! spins on the subscriber ([`WaitMode::BusyPoll`]). It does not use a `WaitSet` because
