@@ -38,8 +38,21 @@ fn the_python_subscriber_reads_the_tracks_the_tracker_publishes() {
         std::thread::sleep(Duration::from_millis(20));
     }
 
+    // Lines from the Python subscriber, read on a thread; one frame at a time so that the
+    // Python side never falls behind by a full subscriber buffer.
+    let stdout = python.0.stdout.take().unwrap();
+    let (line_tx, line_rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::BufReader::new(stdout).lines() {
+            if line_tx.send(line.unwrap()).is_err() {
+                break;
+            }
+        }
+    });
+
     let frames = common::scene_frames(&common::lanes(4), FRAMES, 0.05, 0.2, 3);
     let mut expected = Vec::new();
+    let mut seen = Vec::new();
     for (k, frame) in frames.iter().enumerate() {
         client.send(frame, k as u64, 0);
         let answer = client
@@ -50,12 +63,8 @@ fn the_python_subscriber_reads_the_tracks_the_tracker_publishes() {
             })
             .expect("the tracker answers");
         expected.push(answer);
-    }
-
-    let stdout = python.0.stdout.take().unwrap();
-    let mut seen = Vec::new();
-    for line in std::io::BufReader::new(stdout).lines() {
-        let record: serde_json::Value = serde_json::from_str(&line.unwrap()).expect("one JSON object per line");
+        let line = line_rx.recv_timeout(Duration::from_secs(20)).expect("the Python subscriber prints the frame");
+        let record: serde_json::Value = serde_json::from_str(&line).expect("one JSON object per line");
         let tracks: Vec<(u64, f64, f64, bool)> = record["tracks"]
             .as_array()
             .unwrap()
