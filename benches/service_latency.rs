@@ -7,7 +7,6 @@
 //! `cargo bench --bench service_latency [-- FRAMES]`
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 
 use common::service::{spawn_serve, unique_prefix, TestClient};

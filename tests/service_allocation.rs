@@ -10,6 +10,7 @@
 
 mod common;
 #[path = "common/counting_allocator.rs"]
+#[allow(dead_code)]
 mod counting_allocator;
 
 use common::service::{unique_prefix, TestClient};
