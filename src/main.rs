@@ -1,10 +1,12 @@
-//! The `primm` command: a thin dispatcher over the library's subcommands.
+//! `primm`: command-line host of the PR-IMM tracker. Each subcommand lives in `src/cli/`.
 
 use clap::{Parser, Subcommand};
 use primm::cli;
+use std::process::ExitCode;
 
+/// PR-IMM multi-object tracking for automotive radar.
 #[derive(Debug, Parser)]
-#[command(name = "primm", version, about = "PR-IMM multi-object tracking for automotive radar")]
+#[command(name = "primm", version, about)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -12,20 +14,39 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    Eval(cli::eval::Args),
+    /// Run tracker, publisher and subscriber on a built-in scenario and print accuracy and latency.
+    Demo(cli::demo::Args),
+    /// Run the tracker as a shared-memory service (iceoryx2).
+    Serve(cli::serve::Args),
+    /// Replay measurement frames onto the service (same as `primm-publisher`).
+    Publish(cli::publish::Args),
+    /// Show or record the tracks of the service (same as `primm-subscriber`).
+    Subscribe(cli::subscribe::Args),
+    /// Generate simulated radar sequences as measurement CSV files.
     Generate(cli::generate::Args),
+    /// Track a measurement CSV file offline into a track CSV file.
     Track(cli::track::Args),
+    /// Evaluate methods on a data set and print the paper's tables.
+    Eval(cli::eval::Args),
 }
 
-fn main() {
+fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match &cli.command {
-        Command::Eval(args) => cli::eval::run(args),
-        Command::Generate(args) => cli::generate::run(args),
-        Command::Track(args) => cli::track::run(args),
+    cli::init_logging();
+    let result: Result<(), Box<dyn std::error::Error>> = match cli.command {
+        Command::Demo(args) => cli::demo::run(args).map_err(Into::into),
+        Command::Serve(args) => cli::serve::run(args).map_err(Into::into),
+        Command::Publish(args) => cli::publish::run(args).map_err(Into::into),
+        Command::Subscribe(args) => cli::subscribe::run(args).map_err(Into::into),
+        Command::Generate(args) => cli::generate::run(&args),
+        Command::Track(args) => cli::track::run(&args),
+        Command::Eval(args) => cli::eval::run(&args),
     };
-    if let Err(error) = result {
-        eprintln!("primm: {error}");
-        std::process::exit(1);
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error}");
+            ExitCode::FAILURE
+        }
     }
 }

@@ -17,6 +17,7 @@ use crate::track::{Track, TrackOutput, TrackStatus};
 use crate::track_table::{TrackTable, MAX_TRACKS};
 use crate::validation::{validate_frame, validate_measurement, FrameError, MeasurementRejection};
 use crate::mode::{Mode, ModeSet};
+use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use arrayvec::ArrayVec;
 use glam::DVec2;
 
@@ -146,7 +147,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Tracks one frame and returns the state of every live track.
     pub fn step<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<&[TrackOutput], StepError> {
-        self.advance(frame)?;
+        self.advance(frame, &mut NoObserver)?;
         self.outputs.clear();
         let outputs = &mut self.outputs;
         report(&self.table, &self.rows[..], &self.imm, |output| outputs.push(*output));
@@ -161,22 +162,40 @@ impl<P: DisplacementPredictor> Tracker<P> {
         frame: &F,
         sink: impl FnMut(&TrackOutput),
     ) -> Result<usize, StepError> {
-        self.advance(frame)?;
-        Ok(report(&self.table, &self.rows[..], &self.imm, sink))
+        self.step_observed(frame, &mut NoObserver, sink)
+    }
+
+    /// [`step_into`](Self::step_into), telling `observer` when each [`Stage`] finishes, so
+    /// that a caller can time the stages with its own clock.
+    pub fn step_observed<F: FrameView + ?Sized, O: StageObserver>(
+        &mut self,
+        frame: &F,
+        observer: &mut O,
+        sink: impl FnMut(&TrackOutput),
+    ) -> Result<usize, StepError> {
+        self.advance(frame, observer)?;
+        let count = report(&self.table, &self.rows[..], &self.imm, sink);
+        observer.stage_finished(Stage::Report);
+        Ok(count)
     }
 
     /// Everything but the report.
-    fn advance<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<(), StepError> {
+    fn advance<F: FrameView + ?Sized, O: StageObserver>(&mut self, frame: &F, observer: &mut O) -> Result<(), StepError> {
         let dt_s = self.validate(frame)?;
+        observer.stage_finished(Stage::Validate);
         let t = frame.timestamp_s();
         self.request_learned_predictions(t);
         self.predict_physics(dt_s);
+        observer.stage_finished(Stage::Predict);
         self.fuse_priors();
+        observer.stage_finished(Stage::LearnedWait);
         self.associate(frame)?;
+        observer.stage_finished(Stage::Associate);
         self.update(frame, t);
         self.coast();
         self.initiate(frame, t);
         self.delete(t);
+        observer.stage_finished(Stage::Update);
         self.last_timestamp_s = Some(t);
         self.stats.frames_tracked += 1;
         Ok(())

@@ -1,1 +1,25 @@
-fn main() {}
+//! `primm-subscriber`: shows or records the tracks the primm tracker publishes on
+//! `primm/tracks`, with accuracy and latency. See `primm-subscriber --help`.
+
+use clap::Parser;
+use std::process::ExitCode;
+
+/// Show or record the tracks published on primm/tracks, with accuracy and latency.
+#[derive(Debug, Parser)]
+#[command(name = "primm-subscriber", version)]
+struct Cli {
+    #[command(flatten)]
+    args: primm::cli::subscribe::Args,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    primm::cli::init_logging();
+    match primm::cli::subscribe::run(cli.args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error}");
+            ExitCode::FAILURE
+        }
+    }
+}

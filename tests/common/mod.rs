@@ -157,3 +157,4 @@ impl primm::predictor::DisplacementPredictor for LaneOracle {
         }
     }
 }
+pub mod service;

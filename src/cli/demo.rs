@@ -1,0 +1,234 @@
+//! `primm demo`: the tracker, a publisher and a subscriber as three processes talking over
+//! iceoryx2, on the built-in scenario; prints tracking accuracy and latency percentiles.
+//!
+//! The publisher and subscriber are the `primm-publisher` and `primm-subscriber` binaries next
+//! to this executable when the workspace was built (`cargo build --release --workspace`);
+//! otherwise this executable runs the same code as `primm publish` / `primm subscribe`, so
+//! `cargo run --release -- demo` works from a fresh checkout.
+
+use super::publish::DEFAULT_SCENARIO_SEED;
+use crate::mode::Method;
+use crate::service::catalog;
+use crate::service::{ConnectError, ServiceNames};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
+
+/// Arguments of `primm demo`.
+#[derive(Debug, Clone, clap::Args)]
+#[command(about = "Run tracker, publisher and subscriber over shared memory on a built-in scenario")]
+pub struct Args {
+    /// Seed of the generated scenario.
+    #[arg(long, default_value_t = DEFAULT_SCENARIO_SEED)]
+    pub seed: u64,
+    /// Recorded duration of the scenario, s.
+    #[arg(long, default_value_t = 20.0, value_name = "S")]
+    pub duration_s: f64,
+    /// Replay speed factor.
+    #[arg(long, default_value_t = 2.0, value_name = "FACTOR")]
+    pub speed: f64,
+    /// Tracking method (cv, ca, ct, imm).
+    #[arg(long, default_value = "imm")]
+    pub method: Method,
+    /// Let the tracker and subscriber spin instead of sleeping.
+    #[arg(long)]
+    pub busy_poll: bool,
+}
+
+/// Why the demo failed.
+#[derive(Debug, thiserror::Error)]
+pub enum DemoError {
+    /// This executable's path is unknown.
+    #[error("cannot locate the primm executable: {0}")]
+    Executable(std::io::Error),
+    /// A process could not be started.
+    #[error("cannot start {what}: {source}")]
+    Spawn {
+        /// Which process.
+        what: &'static str,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The demo could not watch the services.
+    #[error(transparent)]
+    Connect(#[from] ConnectError),
+    /// A process did not come up or finish in time.
+    #[error("{what} did not {event} within {seconds} s")]
+    Timeout {
+        /// Which process.
+        what: &'static str,
+        /// What it did not do.
+        event: &'static str,
+        /// The wait.
+        seconds: u64,
+    },
+    /// A process failed.
+    #[error("{what} failed ({status}){output}")]
+    Failed {
+        /// Which process.
+        what: &'static str,
+        /// Its exit status.
+        status: ExitStatus,
+        /// What it printed, if captured.
+        output: String,
+    },
+    /// The subscriber never saw the end of the replay.
+    #[error("the subscriber did not receive the answer to the last frame")]
+    Incomplete,
+}
+
+/// A child process killed when dropped, unless it was waited for.
+struct Managed {
+    what: &'static str,
+    child: Child,
+}
+
+impl Managed {
+    fn spawn(what: &'static str, command: &mut Command) -> Result<Self, DemoError> {
+        let child = command.spawn().map_err(|source| DemoError::Spawn { what, source })?;
+        Ok(Self { what, child })
+    }
+
+    fn is_running(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+
+    /// Waits for exit; captured stdout is returned.
+    fn wait(mut self, timeout: Duration) -> Result<(ExitStatus, String), DemoError> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(status) = self.child.try_wait().map_err(|source| DemoError::Spawn { what: self.what, source })? {
+                let mut output = String::new();
+                if let Some(mut stdout) = self.child.stdout.take() {
+                    use std::io::Read;
+                    let _ = stdout.read_to_string(&mut output);
+                }
+                return Ok((status, output));
+            }
+            if Instant::now() >= deadline {
+                return Err(DemoError::Timeout { what: self.what, event: "finish", seconds: timeout.as_secs() });
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    fn interrupt(&self) {
+        // SAFETY: sending a signal to our own child by its pid has no memory-safety concerns.
+        unsafe {
+            libc::kill(self.child.id() as libc::pid_t, libc::SIGINT);
+        }
+    }
+}
+
+impl Drop for Managed {
+    fn drop(&mut self) {
+        if matches!(self.child.try_wait(), Ok(None)) {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// A command running `binary` next to `exe` if it exists, else `exe subcommand`.
+fn companion(exe: &Path, binary: &str, subcommand: &str) -> Command {
+    let sibling = exe.with_file_name(format!("{binary}{}", std::env::consts::EXE_SUFFIX));
+    if sibling.is_file() {
+        Command::new(sibling)
+    } else {
+        let mut command = Command::new(exe);
+        command.arg(subcommand);
+        command
+    }
+}
+
+/// Runs the demo.
+pub fn run(args: Args) -> Result<(), DemoError> {
+    let exe = std::env::current_exe().map_err(DemoError::Executable)?;
+    let prefix = format!("primm-demo-{}", std::process::id());
+    let names = ServiceNames::new(&prefix);
+    let summary_path: PathBuf = std::env::temp_dir().join(format!("{prefix}-summary.json"));
+    let quiet_logs = |command: &mut Command| {
+        command.env("RUST_LOG", std::env::var("RUST_LOG").unwrap_or_else(|_| "warn".to_owned()));
+    };
+
+    println!(
+        "primm demo: {:.0} s scenario (seed {}) replayed at {}x; tracker method {}; services under '{prefix}/'",
+        args.duration_s, args.seed, args.speed, args.method
+    );
+    let mut serve_command = Command::new(&exe);
+    serve_command
+        .args(["serve", "--service-prefix", &prefix, "--method", args.method.id(), "--latency-every", "50"])
+        .stdout(Stdio::piped());
+    if args.busy_poll {
+        serve_command.arg("--busy-poll");
+    }
+    quiet_logs(&mut serve_command);
+    let mut tracker = Managed::spawn("the tracker (primm serve)", &mut serve_command)?;
+
+    let mut subscriber_command = companion(&exe, "primm-subscriber", "subscribe");
+    subscriber_command
+        .args(["--service-prefix", &prefix, "--until-end", "--quiet", "--idle-timeout-s", "60", "--json"])
+        .arg(&summary_path)
+        .stdout(Stdio::piped());
+    if args.busy_poll {
+        subscriber_command.arg("--busy-poll");
+    }
+    quiet_logs(&mut subscriber_command);
+    let mut subscriber = Managed::spawn("the subscriber", &mut subscriber_command)?;
+
+    // Start the publisher once the tracker serves and the subscriber listens, so that no frame
+    // and no answer is missed.
+    let node = catalog::create_node("primm-demo")?;
+    let tracks = catalog::tracks(&node, &names)?;
+    let ready_deadline = Instant::now() + Duration::from_secs(30);
+    while tracks.publisher_count() == 0 || tracks.subscriber_count() == 0 {
+        if !tracker.is_running() || !subscriber.is_running() || Instant::now() >= ready_deadline {
+            let what = if !tracker.is_running() { tracker.what } else { subscriber.what };
+            return Err(DemoError::Timeout { what, event: "come up", seconds: 30 });
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+
+    let mut publisher_command = companion(&exe, "primm-publisher", "publish");
+    publisher_command.args([
+        "--service-prefix",
+        &prefix,
+        "--scenario",
+        "--seed",
+        &args.seed.to_string(),
+        "--duration-s",
+        &args.duration_s.to_string(),
+        "--speed",
+        &args.speed.to_string(),
+    ]);
+    quiet_logs(&mut publisher_command);
+    let publisher = Managed::spawn("the publisher", &mut publisher_command)?;
+    let replay_s = args.duration_s / args.speed.max(1e-3);
+    let (status, _) = publisher.wait(Duration::from_secs_f64(replay_s + 60.0))?;
+    if !status.success() {
+        return Err(DemoError::Failed { what: "the publisher", status, output: String::new() });
+    }
+    let (status, subscriber_output) = subscriber.wait(Duration::from_secs(60))?;
+    if !status.success() {
+        return Err(DemoError::Failed { what: "the subscriber", status, output: format!(":\n{subscriber_output}") });
+    }
+    tracker.interrupt();
+    let (status, tracker_output) = tracker.wait(Duration::from_secs(10))?;
+    if !status.success() {
+        return Err(DemoError::Failed { what: "the tracker", status, output: format!(":\n{tracker_output}") });
+    }
+
+    println!("\n== subscriber (primm-subscriber) ==\n{subscriber_output}");
+    println!("== tracker (primm serve) ==\n{tracker_output}");
+    let complete = std::fs::read_to_string(&summary_path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .and_then(|json| json.get("stream_end_seen").and_then(serde_json::Value::as_bool))
+        .unwrap_or(false);
+    let _ = std::fs::remove_file(&summary_path);
+    if !complete {
+        return Err(DemoError::Incomplete);
+    }
+    println!("demo finished: every frame tracked and answered over shared memory");
+    Ok(())
+}

@@ -1,0 +1,28 @@
+//! The tracker as a shared-memory service (iceoryx2).
+//!
+//! ```text
+//! primm/measurements ──► TrackingService ──► primm/tracks
+//!  (MeasurementFrame)     Tracker::step_observed      (TrackFrame, written in place)
+//!                         reads the sample in place ──► primm/latency (LatencyReport)
+//! ```
+//!
+//! - [`catalog`]: service names and QoS, shared by every primm program.
+//! - [`tracking`]: the tracking loop.
+//! - [`latency`]: latency histograms, reports and tables.
+//! - [`clock`]: the monotonic clock the latencies are measured with.
+//! - [`shutdown`]: SIGINT/SIGTERM handling.
+//! - [`log_limit`]: bounded logging of repeated faults.
+
+pub mod accuracy;
+pub mod catalog;
+pub mod clock;
+pub mod latency;
+pub mod log_limit;
+pub mod replay;
+pub mod shutdown;
+pub mod track_csv;
+pub mod tracking;
+
+pub use catalog::{ConnectError, ServiceNames};
+pub use shutdown::ShutdownFlag;
+pub use tracking::{ServiceCounters, TrackingLoopError, TrackingOptions, TrackingService, WaitMode};

@@ -1,0 +1,188 @@
+//! The served tracker under faults: malformed frames, dead subscribers, a publisher killed and
+//! restarted, the tracker itself killed with SIGKILL and restarted.
+
+mod common;
+
+use common::service::{spawn_serve, unique_prefix, ChildGuard, TestClient};
+use primm::measurement::Frame;
+use primm::service::ServiceNames;
+use primm::wire::{FrameStatus, TRACK_FLAG_TRACKER_RESET};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn lane_frames(count: usize) -> Vec<Frame> {
+    common::scene_frames(&common::lanes(6), count, 0.05, 0.2, 9)
+}
+
+/// (sequence, status, confirmed ids, measurements rejected, flags) of the next answer.
+fn answer(client: &TestClient) -> (u64, Option<FrameStatus>, Vec<u64>, u16, u8) {
+    client
+        .next_answer(Duration::from_secs(10), |a| {
+            let confirmed = a.valid_tracks().iter().filter(|t| t.status == 1).map(|t| t.id).collect();
+            (a.input_sequence, a.frame_status(), confirmed, a.measurements_rejected, a.flags)
+        })
+        .expect("the tracker answers")
+}
+
+#[test]
+fn malformed_frames_are_rejected_and_counted_and_the_next_good_frame_is_tracked() {
+    let prefix = unique_prefix("malformed");
+    let client = TestClient::new(&ServiceNames::new(&prefix));
+    let serve = spawn_serve(&prefix, &[]);
+    client.wait_for_tracker(Duration::from_secs(20));
+    let frames = lane_frames(40);
+    let mut confirmed_before = Vec::new();
+    for (k, frame) in frames.iter().take(20).enumerate() {
+        client.send(frame, k as u64, 0);
+        let (sequence, status, confirmed, _, _) = answer(&client);
+        assert_eq!((sequence, status), (k as u64, Some(FrameStatus::Tracked)));
+        confirmed_before = confirmed;
+    }
+    assert_eq!(confirmed_before.len(), 6);
+
+    // A NaN position: that measurement is left out, the frame is tracked.
+    let mut with_nan = frames[20].clone();
+    with_nan.measurements[0].x_m = f64::NAN;
+    client.send(&with_nan, 20, 0);
+    let (_, status, _, rejected, _) = answer(&client);
+    assert_eq!((status, rejected), (Some(FrameStatus::Tracked), 1));
+
+    // More measurements claimed than a frame holds.
+    client.send_raw(|frame| {
+        frame.sequence = 21;
+        frame.sensor_timestamp_s = frames[21].timestamp_s;
+        frame.count = 100_000;
+    });
+    assert_eq!(answer(&client).1, Some(FrameStatus::RejectedTooManyMeasurements));
+    // Time going backwards.
+    client.send(&frames[5], 22, 0);
+    assert_eq!(answer(&client).1, Some(FrameStatus::RejectedTimestampNotIncreasing));
+    // A NaN timestamp.
+    client.send_raw(|frame| {
+        frame.sequence = 23;
+        frame.sensor_timestamp_s = f64::NAN;
+    });
+    assert_eq!(answer(&client).1, Some(FrameStatus::RejectedNonFiniteTimestamp));
+
+    // The next good frame continues the same tracks.
+    client.send(&frames[24], 24, 0);
+    let (sequence, status, confirmed, rejected, flags) = answer(&client);
+    assert_eq!((sequence, status, rejected), (24, Some(FrameStatus::Tracked), 0));
+    assert_eq!(confirmed, confirmed_before, "the rejected frames did not disturb the tracks");
+    assert_eq!(flags & TRACK_FLAG_TRACKER_RESET, 0);
+
+    serve.signal(libc::SIGTERM);
+    let (status, stdout) = serve.wait(Duration::from_secs(10));
+    assert!(status.success());
+    assert!(stdout.contains("frames: 25 received, 22 tracked, 3 rejected, 0 lost"), "{stdout}");
+    assert!(stdout.contains("1 rejected; tracks"), "{stdout}");
+}
+
+#[test]
+fn a_subscriber_that_dies_or_stops_reading_never_blocks_the_tracker() {
+    let prefix = unique_prefix("slow-subscriber");
+    let client = TestClient::new(&ServiceNames::new(&prefix));
+    let _serve = spawn_serve(&prefix, &[]);
+    client.wait_for_tracker(Duration::from_secs(20));
+    let spawn_subscriber = || {
+        ChildGuard(
+            Command::new(env!("CARGO_BIN_EXE_primm"))
+                .args(["subscribe", "--quiet", "--service-prefix", &prefix])
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .unwrap(),
+        )
+    };
+    let stopped = spawn_subscriber();
+    let killed = spawn_subscriber();
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while client.tracks.subscriber_count() < 3 {
+        assert!(Instant::now() < deadline, "subscribers did not come up");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    stopped.signal(libc::SIGSTOP);
+    killed.signal(libc::SIGKILL);
+
+    // Far more frames than any subscriber buffer holds; every answer must still come promptly.
+    let frames = lane_frames(300);
+    for (k, frame) in frames.iter().enumerate() {
+        client.send(frame, k as u64, 0);
+        let (sequence, status, _, _, _) = answer(&client);
+        assert_eq!((sequence, status), (k as u64, Some(FrameStatus::Tracked)));
+    }
+    stopped.signal(libc::SIGCONT);
+}
+
+#[test]
+fn a_publisher_killed_mid_stream_and_restarted_resumes_tracking() {
+    let prefix = unique_prefix("publisher-restart");
+    let client = TestClient::new(&ServiceNames::new(&prefix));
+    let _serve = spawn_serve(&prefix, &[]);
+    client.wait_for_tracker(Duration::from_secs(20));
+    let spawn_publisher = || {
+        ChildGuard(
+            Command::new(env!("CARGO_BIN_EXE_primm"))
+                .args(["publish", "--scenario", "--duration-s", "30", "--speed", "2", "--service-prefix", &prefix])
+                .env("RUST_LOG", "warn")
+                .spawn()
+                .unwrap(),
+        )
+    };
+    let receive_until = |count: usize| {
+        let mut answers = Vec::new();
+        while answers.len() < count {
+            answers.push(answer(&client));
+        }
+        answers
+    };
+
+    let first = spawn_publisher();
+    let before = receive_until(60);
+    assert!(before.iter().enumerate().all(|(k, a)| a.0 == k as u64 && a.1 == Some(FrameStatus::Tracked)));
+    first.signal(libc::SIGKILL);
+    drop(first);
+    // Drain what was in flight.
+    while client.next_answer(Duration::from_millis(300), |_| ()).is_some() {}
+
+    let _second = spawn_publisher();
+    let after = receive_until(60);
+    assert_eq!(after[0].0, 0, "the new publisher starts its sequence at 0");
+    assert_ne!(after[0].4 & TRACK_FLAG_TRACKER_RESET, 0, "the tracker starts afresh for the new stream");
+    assert!(after.iter().enumerate().all(|(k, a)| a.0 == k as u64 && a.1 == Some(FrameStatus::Tracked)));
+    assert!(!after.last().unwrap().2.is_empty(), "tracks are confirmed again after the restart");
+}
+
+#[test]
+fn the_tracker_restarts_after_sigkill() {
+    let prefix = unique_prefix("tracker-restart");
+    let client = TestClient::new(&ServiceNames::new(&prefix));
+    let frames = lane_frames(40);
+    let first = spawn_serve(&prefix, &[]);
+    client.wait_for_tracker(Duration::from_secs(20));
+    for (k, frame) in frames.iter().take(10).enumerate() {
+        client.send(frame, k as u64, 0);
+        assert_eq!(answer(&client).0, k as u64);
+    }
+    first.signal(libc::SIGKILL);
+    drop(first);
+
+    let second = spawn_serve(&prefix, &[]);
+    // The dead tracker's publisher may still be listed until the new node cleans it up.
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        client.send(&frames[10], 10, 0);
+        if let Some(sequence) = client.next_answer(Duration::from_millis(200), |a| a.input_sequence) {
+            assert_eq!(sequence, 10);
+            break;
+        }
+        assert!(Instant::now() < deadline, "the restarted tracker does not answer");
+    }
+    for (k, frame) in frames.iter().enumerate().skip(11) {
+        client.send(frame, k as u64, 0);
+        let (sequence, status, _, _, _) = answer(&client);
+        assert_eq!((sequence, status), (k as u64, Some(FrameStatus::Tracked)));
+    }
+    second.signal(libc::SIGINT);
+    assert!(second.wait(Duration::from_secs(10)).0.success());
+}
