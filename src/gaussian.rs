@@ -169,14 +169,12 @@ pub fn kalman_update<const N: usize>(
     let ph_t: SMatrix<f64, N, 2> = prior.covariance.fixed_columns::<2>(0).into_owned();
     let gain = ph_t * s_inverse;
 
-    let mut i_minus_kh = SMatrix::<f64, N, N>::identity();
-    for row in 0..N {
-        for col in 0..2 {
-            i_minus_kh[(row, col)] -= gain[(row, col)];
-        }
-    }
-    let mut covariance =
-        i_minus_kh * prior.covariance * i_minus_kh.transpose() + gain * r * gain.transpose();
+    // Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ, evaluated with H = [I₂ 0] in O(N²):
+    // A = (I − KH)P = P − K·P[0..2, :], then A(I − KH)ᵀ = A − A[:, 0..2]·Kᵀ.
+    let p_top: SMatrix<f64, 2, N> = prior.covariance.fixed_rows::<2>(0).into_owned();
+    let a = prior.covariance - gain * p_top;
+    let a_left: SMatrix<f64, N, 2> = a.fixed_columns::<2>(0).into_owned();
+    let mut covariance = a - a_left * gain.transpose() + gain * r * gain.transpose();
     symmetrize(&mut covariance);
     let mean = prior.mean + gain * innovation;
 
