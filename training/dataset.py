@@ -47,6 +47,7 @@ class Windows:
     previous_measured: np.ndarray  # [N, 2] float32, z_j - z_{j-1} (m), NaN for length 1
     previous_dt_s: np.ndarray  # [N] float64, t_j - t_{j-1}, NaN for length 1
     object_class: np.ndarray  # [N] int64, CLASSES code
+    frames_ahead: np.ndarray  # [N] int64, frames (radar scans) from m_j to m_{j+h}
     sequence: np.ndarray  # [N] int64, index of the file in the sorted file list
 
     def __len__(self) -> int:
@@ -58,7 +59,7 @@ class Windows:
 
 def read_objects(path: str) -> list[np.ndarray]:
     """Per ground-truth object, its measurements in time order as rows
-    ``[t, x, y, vr, rcs, true_x, true_y, class]``. Rows without a ground-truth id or a true
+    ``[t, x, y, vr, rcs, true_x, true_y, class, frame]``. Rows without a ground-truth id or a true
     position are skipped."""
     objects: dict[int, list[list[float]]] = {}
     with open(path, newline="") as handle:
@@ -77,6 +78,7 @@ def read_objects(path: str) -> list[np.ndarray]:
                     float(row["true_x"]),
                     float(row["true_y"]),
                     float(CLASSES[row["class"]]),
+                    float(row["frame"]),
                 ]
             )
     result = []
@@ -128,6 +130,7 @@ def object_windows(m: np.ndarray, max_horizon: int, max_horizon_s: float, max_ga
                 out["previous_measured"].append([np.nan, np.nan])
                 out["previous_dt_s"].append(np.nan)
             out["object_class"].append(int(m[j, 7]))
+            out["frames_ahead"].append(int(m[j + h, 8] - m[j, 8]))
     return out
 
 
@@ -156,6 +159,7 @@ def load_split(
         "previous_measured": np.float32,
         "previous_dt_s": np.float64,
         "object_class": np.int64,
+        "frames_ahead": np.int64,
         "sequence": np.int64,
     }
     arrays = {}

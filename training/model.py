@@ -227,28 +227,36 @@ class ExportGraph(nn.Module):
         return (out @ head + torch.cat([m.head_x.bias, m.head_y.bias])) * m.output_scale
 
     def logit_bound(self) -> float:
-        """An upper bound on every attention score for any input. A LayerNorm output has norm at
-        most ``r = sqrt(d) * max|gamma| + |beta|``; a head's score between tokens ``x`` and ``y`` is
-        ``(W_q x + b_q) . (W_k y + b_k) * scale``, so it is at most
-        ``|W_q^T W_k| r^2 + |W_k^T b_q| r + |W_q^T b_k| r + |b_q . b_k|`` (spectral norm), times the
-        scale."""
-        m = self.model
-        bound = 0.0
+        """An upper bound on every attention score for any input, from the weights alone."""
         with torch.no_grad():
-            for layer in m.layers:
-                norm = layer.norm_attention
-                d = norm.weight.numel()
-                r = math.sqrt(d) * norm.weight.abs().max().item() + norm.bias.norm().item()
-                a = layer.attention
-                for h in range(a.heads):
-                    rows = slice(h * a.head_dim, (h + 1) * a.head_dim)
-                    wq, bq = a.query.weight[rows], a.query.bias[rows]
-                    wk, bk = a.key.weight[rows], a.key.bias[rows]
-                    value = (
-                        torch.linalg.matrix_norm(wq.T @ wk, 2).item() * r * r
-                        + (wk.T @ bq).norm().item() * r
-                        + (wq.T @ bk).norm().item() * r
-                        + abs(float(bq @ bk))
-                    ) * a.scale
-                    bound = max(bound, value)
-        return bound
+            return float(score_bound(self.model))
+
+
+def score_bound(model: PRModel) -> torch.Tensor:
+    """An upper bound on every attention score of ``model`` for any input (differentiable, so
+    training can keep it small).
+
+    A LayerNorm output is ``y = gamma * u + beta`` with ``u`` of zero mean and norm ``sqrt(d)``.
+    With ``W_q' = W_q diag(gamma)`` and ``q0 = W_q beta + b_q`` (likewise for keys), a head's score
+    between tokens ``u`` and ``v`` is ``scale * (u' A v + u . a + b . v + q0 . k0)`` with
+    ``A = W_q'^T W_k'``, ``a = W_q'^T k0``, ``b = W_k'^T q0``. Restricted to zero-mean vectors
+    (projection ``P``), ``|u' A v| <= |P A P| d`` and ``|u . a| <= |P a| sqrt(d)``.
+    """
+    bound = torch.zeros(())
+    for layer in model.layers:
+        norm = layer.norm_attention
+        gamma, beta = norm.weight, norm.bias
+        d = gamma.numel()
+        projection = torch.eye(d) - torch.full((d, d), 1.0 / d)
+        a = layer.attention
+        for h in range(a.heads):
+            rows = slice(h * a.head_dim, (h + 1) * a.head_dim)
+            wq = a.query.weight[rows] * gamma
+            wk = a.key.weight[rows] * gamma
+            q0 = a.query.weight[rows] @ beta + a.query.bias[rows]
+            k0 = a.key.weight[rows] @ beta + a.key.bias[rows]
+            bilinear = torch.linalg.matrix_norm(projection @ wq.T @ wk @ projection, 2) * d
+            linear = (projection @ (wq.T @ k0)).norm() * math.sqrt(d) + (projection @ (wk.T @ q0)).norm() * math.sqrt(d)
+            value = (bilinear + linear + (q0 @ k0).abs()) * a.scale
+            bound = torch.maximum(bound, value)
+    return bound

@@ -35,7 +35,7 @@ import torch
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dataset import CLASSES, MAX_HISTORY, Windows, load_split, truncate  # noqa: E402
-from model import ExportGraph, PRModel  # noqa: E402
+from model import ExportGraph, PRModel, score_bound  # noqa: E402
 
 OPSET = 17
 INPUT_NAMES = ["features", "valid"]
@@ -81,6 +81,13 @@ def parse_args(argv=None):
         choices=["true", "measured"],
         default="true",
         help="train on the true displacement (default) or the measured one z_{j+h} - z_j",
+    )
+    parser.add_argument(
+        "--score-bound-limit",
+        type=float,
+        default=40.0,
+        help="attention-score bound (from the weights) above which training is penalised, keeping the "
+        "exported softmax free of a row maximum (see model.ExportGraph)",
     )
     parser.add_argument("--threads", type=int, default=1, help="PyTorch threads (1 is fastest on a busy 2-core machine)")
     return parser.parse_args(argv)
@@ -198,13 +205,23 @@ def evaluate(model: PRModel, windows: Windows) -> dict:
         f, v = truncate(windows.features[mask], windows.valid[mask], windows.length[mask], new_length)
         by_length[str(length)] = rmse(predict(model, f, v) - truth[mask])
     result["model"]["one_step_by_history_length"] = by_length
-    # Residual covariance of the one-step displacement, m^2 (a value for Q_PR).
+    # Residual covariance of the one-step displacement, m^2, and what it suggests for Q_PR. The
+    # tracker adds Q_PR once per frame (radar scan), and an object is measured only every few
+    # frames, so the covariance per measurement interval is spread over the mean number of frames
+    # in such an interval.
     residual = prediction[one_step] - truth[one_step]
+    frames = windows.frames_ahead[one_step]
     result["residual_covariance_m2"] = {"all": covariance(residual)}
+    result["mean_frames_per_measurement_interval"] = {"all": float(frames.mean())}
+    result["suggested_process_noise_covariance_m2"] = {}
     for name, code in CLASSES.items():
         mask = windows.object_class[one_step] == code
         if mask.any():
-            result["residual_covariance_m2"][name] = covariance(residual[mask])
+            cov = np.asarray(covariance(residual[mask]))
+            per_frame = float(frames[mask].mean())
+            result["residual_covariance_m2"][name] = cov.tolist()
+            result["mean_frames_per_measurement_interval"][name] = per_frame
+            result["suggested_process_noise_covariance_m2"][name] = (cov / per_frame).tolist()
     return result
 
 
@@ -264,6 +281,7 @@ def train(args) -> None:
             index = order[start : start + args.batch_size]
             prediction = model(features[index], valid[index])
             loss = ((((prediction - target[index]) / target_scale) ** 2).sum(dim=1) * train_weight[index]).mean()
+            loss = loss + 0.01 * torch.relu(score_bound(model) - args.score_bound_limit) ** 2
             optimiser.zero_grad(set_to_none=True)
             loss.backward()
             torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
@@ -293,6 +311,8 @@ def train(args) -> None:
             break
     model.load_state_dict(best[2])
     model.eval()
+    os.makedirs(args.out, exist_ok=True)
+    torch.save({"state_dict": best[2], "args": vars(args)}, os.path.join(args.out, "pr_training_state.pt"))
     training_seconds = time.time() - started
     print(f"best epoch {best[1]} (validation loss {best[0]:.4f}); training took {training_seconds:.0f} s", flush=True)
 
