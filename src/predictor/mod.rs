@@ -25,11 +25,6 @@ pub const MAX_HISTORY: usize = 5;
 /// Features per history step: `[x − x_{k−1}, y − y_{k−1}, v_r, RCS, t − t_k]`.
 pub const FEATURES: usize = 5;
 
-/// Step starts closer than this to the latest measurement count as "measured in the previous
-/// frame", s (a microsecond: well above the `f32` rounding of the time feature, far below any
-/// frame interval).
-pub const STEP_TIME_TOLERANCE_S: f64 = 1e-6;
-
 /// One associated measurement in a track's history, absolute values.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct HistoryEntry {
@@ -55,6 +50,8 @@ pub struct PredictionRequest {
     /// The latest measured position `z_{k−1}` in absolute coordinates, m (not a model input;
     /// lets an oracle or a diagnostic relate the request to the scene).
     pub anchor_m: DVec2,
+    /// Time of the latest measurement, s (not a model input).
+    pub anchor_time_s: f64,
     /// Prediction time `t_k`, s (not a model input).
     pub prediction_time_s: f64,
     /// Start of the tracker step, s: the time of the previous frame, where the PR estimate the
@@ -72,6 +69,7 @@ impl PredictionRequest {
         let mut request = PredictionRequest { len: history.len(), prediction_time_s, ..Default::default() };
         if let Some(latest) = history.last() {
             request.anchor_m = DVec2::new(latest.x_m, latest.y_m);
+            request.anchor_time_s = latest.timestamp_s;
             request.step_start_s = latest.timestamp_s;
             for (row, entry) in request.features.iter_mut().zip(history) {
                 *row = [
@@ -89,23 +87,14 @@ impl PredictionRequest {
     /// The same request with the step starting at `step_start_s` (the previous frame's time),
     /// kept between the latest measurement's time and the prediction time.
     pub fn with_step_start(mut self, step_start_s: f64) -> Self {
-        self.step_start_s = step_start_s.max(self.latest_measurement_time_s()).min(self.prediction_time_s);
+        self.step_start_s = step_start_s.max(self.anchor_time_s).min(self.prediction_time_s);
         self
-    }
-
-    /// Time of the latest history measurement, s.
-    pub fn latest_measurement_time_s(&self) -> f64 {
-        match self.len {
-            0 => self.prediction_time_s,
-            len => self.prediction_time_s + f64::from(self.features[len - 1][4]),
-        }
     }
 
     /// Whether the step starts after the latest measurement, i.e. the track was not measured in
     /// the previous frame and the displacement is a difference of two predictions.
-    /// Times closer than [`STEP_TIME_TOLERANCE_S`] count as equal (the time feature is `f32`).
     pub fn step_starts_after_latest_measurement(&self) -> bool {
-        self.len > 0 && self.step_start_s - self.latest_measurement_time_s() > STEP_TIME_TOLERANCE_S
+        self.len > 0 && self.step_start_s > self.anchor_time_s
     }
 
     /// The model input for predicting at `time_s` instead of the prediction time: the time
