@@ -358,8 +358,8 @@ mod tests {
     #[test]
     fn an_indefinite_covariance_is_named() {
         let text = DEFAULT_CONFIG_TOML.replacen(
-            "process_noise_covariance_m2 = [[0.09, 0.0], [0.0, 0.09]]",
-            "process_noise_covariance_m2 = [[0.09, 0.5], [0.5, 0.09]]",
+            "process_noise_covariance_m2 = [[0.01, 0.0], [0.0, 0.017]]",
+            "process_noise_covariance_m2 = [[0.01, 0.5], [0.5, 0.017]]",
             1,
         );
         assert_eq!(invalid_key(&text), "classes.car.learned.process_noise_covariance_m2");

@@ -238,7 +238,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let len = older.len() + newer.len();
             window[..older.len()].copy_from_slice(older);
             window[older.len()..len].copy_from_slice(newer);
-            self.requests.push(PredictionRequest::from_history(&window[..len], t));
+            let step_start = self.last_timestamp_s.unwrap_or(t);
+            self.requests.push(PredictionRequest::from_history(&window[..len], t).with_step_start(step_start));
         }
         self.predictor.submit(&self.requests);
     }

@@ -5,6 +5,18 @@
 //! measurement, radial velocity, RCS, time relative to the prediction time). A
 //! [`DisplacementPredictor`] answers a whole batch at once; `None` for a request means "no
 //! prediction this frame" and the PR mode sits the frame out for that track.
+//!
+//! # Which displacement
+//!
+//! `eq:pr_prior` adds the displacement to the PR estimate of the previous *frame*. A track is
+//! not measured in every frame (the radars scan in turn, and an object is usually seen by only
+//! some of them), so its latest measurement may be older than the previous frame. The
+//! displacement a predictor returns is therefore the one over the tracker step
+//! `[step_start_s, prediction_time_s]`. A model that predicts the displacement from the latest
+//! measurement to a given time, `f(t)`, answers `f(t_k)` when the track was measured in the
+//! previous frame and `f(t_k) − f(t_{k−1})` otherwise, so the PR prior stays
+//! `z_latest + f(t_k)` however many frames the track coasts ([`PredictionRequest::at_time`]
+//! builds the input for `f(t_{k−1})`).
 
 use glam::DVec2;
 
@@ -38,8 +50,14 @@ pub struct PredictionRequest {
     /// The latest measured position `z_{k−1}` in absolute coordinates, m (not a model input;
     /// lets an oracle or a diagnostic relate the request to the scene).
     pub anchor_m: DVec2,
+    /// Time of the latest measurement, s (not a model input).
+    pub anchor_time_s: f64,
     /// Prediction time `t_k`, s (not a model input).
     pub prediction_time_s: f64,
+    /// Start of the tracker step, s: the time of the previous frame, where the PR estimate the
+    /// displacement is added to lives (not a model input). Never earlier than the latest
+    /// history measurement; equal to it when the track was measured in the previous frame.
+    pub step_start_s: f64,
 }
 
 impl PredictionRequest {
@@ -51,6 +69,8 @@ impl PredictionRequest {
         let mut request = PredictionRequest { len: history.len(), prediction_time_s, ..Default::default() };
         if let Some(latest) = history.last() {
             request.anchor_m = DVec2::new(latest.x_m, latest.y_m);
+            request.anchor_time_s = latest.timestamp_s;
+            request.step_start_s = latest.timestamp_s;
             for (row, entry) in request.features.iter_mut().zip(history) {
                 *row = [
                     (entry.x_m - latest.x_m) as f32,
@@ -63,11 +83,36 @@ impl PredictionRequest {
         }
         request
     }
+
+    /// The same request with the step starting at `step_start_s` (the previous frame's time),
+    /// kept between the latest measurement's time and the prediction time.
+    pub fn with_step_start(mut self, step_start_s: f64) -> Self {
+        self.step_start_s = step_start_s.max(self.anchor_time_s).min(self.prediction_time_s);
+        self
+    }
+
+    /// Whether the step starts after the latest measurement, i.e. the track was not measured in
+    /// the previous frame and the displacement is a difference of two predictions.
+    pub fn step_starts_after_latest_measurement(&self) -> bool {
+        self.len > 0 && self.step_start_s > self.anchor_time_s
+    }
+
+    /// The model input for predicting at `time_s` instead of the prediction time: the time
+    /// feature `t_l − t` of every valid row shifted; everything else unchanged.
+    pub fn at_time(&self, time_s: f64) -> Self {
+        let mut request = *self;
+        let shift = (self.prediction_time_s - time_s) as f32;
+        for row in &mut request.features[..self.len] {
+            row[4] += shift;
+        }
+        request.prediction_time_s = time_s;
+        request
+    }
 }
 
-/// Predicts the next displacement of many tracks at once, in two steps so that an
-/// implementation may run the batch elsewhere (another thread) while the tracker predicts its
-/// physics modes.
+/// Predicts the displacement of many tracks over one tracker step (see the module
+/// documentation), in two steps so that an implementation may run the batch elsewhere (another
+/// thread) while the tracker predicts its physics modes.
 pub trait DisplacementPredictor {
     /// Starts predicting one batch. May return before the work is done.
     fn submit(&mut self, requests: &[PredictionRequest]);
@@ -101,3 +146,6 @@ impl<P: DisplacementPredictor + ?Sized> DisplacementPredictor for Box<P> {
         (**self).collect(displacements)
     }
 }
+
+pub mod onnx;
+pub mod threaded;

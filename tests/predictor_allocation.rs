@@ -1,0 +1,92 @@
+//! With the PR model on its inference thread, the tracking thread allocates nothing per frame;
+//! tract's per-run allocations happen, and are counted, on the inference thread.
+
+mod common;
+#[path = "common/counting_allocator.rs"]
+mod counting_allocator;
+
+use counting_allocator::{allocations, count_allocations, CountingAllocator};
+use glam::DVec2;
+use primm::config::Config;
+use primm::measurement::Frame;
+use primm::predictor::onnx::OnnxPredictor;
+use primm::predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
+use primm::predictor::{DisplacementPredictor, PredictionRequest};
+use primm::tracker::Tracker;
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+/// Counts the allocations the wrapped predictor makes (on whatever thread runs it).
+struct CountingPredictor {
+    inner: OnnxPredictor,
+    allocations: Arc<AtomicU64>,
+    batches: Arc<AtomicU64>,
+    on_inference_thread: Arc<AtomicU64>,
+}
+
+impl DisplacementPredictor for CountingPredictor {
+    fn submit(&mut self, _requests: &[PredictionRequest]) {}
+    fn collect(&mut self, _displacements: &mut [Option<DVec2>]) {}
+    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+        let before = allocations();
+        self.inner.predict(requests, displacements);
+        self.allocations.fetch_add(allocations() - before, Ordering::Relaxed);
+        self.batches.fetch_add(1, Ordering::Relaxed);
+        if std::thread::current().name() == Some(INFERENCE_THREAD_NAME) {
+            self.on_inference_thread.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+}
+
+#[test]
+fn two_thousand_frames_with_the_onnx_model_allocate_nothing_on_the_tracking_thread() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr.onnx");
+    let inference_allocations = Arc::new(AtomicU64::new(0));
+    let batches = Arc::new(AtomicU64::new(0));
+    let on_inference_thread = Arc::new(AtomicU64::new(0));
+    let counting = CountingPredictor {
+        inner: OnnxPredictor::load(&path).unwrap(),
+        allocations: inference_allocations.clone(),
+        batches: batches.clone(),
+        on_inference_thread: on_inference_thread.clone(),
+    };
+    // A generous deadline: this test is about allocations, every frame should get its batch.
+    let predictor = ThreadedPredictor::new(counting, Duration::from_secs(10)).unwrap();
+    let mut tracker = Tracker::with_predictor(Config::default(), predictor).unwrap();
+    let base = common::scene_frames(&common::lanes(32), 200, 0.04, 0.2, 7);
+    let mut frame: Frame = base[0].clone();
+    let frames = 2_000usize;
+    let mut updates = 0u64;
+    let warm_up_batches = batches.load(Ordering::Relaxed);
+    let tracking_allocations = count_allocations(|| {
+        for k in 0..frames {
+            let source = &base[k % base.len()];
+            frame.timestamp_s = k as f64 * 0.04;
+            frame.measurements.clone_from(&source.measurements);
+            let outputs = tracker.step(&frame).expect("valid frame");
+            updates += outputs.iter().filter(|o| o.measurement_index.is_some()).count() as u64;
+        }
+    });
+    assert_eq!(tracking_allocations, 0, "the tracking thread allocated");
+    assert_eq!(updates, 32 * frames as u64);
+    let stats = *tracker.predictor().stats();
+    assert_eq!(stats.deadline_misses, 0);
+    // The first frame has no tracks yet, so nothing to predict.
+    assert_eq!(stats.batches_on_time, frames as u64 - 1);
+    assert_eq!(tracker.stats().learned_predictions_missing, 0);
+    let batches = batches.load(Ordering::Relaxed) - warm_up_batches;
+    assert_eq!(batches, frames as u64 - 1);
+    assert_eq!(on_inference_thread.load(Ordering::Relaxed), batches + warm_up_batches);
+    // tract does allocate per run, there: the counter sees it (so it is known to work).
+    let inference_allocations = inference_allocations.load(Ordering::Relaxed);
+    println!(
+        "inference thread: {inference_allocations} allocations over {batches} batches ({:.0} per batch)",
+        inference_allocations as f64 / batches as f64
+    );
+    assert!(inference_allocations >= batches, "{inference_allocations} allocations over {batches} batches");
+}

@@ -1,0 +1,234 @@
+//! The shipped PR model through tract: parity with PyTorch, masking, the step displacement of
+//! coasting tracks, and clear start-up errors for unusable model files.
+
+use glam::DVec2;
+use primm::predictor::onnx::{ModelError, OnnxPredictor, PrModel};
+use primm::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
+use std::path::{Path, PathBuf};
+
+fn repo_path(relative: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+fn model() -> PrModel {
+    PrModel::load(repo_path("models/pr.onnx")).expect("the shipped model loads")
+}
+
+#[derive(serde::Deserialize)]
+struct Parity {
+    features: Vec<[[f32; FEATURES]; MAX_HISTORY]>,
+    valid: Vec<[f32; MAX_HISTORY]>,
+    length: Vec<usize>,
+    displacement: Vec<[f32; 2]>,
+}
+
+fn parity() -> Parity {
+    let text = std::fs::read_to_string(repo_path("models/pr_parity.json")).expect("parity fixture");
+    serde_json::from_str(&text).expect("parity fixture parses")
+}
+
+fn flatten(features: &[[[f32; FEATURES]; MAX_HISTORY]], valid: &[[f32; MAX_HISTORY]]) -> (Vec<f32>, Vec<f32>) {
+    (
+        features.iter().flatten().flatten().copied().collect(),
+        valid.iter().flatten().copied().collect(),
+    )
+}
+
+#[test]
+fn tract_matches_pytorch_on_the_parity_fixture_within_a_tenth_of_a_millimetre() {
+    let parity = parity();
+    assert_eq!(parity.features.len(), 64);
+    // Every history length is represented.
+    for length in 1..=MAX_HISTORY {
+        assert!(parity.length.contains(&length), "no sample of length {length}");
+    }
+    let (features, valid) = flatten(&parity.features, &parity.valid);
+    let mut out = vec![0.0f32; 2 * parity.features.len()];
+    model().run(&features, &valid, &mut out).unwrap();
+    let mut max_difference = 0.0f32;
+    for (got, want) in out.chunks(2).zip(&parity.displacement) {
+        max_difference = max_difference.max((got[0] - want[0]).abs()).max((got[1] - want[1]).abs());
+    }
+    println!("max abs difference tract vs PyTorch: {max_difference:e} m");
+    assert!(max_difference <= 1e-4, "max abs difference {max_difference} m");
+    // The outputs are not trivial: displacements of different samples differ.
+    let spread = parity.displacement.iter().map(|d| d[0]).fold(f32::NEG_INFINITY, f32::max)
+        - parity.displacement.iter().map(|d| d[0]).fold(f32::INFINITY, f32::min);
+    assert!(spread > 0.05, "outputs hardly vary: {spread} m");
+}
+
+#[test]
+fn each_sample_gets_the_same_output_alone_as_in_a_batch_and_padded_rows_are_ignored() {
+    let parity = parity();
+    let mut model = model();
+    let (features, valid) = flatten(&parity.features, &parity.valid);
+    let mut batched = vec![0.0f32; 2 * parity.features.len()];
+    model.run(&features, &valid, &mut batched).unwrap();
+    for (i, (sample, mask)) in parity.features.iter().zip(&parity.valid).enumerate() {
+        // Garbage in the padded rows must not change anything: the attention mask hides them.
+        let mut noisy = *sample;
+        for (row, &v) in noisy.iter_mut().zip(mask) {
+            if v == 0.0 {
+                *row = [37.0, -12.0, 5.5, 20.0, -0.4];
+            }
+        }
+        let mut alone = [0.0f32; 2];
+        model.run(noisy.as_flattened(), mask, &mut alone).unwrap();
+        for axis in 0..2 {
+            assert!(
+                (alone[axis] - batched[2 * i + axis]).abs() <= 1e-5,
+                "sample {i} axis {axis}: alone {} batched {}",
+                alone[axis],
+                batched[2 * i + axis]
+            );
+        }
+    }
+}
+
+#[test]
+fn the_valid_rows_matter() {
+    // Changing a valid row changes the prediction (the model reads its input).
+    let parity = parity();
+    let mut model = model();
+    let index = parity.length.iter().position(|&l| l == MAX_HISTORY).unwrap();
+    let sample = parity.features[index];
+    let mask = parity.valid[index];
+    let mut base = [0.0f32; 2];
+    model.run(sample.as_flattened(), &mask, &mut base).unwrap();
+    let mut moved = sample;
+    moved[0][0] -= 2.0; // the oldest measurement 2 m further back along x
+    let mut out = [0.0f32; 2];
+    model.run(moved.as_flattened(), &mask, &mut out).unwrap();
+    assert!((out[0] - base[0]).abs() > 1e-3, "prediction ignores the history: {base:?} vs {out:?}");
+}
+
+fn history(points: &[(f64, f64, f64)]) -> Vec<HistoryEntry> {
+    points
+        .iter()
+        .map(|&(t, x, y)| HistoryEntry { x_m: x, y_m: y, radial_velocity_mps: -3.0, rcs_dbsm: 5.0, timestamp_s: t })
+        .collect()
+}
+
+fn run_one(model: &mut PrModel, request: &PredictionRequest) -> DVec2 {
+    let mut valid = [0.0f32; MAX_HISTORY];
+    valid[..request.len].fill(1.0);
+    let mut out = [0.0f32; 2];
+    model.run(request.features.as_flattened(), &valid, &mut out).unwrap();
+    DVec2::new(f64::from(out[0]), f64::from(out[1]))
+}
+
+#[test]
+fn a_track_measured_in_the_previous_frame_gets_the_model_output_and_a_coasting_track_the_difference() {
+    let mut model = model();
+    let mut predictor = OnnxPredictor::load(repo_path("models/pr.onnx")).unwrap();
+    let entries = history(&[(0.00, 20.0, 3.0), (0.03, 19.7, 3.0), (0.06, 19.4, 3.01), (0.09, 19.1, 3.0)]);
+    // Measured in the previous frame (t = 0.09), predicting at t = 0.105.
+    let fresh = PredictionRequest::from_history(&entries, 0.105).with_step_start(0.09);
+    // Last measured at 0.09, previous frame at 0.12, predicting at 0.135.
+    let coasting = PredictionRequest::from_history(&entries, 0.135).with_step_start(0.12);
+    assert!(!fresh.step_starts_after_latest_measurement());
+    assert!(coasting.step_starts_after_latest_measurement());
+    let mut out = [None; 2];
+    predictor.predict(&[fresh, coasting], &mut out);
+    let fresh_expected = run_one(&mut model, &fresh);
+    let coasting_expected = run_one(&mut model, &coasting) - run_one(&mut model, &coasting.at_time(0.12));
+    assert!((out[0].unwrap() - fresh_expected).length() < 1e-6);
+    assert!((out[1].unwrap() - coasting_expected).length() < 1e-6);
+    // Telescoping: the coasted steps add up to the displacement from the latest measurement.
+    let to_first_frame = PredictionRequest::from_history(&entries, 0.12).with_step_start(0.09);
+    let mut first = [None];
+    predictor.predict(&[to_first_frame], &mut first);
+    let total = first[0].unwrap() + out[1].unwrap();
+    let direct = run_one(&mut model, &PredictionRequest::from_history(&entries, 0.135));
+    assert!((total - direct).length() < 1e-4, "{total} vs {direct}");
+    assert_eq!(predictor.stats().rows, 3 + 1);
+}
+
+#[test]
+fn unusable_requests_get_none_and_the_rest_of_the_batch_is_predicted() {
+    let mut predictor = OnnxPredictor::load(repo_path("models/pr.onnx")).unwrap();
+    let entries = history(&[(0.0, 10.0, 1.0), (0.03, 10.1, 1.0)]);
+    let good = PredictionRequest::from_history(&entries, 0.05);
+    let empty = PredictionRequest::default();
+    let mut broken = good;
+    broken.features[0][2] = f32::NAN;
+    let mut out = [Some(DVec2::ZERO); 3];
+    predictor.predict(&[good, empty, broken], &mut out);
+    assert!(out[0].is_some());
+    assert_eq!(out[1], None);
+    assert_eq!(out[2], None);
+    assert_eq!(predictor.stats().invalid_requests, 2);
+    assert_eq!(predictor.stats().predictions, 1);
+}
+
+#[test]
+fn a_missing_model_file_is_a_start_up_error_naming_the_file() {
+    let path = repo_path("models/does_not_exist.onnx");
+    let error = PrModel::load(&path).unwrap_err();
+    assert!(matches!(error, ModelError::NotFound { .. }), "{error:?}");
+    assert!(error.to_string().contains("does_not_exist.onnx"), "{error}");
+}
+
+#[test]
+fn a_file_of_garbage_is_a_start_up_error_naming_the_file() {
+    let dir = std::env::temp_dir().join(format!("primm-onnx-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("garbage.onnx");
+    std::fs::write(&path, b"\x08\x07this is not a protobuf model \xff\xfe\x00\x01 at all").unwrap();
+    let error = PrModel::load(&path).unwrap_err();
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(matches!(error, ModelError::NotOnnx { .. }), "{error:?}");
+    assert!(error.to_string().contains("garbage.onnx"), "{error}");
+}
+
+#[test]
+fn a_directory_is_not_a_model() {
+    let error = PrModel::load(repo_path("models")).unwrap_err();
+    assert!(matches!(error, ModelError::Unreadable { .. }), "{error:?}");
+}
+
+#[test]
+fn a_model_with_four_history_rows_is_rejected_with_the_shapes() {
+    let error = PrModel::load(repo_path("tests/fixtures/pr_wrong_feature_shape.onnx")).unwrap_err();
+    let message = error.to_string();
+    let ModelError::Shape { name, .. } = &error else { panic!("{error:?}") };
+    assert_eq!(name, "features");
+    assert!(message.contains("pr_wrong_feature_shape.onnx"), "{message}");
+    assert!(message.contains("[batch, 4, 5]"), "{message}");
+    assert!(message.contains("[batch, 5, 5]"), "{message}");
+}
+
+#[test]
+fn a_model_without_a_symbolic_batch_axis_is_rejected() {
+    let error = PrModel::load(repo_path("tests/fixtures/pr_fixed_batch.onnx")).unwrap_err();
+    let ModelError::Shape { name, found, .. } = &error else { panic!("{error:?}") };
+    assert_eq!(name, "features");
+    assert!(found.contains("[1, 5, 5]"), "{found}");
+}
+
+#[test]
+fn a_model_with_the_wrong_output_shape_is_rejected() {
+    let error = PrModel::load(repo_path("tests/fixtures/pr_wrong_output_shape.onnx")).unwrap_err();
+    let ModelError::Shape { name, found, .. } = &error else { panic!("{error:?}") };
+    assert_eq!(name, "displacement");
+    assert!(found.contains('3'), "{found}");
+    assert!(error.to_string().contains("pr_wrong_output_shape.onnx"));
+}
+
+#[test]
+fn a_model_without_the_valid_input_is_rejected() {
+    let error = PrModel::load(repo_path("tests/fixtures/pr_missing_valid_input.onnx")).unwrap_err();
+    let ModelError::Signature { found, .. } = &error else { panic!("{error:?}") };
+    assert!(found.contains("features"), "{found}");
+    assert!(error.to_string().contains("pr_missing_valid_input.onnx"));
+}
+
+#[test]
+fn the_command_line_loads_the_model_for_learned_methods_only() {
+    use primm::cli::predictor::predictor_for;
+    use primm::mode::Method;
+    assert!(predictor_for(Method::Imm, Some(Path::new("/nonexistent.onnx"))).is_ok());
+    let error = predictor_for(Method::PrImm, Some(Path::new("/nonexistent/pr.onnx"))).err().unwrap();
+    assert!(error.contains("/nonexistent/pr.onnx"), "{error}");
+    assert!(predictor_for(Method::Learned, Some(&repo_path("models/pr.onnx"))).is_ok());
+}

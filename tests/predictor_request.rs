@@ -1,0 +1,68 @@
+//! The request's step start and its re-timing for the start-of-step prediction.
+
+use primm::predictor::{HistoryEntry, PredictionRequest, MAX_HISTORY};
+
+fn entries(times: &[f64]) -> Vec<HistoryEntry> {
+    times
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| HistoryEntry {
+            x_m: 10.0 + i as f64,
+            y_m: -2.0 * i as f64,
+            radial_velocity_mps: 1.5,
+            rcs_dbsm: -3.0,
+            timestamp_s: t,
+        })
+        .collect()
+}
+
+#[test]
+fn by_default_the_step_starts_at_the_latest_measurement() {
+    let request = PredictionRequest::from_history(&entries(&[100.00, 100.03, 100.06]), 100.075);
+    assert_eq!(request.step_start_s, 100.06);
+    assert_eq!(request.anchor_time_s, 100.06);
+    assert!(!request.step_starts_after_latest_measurement());
+}
+
+#[test]
+fn the_step_start_is_kept_between_the_latest_measurement_and_the_prediction_time() {
+    let request = PredictionRequest::from_history(&entries(&[1.0, 1.02]), 1.05);
+    assert_eq!(request.with_step_start(0.5).step_start_s, request.step_start_s);
+    assert_eq!(request.with_step_start(2.0).step_start_s, 1.05);
+    let coasting = request.with_step_start(1.035);
+    assert_eq!(coasting.step_start_s, 1.035);
+    assert!(coasting.step_starts_after_latest_measurement());
+    // The previous frame at the latest measurement's time: measured in the previous frame.
+    assert!(!request.with_step_start(1.02).step_starts_after_latest_measurement());
+}
+
+#[test]
+fn re_timing_shifts_only_the_time_feature_of_the_valid_rows() {
+    let request = PredictionRequest::from_history(&entries(&[0.0, 0.03, 0.06, 0.09]), 0.12).with_step_start(0.105);
+    let earlier = request.at_time(0.105);
+    assert_eq!(earlier.prediction_time_s, 0.105);
+    assert_eq!(earlier.len, request.len);
+    assert_eq!(earlier.anchor_m, request.anchor_m);
+    for row in 0..MAX_HISTORY {
+        for feature in 0..4 {
+            assert_eq!(earlier.features[row][feature], request.features[row][feature]);
+        }
+        if row < request.len {
+            let expected = request.features[row][4] + 0.015;
+            assert!((earlier.features[row][4] - expected).abs() < 1e-6, "row {row}");
+        } else {
+            assert_eq!(earlier.features[row], [0.0; 5]);
+        }
+    }
+    assert_eq!(earlier.anchor_time_s, request.anchor_time_s);
+}
+
+#[test]
+fn only_the_latest_five_measurements_are_used_and_positions_are_relative_to_the_latest() {
+    let request = PredictionRequest::from_history(&entries(&[0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6]), 0.65);
+    assert_eq!(request.len, MAX_HISTORY);
+    assert_eq!(request.features[MAX_HISTORY - 1][0], 0.0);
+    assert_eq!(request.features[MAX_HISTORY - 1][1], 0.0);
+    assert_eq!(request.features[0][0], -4.0);
+    assert!((request.features[0][4] + 0.45).abs() < 1e-6);
+}

@@ -1,0 +1,191 @@
+"""Training windows for the PR model, cut from measurement CSV files.
+
+Every sequence file is grouped by ground-truth id (the generator's object id, like a
+RadarScenes track id). For an object with measurements ``m_0 .. m_{n-1}`` (time order) and every
+anchor ``j`` with at least one later measurement, the history is ``m_{max(0, j-4)} .. m_j``
+(oldest first, at most five, none before a gap longer than ``max_gap_s``: a tracker deletes a
+track that coasts that long) and the prediction time ``tau`` is the time of one of the next
+``max_horizon`` measurements ``m_{j+h}`` no more than ``max_horizon_s`` after ``m_j``.
+
+Each window is laid out exactly like ``PredictionRequest`` (``eq:pr_input``): rows ``0..len``
+hold ``[x_l - x_j, y_l - y_j, v_r_l, RCS_l, t_l - tau]``, rows ``len..`` are zero (right
+padding), and ``valid`` marks the rows ``0..len``.
+
+Two displacement labels are kept per window:
+
+* ``true``: ``p_{j+h} - p_j`` from the ``true_x``/``true_y`` columns (box centre), the label
+  the model is trained on (see ``training/README.md`` for why);
+* ``measured``: ``z_{j+h} - z_j``, what a data set without ground-truth positions offers; it is
+  reported next to the true label to show how much of it is measurement noise.
+"""
+
+from __future__ import annotations
+
+import csv
+import glob
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+MAX_HISTORY = 5
+FEATURES = 5
+CLASSES = {"car": 0, "pedestrian": 1, "two_wheeler": 2}
+
+
+@dataclass
+class Windows:
+    """A set of windows as parallel arrays (N windows)."""
+
+    features: np.ndarray  # [N, 5, 5] float32, eq:pr_input rows, zero padded at the end
+    valid: np.ndarray  # [N, 5] float32, 1 for rows 0..len
+    length: np.ndarray  # [N] int64, 1..5
+    horizon: np.ndarray  # [N] int64, h: prediction at the h-th next measurement
+    dt_s: np.ndarray  # [N] float64, tau - t_j
+    true_displacement: np.ndarray  # [N, 2] float32, p_{j+h} - p_j (m)
+    measured_displacement: np.ndarray  # [N, 2] float32, z_{j+h} - z_j (m)
+    previous_measured: np.ndarray  # [N, 2] float32, z_j - z_{j-1} (m), NaN for length 1
+    previous_dt_s: np.ndarray  # [N] float64, t_j - t_{j-1}, NaN for length 1
+    object_class: np.ndarray  # [N] int64, CLASSES code
+    frames_ahead: np.ndarray  # [N] int64, frames (radar scans) from m_j to m_{j+h}
+    sequence: np.ndarray  # [N] int64, index of the file in the sorted file list
+
+    def __len__(self) -> int:
+        return len(self.length)
+
+    def subset(self, mask: np.ndarray) -> "Windows":
+        return Windows(**{name: getattr(self, name)[mask] for name in self.__dataclass_fields__})
+
+
+def read_objects(path: str) -> list[np.ndarray]:
+    """Per ground-truth object, its measurements in time order as rows
+    ``[t, x, y, vr, rcs, true_x, true_y, class, frame]``. Rows without a ground-truth id or a true
+    position are skipped."""
+    objects: dict[int, list[list[float]]] = {}
+    with open(path, newline="") as handle:
+        rows = csv.DictReader(line for line in handle if not line.startswith("#"))
+        for row in rows:
+            gt = row.get("gt_id", "")
+            if gt in ("", "-1") or row.get("x", "") == "" or row.get("true_x", "") == "":
+                continue
+            objects.setdefault(int(gt), []).append(
+                [
+                    float(row["t"]),
+                    float(row["x"]),
+                    float(row["y"]),
+                    float(row["vr"]),
+                    float(row["rcs"]),
+                    float(row["true_x"]),
+                    float(row["true_y"]),
+                    float(CLASSES[row["class"]]),
+                    float(row["frame"]),
+                ]
+            )
+    result = []
+    for gt in sorted(objects):
+        array = np.asarray(objects[gt], dtype=np.float64)
+        result.append(array[np.argsort(array[:, 0], kind="stable")])
+    return result
+
+
+def object_windows(m: np.ndarray, max_horizon: int, max_horizon_s: float, max_gap_s: float) -> dict[str, list]:
+    """All windows of one object (see the module documentation)."""
+    out: dict[str, list] = {k: [] for k in Windows.__dataclass_fields__ if k != "sequence"}
+    n = len(m)
+    gap_after = np.diff(m[:, 0]) > max_gap_s  # gap_after[i]: a gap between m_i and m_{i+1}
+    for j in range(n - 1):
+        start = max(0, j - MAX_HISTORY + 1)
+        while start < j and gap_after[start:j].any():
+            start += 1
+        history = m[start : j + 1]
+        length = len(history)
+        for h in range(1, max_horizon + 1):
+            if j + h >= n:
+                break
+            tau = m[j + h, 0]
+            dt = tau - m[j, 0]
+            if dt > max_horizon_s:
+                break
+            if dt <= 0.0:
+                continue
+            features = np.zeros((MAX_HISTORY, FEATURES), dtype=np.float32)
+            features[:length, 0] = history[:, 1] - m[j, 1]
+            features[:length, 1] = history[:, 2] - m[j, 2]
+            features[:length, 2] = history[:, 3]
+            features[:length, 3] = history[:, 4]
+            features[:length, 4] = history[:, 0] - tau
+            valid = np.zeros(MAX_HISTORY, dtype=np.float32)
+            valid[:length] = 1.0
+            out["features"].append(features)
+            out["valid"].append(valid)
+            out["length"].append(length)
+            out["horizon"].append(h)
+            out["dt_s"].append(dt)
+            out["true_displacement"].append(m[j + h, 5:7] - m[j, 5:7])
+            out["measured_displacement"].append(m[j + h, 1:3] - m[j, 1:3])
+            if j >= 1:
+                out["previous_measured"].append(m[j, 1:3] - m[j - 1, 1:3])
+                out["previous_dt_s"].append(m[j, 0] - m[j - 1, 0])
+            else:
+                out["previous_measured"].append([np.nan, np.nan])
+                out["previous_dt_s"].append(np.nan)
+            out["object_class"].append(int(m[j, 7]))
+            out["frames_ahead"].append(int(m[j + h, 8] - m[j, 8]))
+    return out
+
+
+def load_split(
+    directory: str, max_horizon: int, max_horizon_s: float, max_gap_s: float = 1.0
+) -> tuple[Windows, list[str]]:
+    """Windows of every ``*.csv`` file in ``directory`` (sorted by name)."""
+    files = sorted(glob.glob(os.path.join(directory, "*.csv")))
+    if not files:
+        raise FileNotFoundError(f"no measurement CSV files in {directory}")
+    parts: dict[str, list] = {k: [] for k in Windows.__dataclass_fields__}
+    for index, path in enumerate(files):
+        for m in read_objects(path):
+            windows = object_windows(m, max_horizon, max_horizon_s, max_gap_s)
+            for key, values in windows.items():
+                parts[key].extend(values)
+            parts["sequence"].extend([index] * len(windows["length"]))
+    dtypes = {
+        "features": np.float32,
+        "valid": np.float32,
+        "length": np.int64,
+        "horizon": np.int64,
+        "dt_s": np.float64,
+        "true_displacement": np.float32,
+        "measured_displacement": np.float32,
+        "previous_measured": np.float32,
+        "previous_dt_s": np.float64,
+        "object_class": np.int64,
+        "frames_ahead": np.int64,
+        "sequence": np.int64,
+    }
+    arrays = {}
+    for key, dtype in dtypes.items():
+        values = parts[key]
+        arrays[key] = np.asarray(values, dtype=dtype)
+    arrays["features"] = arrays["features"].reshape(-1, MAX_HISTORY, FEATURES)
+    arrays["valid"] = arrays["valid"].reshape(-1, MAX_HISTORY)
+    for key in ("true_displacement", "measured_displacement", "previous_measured"):
+        arrays[key] = arrays[key].reshape(-1, 2)
+    return Windows(**arrays), files
+
+
+def truncate(features: np.ndarray, valid: np.ndarray, length: np.ndarray, new_length: np.ndarray):
+    """Keeps only the latest ``new_length`` rows of each window (``new_length <= length``),
+    re-anchored to the same latest measurement: the rows move to the front and the rest is zero.
+    Positions stay relative to the latest row, so only the row order changes."""
+    n = len(length)
+    out_f = np.zeros_like(features)
+    out_v = np.zeros_like(valid)
+    rows = np.arange(MAX_HISTORY)
+    # Source row of target row r: (length - new_length) + r, for r < new_length.
+    source = (length - new_length)[:, None] + rows[None, :]
+    keep = rows[None, :] < new_length[:, None]
+    source = np.where(keep, source, 0)
+    gathered = features[np.arange(n)[:, None], source]
+    out_f[keep] = gathered[keep]
+    out_v[keep] = 1.0
+    return out_f, out_v
