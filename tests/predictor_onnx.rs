@@ -28,10 +28,7 @@ fn parity() -> Parity {
 }
 
 fn flatten(features: &[[[f32; FEATURES]; MAX_HISTORY]], valid: &[[f32; MAX_HISTORY]]) -> (Vec<f32>, Vec<f32>) {
-    (
-        features.iter().flatten().flatten().copied().collect(),
-        valid.iter().flatten().copied().collect(),
-    )
+    (features.iter().flatten().flatten().copied().collect(), valid.iter().flatten().copied().collect())
 }
 
 #[test]

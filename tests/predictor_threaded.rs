@@ -201,7 +201,8 @@ fn dropping_the_predictor_stops_its_thread() {
         }
     }
     let dropped = Arc::new(AtomicU64::new(0));
-    let predictor = ThreadedPredictor::new(Holder(Echo::new(), Counted(dropped.clone())), Duration::from_secs(1)).unwrap();
+    let predictor =
+        ThreadedPredictor::new(Holder(Echo::new(), Counted(dropped.clone())), Duration::from_secs(1)).unwrap();
     drop(predictor);
     // The inference thread was joined, so the predictor it owned is gone.
     assert_eq!(dropped.load(Ordering::SeqCst), 1);

@@ -107,5 +107,5 @@ fn the_model_predicts_the_next_displacement_far_better_than_constant_velocity_fr
     }
     assert!(model.count > 2_000, "only {} cases", model.count);
     assert!(model.rmse() < 0.25 * two_point.rmse(), "PR {} vs CV {}", model.rmse(), two_point.rmse());
-    assert!(model.rmse() < 0.9 * still.rmse(), "PR {} vs no motion {}", model.rmse(), still.rmse());
+    assert!(model.rmse() < 0.75 * still.rmse(), "PR {} vs no motion {}", model.rmse(), still.rmse());
 }

@@ -52,6 +52,12 @@ def parse_args(argv=None):
     parser.add_argument("--data", default="data", help="directory with train/ and validation/ CSV files")
     parser.add_argument("--out", default="models", help="output directory")
     parser.add_argument("--seed", type=int, default=20240607)
+    parser.add_argument(
+        "--data-seed-base",
+        type=int,
+        default=88314347343104,
+        help="the --seed-base the data was generated with (recorded in pr.json; default: the preset's)",
+    )
     parser.add_argument("--epochs", type=int, default=40)
     parser.add_argument("--patience", type=int, default=8, help="stop after this many epochs without improvement")
     parser.add_argument("--batch-size", type=int, default=256)
@@ -402,6 +408,15 @@ def check_with_onnxruntime(path: str, parity: dict):
     return diff
 
 
+def files_digest(paths) -> str:
+    """SHA-256 over the contents of the files, in order (identifies the data set)."""
+    digest = hashlib.sha256()
+    for path in paths:
+        with open(path, "rb") as handle:
+            digest.update(handle.read())
+    return digest.hexdigest()
+
+
 def file_digest(path: str) -> str:
     with open(path, "rb") as handle:
         return hashlib.sha256(handle.read()).hexdigest()
@@ -458,16 +473,21 @@ def write_metadata(args, model, mean, std, scale, train_windows, train_files, va
             "optimiser": "AdamW", "learning_rate": args.learning_rate, "weight_decay": args.weight_decay,
             "batch_size": args.batch_size, "epochs_max": args.epochs, "patience": args.patience,
             "truncate_probability": args.truncate_probability, "seed": args.seed,
+            "samples_per_epoch": args.samples_per_epoch, "epochs_run": len(history),
+            "full_weight_horizon_s": args.full_weight_horizon_s, "score_bound_limit": args.score_bound_limit,
             "best_epoch": best[1], "best_validation_loss": best[0], "seconds": round(training_seconds, 1),
             "threads": args.threads, "machine": platform.machine(), "processor_count": os.cpu_count(),
             "history": history,
         },
         "data": {
             "generator": "primm generate (default preset)",
+            "seed_base": args.data_seed_base,
             "train": {"directory": os.path.join(args.data, "train"), "sequences": len(train_files),
+                      "sha256_of_files": files_digest(train_files),
                       "windows": len(train_windows), "objects_note": "windows grouped by ground-truth id",
                       "first_file": os.path.basename(train_files[0]), "last_file": os.path.basename(train_files[-1])},
             "validation": {"directory": os.path.join(args.data, "validation"), "sequences": len(val_files),
+                           "sha256_of_files": files_digest(val_files),
                            "windows": len(val_windows)},
             "scenario_seeds": "sequence i of split k uses seed_base + k * 2^40 + i (docs/scenario.md)",
         },

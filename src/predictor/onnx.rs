@@ -230,14 +230,12 @@ fn check_signature(path: &Path, model: &InferenceModel) -> Result<(), ModelError
             found: format!("outputs {outputs:?}"),
         });
     }
-    for (index, (name, fixed)) in [(FEATURES_INPUT, &[MAX_HISTORY, FEATURES][..]), (VALID_INPUT, &[MAX_HISTORY][..])]
-        .into_iter()
-        .enumerate()
+    for (index, (name, fixed)) in
+        [(FEATURES_INPUT, &[MAX_HISTORY, FEATURES][..]), (VALID_INPUT, &[MAX_HISTORY][..])].into_iter().enumerate()
     {
-        let fact = model.input_fact(index).map_err(|e| ModelError::NotOnnx {
-            path: path.to_path_buf(),
-            reason: format!("{e:#}"),
-        })?;
+        let fact = model
+            .input_fact(index)
+            .map_err(|e| ModelError::NotOnnx { path: path.to_path_buf(), reason: format!("{e:#}") })?;
         let expected_dims: Vec<String> =
             std::iter::once(BATCH_SYMBOL.to_string()).chain(fixed.iter().map(|d| d.to_string())).collect();
         let dims: Vec<&GenericFactoid<TDim>> = fact.shape.dims().collect();
@@ -259,10 +257,9 @@ fn check_signature(path: &Path, model: &InferenceModel) -> Result<(), ModelError
 }
 
 fn check_output(path: &Path, model: &TypedModel) -> Result<(), ModelError> {
-    let fact = model.output_fact(0).map_err(|e| ModelError::Preparation {
-        path: path.to_path_buf(),
-        reason: format!("{e:#}"),
-    })?;
+    let fact = model
+        .output_fact(0)
+        .map_err(|e| ModelError::Preparation { path: path.to_path_buf(), reason: format!("{e:#}") })?;
     let dims = fact.shape.dims();
     let ok = fact.datum_type == DatumType::F32
         && dims.len() == 2

@@ -292,7 +292,11 @@ impl Drop for ThreadedPredictor {
 }
 
 /// The inference thread: predicts every batch it receives and sends it back.
-fn inference_loop<P: DisplacementPredictor>(mut predictor: P, work: Receiver<Box<Batch>>, done: SyncSender<Box<Batch>>) {
+fn inference_loop<P: DisplacementPredictor>(
+    mut predictor: P,
+    work: Receiver<Box<Batch>>,
+    done: SyncSender<Box<Batch>>,
+) {
     while let Ok(mut batch) = work.recv() {
         let len = batch.len;
         let Batch { requests, displacements, .. } = &mut *batch;
