@@ -71,7 +71,8 @@ pub enum ModelError {
         /// tract's description of the problem.
         reason: String,
     },
-    /// The model's inputs are not `features` and `valid`, or its outputs not one `displacement`.
+    /// The model's inputs are not `features` and `valid` (in this order), or it has not exactly
+    /// one output.
     #[error("PR model {path}: expected {expected}, found {found}")]
     Signature {
         /// The model file.
