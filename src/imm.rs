@@ -31,7 +31,7 @@ pub type ModeProbabilities = [f64; MODE_COUNT];
 
 /// A track's estimate in every mode plus the mode probabilities: a small `Copy` value.
 /// Inactive modes are carried but never read.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ImmState {
     /// PR mode, `[x, y]`.
     pub learned: Gaussian<2>,
@@ -72,7 +72,7 @@ impl ImmState {
 }
 
 /// The outcome of [`Imm::predict`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ImmPrior {
     /// Each mode's prior; `probabilities` holds the prior mode probabilities `c`.
     pub state: ImmState,
@@ -86,7 +86,7 @@ pub struct ImmPrior {
 /// The IMM between [`Imm::predict_physics`] and [`Imm::complete_prior`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PendingPrior {
-    state: ImmState,
+    prior: ImmPrior,
     dt_s: f64,
 }
 
@@ -103,13 +103,27 @@ pub struct Imm {
 /// Weighted mean and covariance with the spread-of-means term
 /// (`eq:mixed_pos`, `eq:mixed_pos_cov`); weights must sum to 1 over `modes`.
 pub fn mix_positions(state: &ImmState, modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
+    mix(&mode_positions(state, modes), modes, weights)
+}
+
+/// Every mode's position estimate (entries of modes outside `modes` are left at zero).
+fn mode_positions(state: &ImmState, modes: ModeSet) -> [PositionEstimate; MODE_COUNT] {
+    let mut positions = [PositionEstimate::default(); MODE_COUNT];
+    for mode in modes.iter() {
+        positions[mode.index()] = state.position(mode);
+    }
+    positions
+}
+
+/// [`mix_positions`] on positions already extracted.
+fn mix(positions: &[PositionEstimate; MODE_COUNT], modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
     let mut mean = DVec2::ZERO;
     for mode in modes.iter() {
-        mean += weights[mode.index()] * state.position(mode).mean;
+        mean += weights[mode.index()] * positions[mode.index()].mean;
     }
     let mut covariance = DMat2::ZERO;
     for mode in modes.iter() {
-        let position = state.position(mode);
+        let position = &positions[mode.index()];
         let spread = position.mean - mean;
         covariance += (position.covariance + outer(spread, spread)) * weights[mode.index()];
     }
@@ -220,8 +234,10 @@ impl Imm {
     /// Mixing, per-mode prediction and prior fusion in one call: [`Imm::predict_physics`]
     /// followed by [`Imm::complete_prior`].
     pub fn predict(&self, models: &ModeModels, posterior: &ImmState, context: &PredictContext) -> ImmPrior {
-        let pending = self.predict_physics(models, posterior, context.dt_s);
-        self.complete_prior(models, &pending, context.displacement_m)
+        let mut prior = ImmPrior::default();
+        self.predict_physics_into(models, posterior, context.dt_s, &mut prior);
+        self.complete_prior_in_place(models, &mut prior, context.dt_s, context.displacement_m);
+        prior
     }
 
     /// First half of the prediction, which needs no learned displacement: prior mode
@@ -229,19 +245,28 @@ impl Imm {
     /// left at its mixed starting point. Lets the caller predict the physics modes while the
     /// learned predictor is still running.
     pub fn predict_physics(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64) -> PendingPrior {
+        let mut prior = ImmPrior::default();
+        self.predict_physics_into(models, posterior, dt_s, &mut prior);
+        PendingPrior { prior, dt_s }
+    }
+
+    /// [`predict_physics`](Self::predict_physics) written into `prior` in place (no copy of the
+    /// multi-mode state). `prior.available` and `prior.fused` are only meaningful after
+    /// [`complete_prior_in_place`](Self::complete_prior_in_place).
+    pub fn predict_physics_into(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64, prior: &mut ImmPrior) {
         let c = self.prior_probabilities(&posterior.probabilities);
-        let mixed = |mode: Mode| {
-            let beta = self.mixing_probabilities(&posterior.probabilities, &c, mode);
-            mix_positions(posterior, self.modes, &beta)
-        };
+        let positions = mode_positions(posterior, self.modes);
         let context = PredictContext { dt_s, displacement_m: None };
-        let mut state = *posterior;
+        let state = &mut prior.state;
         state.probabilities = c;
+        state.learned_velocity_mps = posterior.learned_velocity_mps;
         for mode in self.modes.iter() {
-            let start = mixed(mode);
+            let beta = self.mixing_probabilities(&posterior.probabilities, &c, mode);
+            let start = mix(&positions, self.modes, &beta);
             match mode {
                 Mode::Learned => {
-                    if state.learned.position() != start {
+                    state.learned = posterior.learned;
+                    if positions[mode.index()] != start {
                         replace_position(&mut state.learned, &start);
                     }
                 }
@@ -259,34 +284,73 @@ impl Imm {
                 }
             }
         }
-        PendingPrior { state, dt_s }
+        // Inactive modes are carried along unchanged, so that no stale values linger.
+        for mode in ModeSet::ALL.iter().filter(|mode| !self.modes.contains(*mode)) {
+            match mode {
+                Mode::Learned => state.learned = posterior.learned,
+                Mode::ConstantVelocity => state.constant_velocity = posterior.constant_velocity,
+                Mode::ConstantAcceleration => state.constant_acceleration = posterior.constant_acceleration,
+                Mode::CoordinatedTurn => state.coordinated_turn = posterior.coordinated_turn,
+            }
+        }
+        prior.available = self.modes;
     }
 
     /// Second half of the prediction: the PR prior from the learned displacement
     /// (`eq:pr_prior`, `eq:pr_cov`) and the fused prior (`eq:prior_fusion`). Without a
     /// displacement the PR mode sits the step out (see the module documentation).
     pub fn complete_prior(&self, models: &ModeModels, pending: &PendingPrior, displacement_m: Option<DVec2>) -> ImmPrior {
-        let mut state = pending.state;
+        let mut prior = pending.prior;
+        self.complete_prior_in_place(models, &mut prior, pending.dt_s, displacement_m);
+        prior
+    }
+
+    /// [`complete_prior`](Self::complete_prior) on a prior filled by
+    /// [`predict_physics_into`](Self::predict_physics_into) for the same `dt_s`.
+    pub fn complete_prior_in_place(&self, models: &ModeModels, prior: &mut ImmPrior, dt_s: f64, displacement_m: Option<DVec2>) {
+        let state = &mut prior.state;
         if self.modes.contains(Mode::Learned) {
-            let context = PredictContext { dt_s: pending.dt_s, displacement_m };
+            let context = PredictContext { dt_s, displacement_m };
             state.learned = models.learned.predict(&state.learned, &context);
             if let Some(displacement) = displacement_m {
-                state.learned_velocity_mps = displacement / pending.dt_s;
+                state.learned_velocity_mps = displacement / dt_s;
             }
         }
         let mut available = self.modes;
         if displacement_m.is_none() && self.modes.len() > 1 {
             available = available.without(Mode::Learned);
         }
-        let c = state.probabilities;
-        let fused = mix_positions(&state, available, &renormalised(&c, available));
-        ImmPrior { state, available, fused }
+        prior.available = available;
+        prior.fused = mix_positions(state, available, &renormalised(&state.probabilities, available));
     }
 
     /// Kalman update of every active mode with measurement `z`, tempered mode-probability
     /// update and floor. On a numerical failure of any mode the prior is left as it was.
     pub fn update(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2) -> Result<ImmState, UpdateError> {
-        let mut state = prior.state;
+        let mut state = ImmState::default();
+        self.update_into(models, prior, z, &mut state)?;
+        Ok(state)
+    }
+
+    /// [`update`](Self::update) written into `posterior` in place. On error `posterior` holds
+    /// the prior's state (the track coasts; nothing half-updated is left behind).
+    pub fn update_into(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2, posterior: &mut ImmState) -> Result<(), UpdateError> {
+        *posterior = prior.state;
+        match self.update_modes(models, z, posterior) {
+            Ok(log_likelihood) => {
+                posterior.probabilities =
+                    self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
+                Ok(())
+            }
+            Err(error) => {
+                *posterior = prior.state;
+                Err(error)
+            }
+        }
+    }
+
+    /// Each active mode's Kalman update in place; the log-likelihoods.
+    fn update_modes(&self, models: &ModeModels, z: DVec2, state: &mut ImmState) -> Result<ModeProbabilities, UpdateError> {
         let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
         for mode in self.modes.iter() {
             log_likelihood[mode.index()] = match mode {
@@ -298,8 +362,7 @@ impl Imm {
                 Mode::CoordinatedTurn => update_mode(&mut state.coordinated_turn, &models.coordinated_turn, z)?,
             };
         }
-        state.probabilities = self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
-        Ok(state)
+        Ok(log_likelihood)
     }
 
     /// `μ_i ∝ Λ_i^τ c_i` over the available modes (`eq:mode_update`), in log space; a mode that

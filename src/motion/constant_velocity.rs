@@ -63,10 +63,12 @@ impl MotionModel<4> for ConstantVelocity {
     }
 
     fn predict(&self, posterior: &Gaussian<4>, context: &PredictContext) -> Gaussian<4> {
-        let f = Self::transition(context.dt_s);
-        let mut covariance = f * posterior.covariance * f.transpose() + self.process_noise(context.dt_s);
-        crate::gaussian::symmetrize(&mut covariance);
-        Gaussian::new(f * posterior.mean, covariance)
+        let dt = context.dt_s;
+        // F = transition(dt), applied through its two off-diagonal terms.
+        let mut prior = super::propagate_linear(posterior, &[(index::X, index::VX, dt), (index::Y, index::VY, dt)]);
+        prior.covariance += self.process_noise(dt);
+        crate::gaussian::symmetrize(&mut prior.covariance);
+        prior
     }
 
     fn measurement_noise(&self) -> Matrix2<f64> {
