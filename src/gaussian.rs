@@ -185,6 +185,35 @@ pub fn kalman_update<const N: usize>(
     z: DVec2,
     r: &Matrix2<f64>,
 ) -> Result<KalmanUpdate<N>, UpdateError> {
+    let mut posterior = *prior;
+    let terms = kalman_update_into(prior, z, r, &mut posterior)?;
+    Ok(KalmanUpdate {
+        posterior,
+        innovation: terms.innovation,
+        innovation_covariance: terms.innovation_covariance,
+        log_likelihood: terms.log_likelihood,
+    })
+}
+
+/// The by-products of [`kalman_update_into`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UpdateTerms {
+    /// `ν = z − H x⁻`, m.
+    pub innovation: Vector2<f64>,
+    /// `S = H P⁻ Hᵀ + R`, m².
+    pub innovation_covariance: Matrix2<f64>,
+    /// `ln N(ν; 0, S)`.
+    pub log_likelihood: f64,
+}
+
+/// [`kalman_update`] written straight into `posterior` (no temporary copies of the state), for
+/// the hot path. On error `posterior` holds unspecified values and must be discarded.
+pub fn kalman_update_into<const N: usize>(
+    prior: &Gaussian<N>,
+    z: DVec2,
+    r: &Matrix2<f64>,
+    posterior: &mut Gaussian<N>,
+) -> Result<UpdateTerms, UpdateError> {
     let p = &prior.covariance;
     let innovation = Vector2::new(z.x - prior.mean[0], z.y - prior.mean[1]);
     // S = H P Hᵀ + R is the top-left block plus R, symmetrised.
@@ -196,54 +225,50 @@ pub fn kalman_update<const N: usize>(
         return Err(UpdateError);
     }
     let (i00, i01, i11) = (s11 / determinant, -s01 / determinant, s00 / determinant);
-
-    // K = P Hᵀ S⁻¹: P Hᵀ is P's first two columns.
-    let mut gain = SMatrix::<f64, N, 2>::zeros();
-    for row in 0..N {
-        let (a, b) = (p[(row, 0)], p[(row, 1)]);
-        gain[(row, 0)] = a * i00 + b * i01;
-        gain[(row, 1)] = a * i01 + b * i11;
-    }
-
-    // Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ, evaluated with H = [I₂ 0] in O(N²):
-    // A = (I − KH)P = P − K·P[0..2, :]; then A(I − KH)ᵀ = A − A[:, 0..2]·Kᵀ; then + K R Kᵀ.
-    let mut a = *p;
-    for column in 0..N {
-        let (top0, top1) = (p[(0, column)], p[(1, column)]);
-        for row in 0..N {
-            a[(row, column)] -= gain[(row, 0)] * top0 + gain[(row, 1)] * top1;
-        }
-    }
-    let (r00, r01, r10, r11) = (r[(0, 0)], r[(0, 1)], r[(1, 0)], r[(1, 1)]);
-    let mut covariance = SMatrix::<f64, N, N>::zeros();
-    for column in 0..N {
-        let (k0, k1) = (gain[(column, 0)], gain[(column, 1)]);
-        // Column `column` of (R Kᵀ).
-        let (rk0, rk1) = (r00 * k0 + r01 * k1, r10 * k0 + r11 * k1);
-        for row in 0..N {
-            covariance[(row, column)] = a[(row, column)] - (a[(row, 0)] * k0 + a[(row, 1)] * k1)
-                + (gain[(row, 0)] * rk0 + gain[(row, 1)] * rk1);
-        }
-    }
-    symmetrize(&mut covariance);
-    let mut mean = prior.mean;
-    for row in 0..N {
-        mean[row] += gain[(row, 0)] * innovation.x + gain[(row, 1)] * innovation.y;
-    }
-
     let mahalanobis_squared = innovation.x * (i00 * innovation.x + i01 * innovation.y)
         + innovation.y * (i01 * innovation.x + i11 * innovation.y);
     let log_likelihood = -0.5 * mahalanobis_squared - LN_TWO_PI - 0.5 * determinant.ln();
-
-    if !log_likelihood.is_finite() || mean.iter().any(|v| !v.is_finite()) {
+    if !log_likelihood.is_finite() {
         return Err(UpdateError);
     }
-    Ok(KalmanUpdate {
-        posterior: Gaussian { mean, covariance },
-        innovation,
-        innovation_covariance: Matrix2::new(s00, s01, s01, s11),
-        log_likelihood,
-    })
+
+    // K = P Hᵀ S⁻¹ (P Hᵀ is P's first two columns), and the first two columns of
+    // A = (I − KH)P = P − K·P[0..2, :].
+    let mut gain = [[0.0; 2]; N];
+    let mut a_left = [[0.0; 2]; N];
+    for row in 0..N {
+        let (p0, p1) = (p[(row, 0)], p[(row, 1)]);
+        let k = [p0 * i00 + p1 * i01, p0 * i01 + p1 * i11];
+        gain[row] = k;
+        a_left[row] = [
+            p0 - (k[0] * p[(0, 0)] + k[1] * p[(1, 0)]),
+            p1 - (k[0] * p[(0, 1)] + k[1] * p[(1, 1)]),
+        ];
+    }
+    // Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ with H = [I₂ 0], element by element in O(N²):
+    // A − A[:, 0..2]·Kᵀ + K R Kᵀ, where A = P − K·P[0..2, :]. Upper triangle, mirrored.
+    let (r00, r01, r10, r11) = (r[(0, 0)], r[(0, 1)], r[(1, 0)], r[(1, 1)]);
+    for column in 0..N {
+        let k = gain[column];
+        let (top0, top1) = (p[(0, column)], p[(1, column)]);
+        // Column `column` of R Kᵀ.
+        let (rk0, rk1) = (r00 * k[0] + r01 * k[1], r10 * k[0] + r11 * k[1]);
+        for row in 0..=column {
+            let g = gain[row];
+            let a = p[(row, column)] - (g[0] * top0 + g[1] * top1);
+            let value = a - (a_left[row][0] * k[0] + a_left[row][1] * k[1]) + (g[0] * rk0 + g[1] * rk1);
+            posterior.covariance[(row, column)] = value;
+            posterior.covariance[(column, row)] = value;
+        }
+    }
+    for row in 0..N {
+        let value = prior.mean[row] + gain[row][0] * innovation.x + gain[row][1] * innovation.y;
+        if !value.is_finite() {
+            return Err(UpdateError);
+        }
+        posterior.mean[row] = value;
+    }
+    Ok(UpdateTerms { innovation, innovation_covariance: Matrix2::new(s00, s01, s01, s11), log_likelihood })
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@
 //! way), the others sharing `1 − c_PR`.
 
 use crate::config::ImmConfig;
-use crate::gaussian::{kalman_update, replace_position, Gaussian, PositionEstimate, UpdateError};
+use crate::gaussian::{kalman_update_into, replace_position, Gaussian, PositionEstimate, UpdateError};
 use crate::measurement::Measurement;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
 use crate::motion::{ModeModels, MotionModel, PredictContext};
@@ -134,14 +134,24 @@ fn outer(a: DVec2, b: DVec2) -> DMat2 {
     DMat2::from_cols(a * b.x, a * b.y)
 }
 
-/// Kalman update of one mode's prior in place; returns its log-likelihood.
-fn update_mode<const N: usize, M: MotionModel<N>>(estimate: &mut Gaussian<N>, model: &M, z: DVec2) -> Result<f64, UpdateError> {
-    let update = kalman_update(estimate, z, &model.measurement_noise())?;
-    *estimate = update.posterior;
-    Ok(update.log_likelihood)
+/// One mode's Kalman update from `prior` into `posterior` and its log-likelihood; an inactive
+/// mode is copied unchanged.
+fn update_mode<const N: usize, M: MotionModel<N>>(
+    prior: &Gaussian<N>,
+    posterior: &mut Gaussian<N>,
+    model: &M,
+    z: DVec2,
+    active: bool,
+    log_likelihood: &mut f64,
+) -> Result<(), UpdateError> {
+    if !active {
+        *posterior = *prior;
+        return Ok(());
+    }
+    *log_likelihood = kalman_update_into(prior, z, &model.measurement_noise(), posterior)?.log_likelihood;
+    Ok(())
 }
 
-/// Mixes one mode's posterior and predicts it.
 fn mix_and_predict<const N: usize, M: MotionModel<N>>(
     model: &M,
     posterior: &Gaussian<N>,
@@ -335,11 +345,11 @@ impl Imm {
     /// [`update`](Self::update) written into `posterior` in place. On error `posterior` holds
     /// the prior's state (the track coasts; nothing half-updated is left behind).
     pub fn update_into(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2, posterior: &mut ImmState) -> Result<(), UpdateError> {
-        *posterior = prior.state;
-        match self.update_modes(models, z, posterior) {
+        match self.update_modes(models, prior, z, posterior) {
             Ok(log_likelihood) => {
                 posterior.probabilities =
                     self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
+                posterior.learned_velocity_mps = prior.state.learned_velocity_mps;
                 Ok(())
             }
             Err(error) => {
@@ -349,18 +359,47 @@ impl Imm {
         }
     }
 
-    /// Each active mode's Kalman update in place; the log-likelihoods.
-    fn update_modes(&self, models: &ModeModels, z: DVec2, state: &mut ImmState) -> Result<ModeProbabilities, UpdateError> {
+    /// Each mode's Kalman update from `prior` into `posterior` (inactive modes are copied);
+    /// the log-likelihoods. Stops at the first failing mode.
+    fn update_modes(
+        &self,
+        models: &ModeModels,
+        prior: &ImmPrior,
+        z: DVec2,
+        posterior: &mut ImmState,
+    ) -> Result<ModeProbabilities, UpdateError> {
         let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
-        for mode in self.modes.iter() {
-            log_likelihood[mode.index()] = match mode {
-                Mode::Learned => update_mode(&mut state.learned, &models.learned, z)?,
-                Mode::ConstantVelocity => update_mode(&mut state.constant_velocity, &models.constant_velocity, z)?,
-                Mode::ConstantAcceleration => {
-                    update_mode(&mut state.constant_acceleration, &models.constant_acceleration, z)?
-                }
-                Mode::CoordinatedTurn => update_mode(&mut state.coordinated_turn, &models.coordinated_turn, z)?,
-            };
+        let (from, to) = (&prior.state, posterior);
+        for mode in ModeSet::ALL.iter() {
+            let active = self.modes.contains(mode);
+            let i = mode.index();
+            match mode {
+                Mode::Learned => update_mode(&from.learned, &mut to.learned, &models.learned, z, active, &mut log_likelihood[i])?,
+                Mode::ConstantVelocity => update_mode(
+                    &from.constant_velocity,
+                    &mut to.constant_velocity,
+                    &models.constant_velocity,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+                Mode::ConstantAcceleration => update_mode(
+                    &from.constant_acceleration,
+                    &mut to.constant_acceleration,
+                    &models.constant_acceleration,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+                Mode::CoordinatedTurn => update_mode(
+                    &from.coordinated_turn,
+                    &mut to.coordinated_turn,
+                    &models.coordinated_turn,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+            }
         }
         Ok(log_likelihood)
     }
