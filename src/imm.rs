@@ -152,19 +152,22 @@ fn update_mode<const N: usize, M: MotionModel<N>>(
     Ok(())
 }
 
+/// One mode's start (its posterior with the mixed position written in, `eq:mixed_state` …
+/// `eq:reconstructed_cov`) predicted into `prior`.
 fn mix_and_predict<const N: usize, M: MotionModel<N>>(
     model: &M,
     posterior: &Gaussian<N>,
     mixed: &PositionEstimate,
     context: &PredictContext,
-) -> Gaussian<N> {
-    let mut start = *posterior;
+    prior: &mut Gaussian<N>,
+) {
+    *prior = *posterior;
     // With nothing to mix (a single mode, or all weight on itself) the write-back is the
     // identity; skipping it keeps single-mode filtering bit-identical to a plain filter.
-    if start.position() != *mixed {
-        replace_position(&mut start, mixed);
+    if prior.position() != *mixed {
+        replace_position(prior, mixed);
     }
-    model.predict(&start, context)
+    model.predict_in_place(prior, context);
 }
 
 impl Imm {
@@ -281,16 +284,19 @@ impl Imm {
                     }
                 }
                 Mode::ConstantVelocity => {
-                    state.constant_velocity =
-                        mix_and_predict(&models.constant_velocity, &posterior.constant_velocity, &start, &context)
+                    mix_and_predict(&models.constant_velocity, &posterior.constant_velocity, &start, &context, &mut state.constant_velocity)
                 }
                 Mode::ConstantAcceleration => {
-                    state.constant_acceleration =
-                        mix_and_predict(&models.constant_acceleration, &posterior.constant_acceleration, &start, &context)
+                    mix_and_predict(
+                        &models.constant_acceleration,
+                        &posterior.constant_acceleration,
+                        &start,
+                        &context,
+                        &mut state.constant_acceleration,
+                    )
                 }
                 Mode::CoordinatedTurn => {
-                    state.coordinated_turn =
-                        mix_and_predict(&models.coordinated_turn, &posterior.coordinated_turn, &start, &context)
+                    mix_and_predict(&models.coordinated_turn, &posterior.coordinated_turn, &start, &context, &mut state.coordinated_turn)
                 }
             }
         }

@@ -119,22 +119,32 @@ impl TurnTerms {
         )
     }
 
-    fn jacobian(&self, state: &Vector5, dt: f64) -> Matrix5 {
+    /// The Jacobian's entries off the identity as `(row, column, J[row, column] − δ)`: rows x,
+    /// y, vx, vy against columns vx, vy, ω.
+    fn jacobian_off_identity(&self, state: &Vector5, dt: f64) -> [(usize, usize, f64); 12] {
         let (vx, vy) = (state[index::VX], state[index::VY]);
         let Self { sin, cos, s, g, ds, dg } = *self;
+        [
+            (index::X, index::VX, dt * s),
+            (index::X, index::VY, -dt * g),
+            (index::X, index::OMEGA, dt * dt * (ds * vx - dg * vy)),
+            (index::Y, index::VX, dt * g),
+            (index::Y, index::VY, dt * s),
+            (index::Y, index::OMEGA, dt * dt * (dg * vx + ds * vy)),
+            (index::VX, index::VX, cos - 1.0),
+            (index::VX, index::VY, -sin),
+            (index::VX, index::OMEGA, dt * (-sin * vx - cos * vy)),
+            (index::VY, index::VX, sin),
+            (index::VY, index::VY, cos - 1.0),
+            (index::VY, index::OMEGA, dt * (cos * vx - sin * vy)),
+        ]
+    }
+
+    fn jacobian(&self, state: &Vector5, dt: f64) -> Matrix5 {
         let mut j = Matrix5::identity();
-        j[(index::X, index::VX)] = dt * s;
-        j[(index::X, index::VY)] = -dt * g;
-        j[(index::X, index::OMEGA)] = dt * dt * (ds * vx - dg * vy);
-        j[(index::Y, index::VX)] = dt * g;
-        j[(index::Y, index::VY)] = dt * s;
-        j[(index::Y, index::OMEGA)] = dt * dt * (dg * vx + ds * vy);
-        j[(index::VX, index::VX)] = cos;
-        j[(index::VX, index::VY)] = -sin;
-        j[(index::VX, index::OMEGA)] = dt * (-sin * vx - cos * vy);
-        j[(index::VY, index::VX)] = sin;
-        j[(index::VY, index::VY)] = cos;
-        j[(index::VY, index::OMEGA)] = dt * (cos * vx - sin * vy);
+        for (row, column, value) in self.jacobian_off_identity(state, dt) {
+            j[(row, column)] += value;
+        }
         j
     }
 }
@@ -195,17 +205,8 @@ impl MotionModel<5> for CoordinatedTurn {
         // One evaluation of sin/cos serves both the mean and the Jacobian.
         let terms = TurnTerms::new(&posterior.mean, dt);
         // J P Jᵀ through J's twelve entries off the identity (rows x, y, vx, vy; columns vx,
-        // vy, ω); the mean goes through the nonlinear transition.
-        let f = terms.jacobian(&posterior.mean, dt);
-        let mut off_identity = [(0, 0, 0.0); 12];
-        for (slot, (row, column)) in off_identity.iter_mut().zip(
-            [index::X, index::Y, index::VX, index::VY]
-                .into_iter()
-                .flat_map(|row| [index::VX, index::VY, index::OMEGA].map(move |column| (row, column))),
-        ) {
-            let identity = if row == column { 1.0 } else { 0.0 };
-            *slot = (row, column, f[(row, column)] - identity);
-        }
+        // vy, ω; see `jacobian`); the mean goes through the nonlinear transition.
+        let off_identity = terms.jacobian_off_identity(&posterior.mean, dt);
         let mut prior = super::propagate_linear(posterior, &off_identity);
         prior.mean = terms.transition(&posterior.mean, dt);
         prior.covariance += self.process_noise(dt);
