@@ -419,21 +419,24 @@ impl Imm {
         log_likelihood: &ModeProbabilities,
     ) -> ModeProbabilities {
         let weights = renormalised(prior, available);
-        let mut log_weight = [f64::NEG_INFINITY; MODE_COUNT];
+        // μ_i ∝ exp(τ ℓ_i − max_j τ ℓ_j) · c_i: the shift by the largest tempered
+        // log-likelihood keeps the exponentials in range, and the mode attaining it keeps a
+        // positive weight, so the sum cannot vanish.
         let mut largest = f64::NEG_INFINITY;
         for mode in available.iter() {
             let i = mode.index();
             if weights[i] > 0.0 {
-                log_weight[i] = self.temperature * log_likelihood[i] + weights[i].ln();
-                largest = largest.max(log_weight[i]);
+                largest = largest.max(self.temperature * log_likelihood[i]);
             }
         }
         let mut mu = [0.0; MODE_COUNT];
         let mut sum = 0.0;
         for mode in available.iter() {
             let i = mode.index();
-            mu[i] = (log_weight[i] - largest).exp();
-            sum += mu[i];
+            if weights[i] > 0.0 {
+                mu[i] = (self.temperature * log_likelihood[i] - largest).exp() * weights[i];
+                sum += mu[i];
+            }
         }
         let sitting_out: f64 = self.modes.iter().filter(|m| !available.contains(*m)).map(|m| prior[m.index()]).sum();
         for mode in self.modes.iter() {
@@ -464,7 +467,7 @@ impl Imm {
     /// Raises every active mode's probability to at least the floor and renormalises, keeping
     /// the floored modes at exactly the floor.
     pub fn apply_floor(&self, mut mu: ModeProbabilities) -> ModeProbabilities {
-        if self.floor <= 0.0 {
+        if self.floor <= 0.0 || self.modes.iter().all(|mode| mu[mode.index()] >= self.floor) {
             return mu;
         }
         let mut floored = ModeSet::EMPTY;
