@@ -1,4 +1,8 @@
-//! Timing of the assignment solver on square problems of tracking-like and dense structure.
+//! Timing of the assignment solver on square problems of tracking-like and dense structure,
+//! and of the tracker's whole association step (per-class gating, clusters, solves) against
+//! one dense gated solve per class of the same frame.
+//!
+//! `cargo bench --bench assignment`
 
 use std::hint::black_box;
 
@@ -64,5 +68,95 @@ fn bench_assignment(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_assignment);
+/// Tracks on lanes 4 m apart (cars and pedestrians alternating), priors 0.3 m off their
+/// measurements, in shuffled measurement order.
+fn association_scene(
+    n: usize,
+) -> (Vec<primm::track::Track>, Vec<primm::imm::ImmPrior>, primm::measurement::Frame, Vec<bool>) {
+    use primm::measurement::{Frame, Measurement, ObjectClass};
+    let config = primm::config::Config::default();
+    let imm = primm::imm::Imm::new(&config.imm);
+    let mut rng = ChaCha8Rng::seed_from_u64(n as u64);
+    let mut tracks = Vec::new();
+    let mut priors = Vec::new();
+    let mut frame = Frame::new(0.05);
+    for i in 0..n {
+        let (lane, block) = (i % 16, i / 16);
+        let class = if lane % 2 == 0 { ObjectClass::Car } else { ObjectClass::Pedestrian };
+        let measurement = Measurement {
+            x_m: -150.0 + 40.0 * block as f64 + rng.random_range(-0.3..0.3),
+            y_m: -32.0 + 4.0 * lane as f64 + rng.random_range(-0.3..0.3),
+            radial_velocity_mps: 5.0,
+            rcs_dbsm: 0.0,
+            class,
+            sensor_id: None,
+            ground_truth_id: None,
+        };
+        let models = primm::motion::ModeModels::from_config(config.classes.get(class));
+        let state = imm.initiate(&models, &measurement);
+        let context = primm::motion::PredictContext { dt_s: 0.05, displacement_m: None };
+        let mut prior = imm.predict(&models, &state, &context);
+        prior.fused.mean = glam::DVec2::new(measurement.x_m + 0.3, measurement.y_m - 0.2);
+        tracks.push(primm::track::Track::new(i as u64, &measurement, 0.0, state));
+        priors.push(prior);
+        frame.measurements.push(measurement);
+    }
+    for index in (1..n).rev() {
+        frame.measurements.swap(index, rng.random_range(0..=index));
+    }
+    (tracks, priors, frame, vec![true; n])
+}
+
+fn bench_association(c: &mut Criterion) {
+    use primm::association::associator::Associator;
+    use primm::association::cost::association_cost;
+    use primm::measurement::ObjectClass;
+    let config = primm::config::Config::default();
+    let mut group = c.benchmark_group("association");
+    for n in SIZES {
+        let (tracks, priors, frame, accepted) = association_scene(n);
+        let mut associator = Associator::new();
+        let mut track_to_measurement = vec![None; n];
+        group.bench_function(BenchmarkId::new("clustered", n), |bencher| {
+            bencher.iter(|| {
+                associator
+                    .associate(&tracks, &priors, &frame, &accepted, &config, &mut track_to_measurement)
+                    .expect("valid problem");
+                black_box(track_to_measurement[0])
+            });
+        });
+        // The same frame as one dense gated matrix per class (the cost matrix filled in full).
+        let mut solver = AssignmentSolver::with_capacity(n, n);
+        let mut costs = vec![0.0; n * n];
+        let mut row_to_col = vec![None; n];
+        group.bench_function(BenchmarkId::new("dense_per_class", n), |bencher| {
+            bencher.iter(|| {
+                for class in ObjectClass::ALL {
+                    let rows: Vec<usize> = (0..n).filter(|&i| tracks[i].class == class).collect();
+                    let columns: Vec<usize> = (0..n).filter(|&j| frame.measurements[j].class == class).collect();
+                    let gate = config.classes.get(class).gate_m;
+                    for (r, &i) in rows.iter().enumerate() {
+                        for (k, &j) in columns.iter().enumerate() {
+                            let cost = association_cost(
+                                priors[i].fused.mean,
+                                tracks[i].last_radial_velocity_mps,
+                                &frame.measurements[j],
+                                &config.association,
+                            );
+                            costs[r * columns.len() + k] = if cost <= gate { cost } else { f64::INFINITY };
+                        }
+                    }
+                    let cells = rows.len() * columns.len();
+                    solver
+                        .solve(rows.len(), columns.len(), &costs[..cells], &mut row_to_col[..rows.len()])
+                        .expect("valid problem");
+                }
+                black_box(row_to_col[0])
+            });
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_assignment, bench_association);
 criterion_main!(benches);

@@ -1,10 +1,19 @@
 //! Service latency: a measurement frame sent by a publisher until its track frame is received
-//! by a subscriber, through a `primm serve` process, with the tracker waiting on events
-//! (default) and busy-polling. Frames are sent one at a time (each after the previous answer),
-//! so the figures are latencies, not queueing. Prints HdrHistogram percentiles; nothing is
+//! by a subscriber, through a real `primm serve` process, with the tracker and this client
+//! waiting on events (default) or both busy-polling. Frames are sent one at a time (each after
+//! the previous answer), so the figures are latencies, not queueing.
+//!
+//! Per frame, with the same-host monotonic clock of both processes:
+//! * `send -> answer`: the client's send until it holds the track frame;
+//! * `send -> tracker receive` and `tracker publish -> answer`: the two IPC legs;
+//! * `tracker receive -> publish`: the tracker's own compute (validate … publish);
+//! * `IPC overhead`: `send -> answer` minus the tracker's compute, i.e. what shared memory,
+//!   notification and wake-ups add.
+//!
+//! Prints HdrHistogram percentiles and writes `benches/results/service_latency.md`; nothing is
 //! asserted.
 //!
-//! `cargo bench --bench service_latency [-- FRAMES]`
+//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--no-write]`
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -13,55 +22,101 @@ use common::service::{spawn_serve, unique_prefix, TestClient};
 use hdrhistogram::Histogram;
 use primm::service::clock::monotonic_ns;
 use primm::service::ServiceNames;
+use std::fmt::Write as _;
 use std::time::Duration;
 
-fn measure(mode: &str, extra: &[&str], frames: usize) {
+const LEGS: [&str; 5] =
+    ["send -> answer", "send -> tracker receive", "tracker receive -> publish", "tracker publish -> answer", "IPC overhead"];
+
+fn measure(mode: &str, method: &str, objects: usize, frames: usize) -> Vec<Histogram<u64>> {
     let prefix = unique_prefix(&format!("bench-{mode}"));
     let client = TestClient::new(&ServiceNames::new(&prefix));
-    let serve = spawn_serve(&prefix, extra);
-    client.wait_for_tracker(Duration::from_secs(30));
-    let scene = common::scene_frames(&common::lanes(32), 500, 0.05, 0.2, 11);
-    let mut round_trip = Histogram::<u64>::new_with_bounds(1, 60_000_000_000, 3).unwrap();
-    let mut tracker_internal = Histogram::<u64>::new_with_bounds(1, 60_000_000_000, 3).unwrap();
-    let warm_up = 200;
+    let mut extra = vec!["--method", method];
+    let busy = mode == "busy-poll";
+    if busy {
+        extra.push("--busy-poll");
+    }
+    let serve = spawn_serve(&prefix, &extra);
+    client.wait_for_tracker(Duration::from_secs(60));
+    let scene = common::scene_frames(&common::lanes(objects), 500, 0.05, 0.2, 11);
+    let mut histograms: Vec<Histogram<u64>> =
+        LEGS.iter().map(|_| Histogram::<u64>::new_with_bounds(1, 60_000_000_000, 3).unwrap()).collect();
+    let warm_up = 500;
     let mut frame = scene[0].clone();
     for k in 0..warm_up + frames {
         let source = &scene[k % scene.len()];
         frame.timestamp_s = k as f64 * 0.05;
         frame.measurements.clone_from(&source.measurements);
         client.send(&frame, k as u64, 0);
-        let (sent_ns, receive_ns, publish_ns) = client
-            .next_answer(Duration::from_secs(10), |answer| {
-                (answer.input_publish_time_ns, answer.receive_time_ns, answer.publish_time_ns)
-            })
-            .expect("the tracker answers");
+        let read = |answer: &primm::wire::TrackFrame| {
+            (answer.input_publish_time_ns, answer.receive_time_ns, answer.publish_time_ns)
+        };
+        let answer = if busy {
+            client.next_answer_spinning(Duration::from_secs(10), read)
+        } else {
+            client.next_answer(Duration::from_secs(10), read)
+        };
+        let (sent_ns, receive_ns, publish_ns) = answer.expect("the tracker answers");
         let received_ns = monotonic_ns();
         if k >= warm_up {
-            round_trip.saturating_record(received_ns - sent_ns);
-            tracker_internal.saturating_record(publish_ns - receive_ns);
+            let round_trip = received_ns.saturating_sub(sent_ns);
+            let compute = publish_ns.saturating_sub(receive_ns);
+            let values = [
+                round_trip,
+                receive_ns.saturating_sub(sent_ns),
+                compute,
+                received_ns.saturating_sub(publish_ns),
+                round_trip.saturating_sub(compute),
+            ];
+            for (histogram, value) in histograms.iter_mut().zip(values) {
+                histogram.saturating_record(value.max(1));
+            }
         }
     }
     serve.signal(libc::SIGINT);
     let _ = serve.wait(Duration::from_secs(10));
-    let us = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q) as f64 / 1000.0;
-    for (name, h) in [("send -> track frame received", &round_trip), ("tracker receive -> publish", &tracker_internal)] {
-        println!(
-            "{mode:<10} {name:<30} n {:>6}  p50 {:>8.1} µs  p99 {:>8.1} µs  p99.9 {:>8.1} µs  max {:>8.1} µs",
-            h.len(),
-            us(h, 0.5),
-            us(h, 0.99),
-            us(h, 0.999),
-            h.max() as f64 / 1000.0
-        );
-    }
+    histograms
+}
+
+fn argument(name: &str) -> Option<String> {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter().position(|a| a == name).and_then(|i| args.get(i + 1).cloned())
 }
 
 fn main() {
-    let frames = std::env::args()
-        .skip(1)
-        .find_map(|arg| arg.parse::<usize>().ok())
-        .unwrap_or(5000);
-    println!("service latency, 32 objects per frame, {frames} frames after warm-up");
-    measure("event", &[], frames);
-    measure("busy-poll", &["--busy-poll"], frames);
+    let frames: usize = argument("--frames").and_then(|v| v.parse().ok()).unwrap_or(100_000);
+    let objects: usize = argument("--objects").and_then(|v| v.parse().ok()).unwrap_or(64);
+    let method = argument("--method").unwrap_or_else(|| "imm".into());
+    let modes = argument("--modes").unwrap_or_else(|| "event,busy-poll".into());
+    let us = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q) as f64 / 1000.0;
+    let mut table = String::new();
+    writeln!(table, "| wait mode | leg | frames | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |").unwrap();
+    writeln!(table, "|---|---|---|---|---|---|---|---|").unwrap();
+    for mode in modes.split(',') {
+        let histograms = measure(mode, &method, objects, frames);
+        for (leg, h) in LEGS.iter().zip(&histograms) {
+            writeln!(
+                table,
+                "| {mode} | {leg} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
+                h.len(),
+                us(h, 0.5),
+                us(h, 0.9),
+                us(h, 0.99),
+                us(h, 0.999),
+                h.max() as f64 / 1000.0
+            )
+            .unwrap();
+        }
+    }
+    let heading = format!(
+        "Service latency through `primm serve --method {method}`, {objects} objects per frame, {frames} frames per wait mode after 500 warm-up frames, one frame in flight.\n\n"
+    );
+    println!("{heading}{table}");
+    if !std::env::args().any(|a| a == "--no-write") {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
+        std::fs::create_dir_all(&dir).unwrap();
+        let name = if method == "imm" { "service_latency.md".to_string() } else { format!("service_latency_{method}.md") };
+        std::fs::write(dir.join(&name), heading + &table).unwrap();
+        eprintln!("wrote {}", dir.join(name).display());
+    }
 }

@@ -20,7 +20,7 @@
 //! way), the others sharing `1 − c_PR`.
 
 use crate::config::ImmConfig;
-use crate::gaussian::{kalman_update, replace_position, Gaussian, PositionEstimate, UpdateError};
+use crate::gaussian::{kalman_update_into, replace_position, Gaussian, PositionEstimate, UpdateError};
 use crate::measurement::Measurement;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
 use crate::motion::{ModeModels, MotionModel, PredictContext};
@@ -31,7 +31,7 @@ pub type ModeProbabilities = [f64; MODE_COUNT];
 
 /// A track's estimate in every mode plus the mode probabilities: a small `Copy` value.
 /// Inactive modes are carried but never read.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ImmState {
     /// PR mode, `[x, y]`.
     pub learned: Gaussian<2>,
@@ -72,7 +72,7 @@ impl ImmState {
 }
 
 /// The outcome of [`Imm::predict`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ImmPrior {
     /// Each mode's prior; `probabilities` holds the prior mode probabilities `c`.
     pub state: ImmState,
@@ -86,7 +86,7 @@ pub struct ImmPrior {
 /// The IMM between [`Imm::predict_physics`] and [`Imm::complete_prior`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PendingPrior {
-    state: ImmState,
+    prior: ImmPrior,
     dt_s: f64,
 }
 
@@ -103,13 +103,27 @@ pub struct Imm {
 /// Weighted mean and covariance with the spread-of-means term
 /// (`eq:mixed_pos`, `eq:mixed_pos_cov`); weights must sum to 1 over `modes`.
 pub fn mix_positions(state: &ImmState, modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
+    mix(&mode_positions(state, modes), modes, weights)
+}
+
+/// Every mode's position estimate (entries of modes outside `modes` are left at zero).
+fn mode_positions(state: &ImmState, modes: ModeSet) -> [PositionEstimate; MODE_COUNT] {
+    let mut positions = [PositionEstimate::default(); MODE_COUNT];
+    for mode in modes.iter() {
+        positions[mode.index()] = state.position(mode);
+    }
+    positions
+}
+
+/// [`mix_positions`] on positions already extracted.
+fn mix(positions: &[PositionEstimate; MODE_COUNT], modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
     let mut mean = DVec2::ZERO;
     for mode in modes.iter() {
-        mean += weights[mode.index()] * state.position(mode).mean;
+        mean += weights[mode.index()] * positions[mode.index()].mean;
     }
     let mut covariance = DMat2::ZERO;
     for mode in modes.iter() {
-        let position = state.position(mode);
+        let position = &positions[mode.index()];
         let spread = position.mean - mean;
         covariance += (position.covariance + outer(spread, spread)) * weights[mode.index()];
     }
@@ -120,27 +134,40 @@ fn outer(a: DVec2, b: DVec2) -> DMat2 {
     DMat2::from_cols(a * b.x, a * b.y)
 }
 
-/// Kalman update of one mode's prior in place; returns its log-likelihood.
-fn update_mode<const N: usize, M: MotionModel<N>>(estimate: &mut Gaussian<N>, model: &M, z: DVec2) -> Result<f64, UpdateError> {
-    let update = kalman_update(estimate, z, &model.measurement_noise())?;
-    *estimate = update.posterior;
-    Ok(update.log_likelihood)
+/// One mode's Kalman update from `prior` into `posterior` and its log-likelihood; an inactive
+/// mode is copied unchanged.
+fn update_mode<const N: usize, M: MotionModel<N>>(
+    prior: &Gaussian<N>,
+    posterior: &mut Gaussian<N>,
+    model: &M,
+    z: DVec2,
+    active: bool,
+    log_likelihood: &mut f64,
+) -> Result<(), UpdateError> {
+    if !active {
+        *posterior = *prior;
+        return Ok(());
+    }
+    *log_likelihood = kalman_update_into(prior, z, &model.measurement_noise(), posterior)?.log_likelihood;
+    Ok(())
 }
 
-/// Mixes one mode's posterior and predicts it.
+/// One mode's start (its posterior with the mixed position written in, `eq:mixed_state` …
+/// `eq:reconstructed_cov`) predicted into `prior`.
 fn mix_and_predict<const N: usize, M: MotionModel<N>>(
     model: &M,
     posterior: &Gaussian<N>,
     mixed: &PositionEstimate,
     context: &PredictContext,
-) -> Gaussian<N> {
-    let mut start = *posterior;
+    prior: &mut Gaussian<N>,
+) {
+    *prior = *posterior;
     // With nothing to mix (a single mode, or all weight on itself) the write-back is the
     // identity; skipping it keeps single-mode filtering bit-identical to a plain filter.
-    if start.position() != *mixed {
-        replace_position(&mut start, mixed);
+    if prior.position() != *mixed {
+        replace_position(prior, mixed);
     }
-    model.predict(&start, context)
+    model.predict_in_place(prior, context);
 }
 
 impl Imm {
@@ -220,8 +247,10 @@ impl Imm {
     /// Mixing, per-mode prediction and prior fusion in one call: [`Imm::predict_physics`]
     /// followed by [`Imm::complete_prior`].
     pub fn predict(&self, models: &ModeModels, posterior: &ImmState, context: &PredictContext) -> ImmPrior {
-        let pending = self.predict_physics(models, posterior, context.dt_s);
-        self.complete_prior(models, &pending, context.displacement_m)
+        let mut prior = ImmPrior::default();
+        self.predict_physics_into(models, posterior, context.dt_s, &mut prior);
+        self.complete_prior_in_place(models, &mut prior, context.dt_s, context.displacement_m);
+        prior
     }
 
     /// First half of the prediction, which needs no learned displacement: prior mode
@@ -229,77 +258,156 @@ impl Imm {
     /// left at its mixed starting point. Lets the caller predict the physics modes while the
     /// learned predictor is still running.
     pub fn predict_physics(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64) -> PendingPrior {
+        let mut prior = ImmPrior::default();
+        self.predict_physics_into(models, posterior, dt_s, &mut prior);
+        PendingPrior { prior, dt_s }
+    }
+
+    /// [`predict_physics`](Self::predict_physics) written into `prior` in place (no copy of the
+    /// multi-mode state). `prior.available` and `prior.fused` are only meaningful after
+    /// [`complete_prior_in_place`](Self::complete_prior_in_place).
+    pub fn predict_physics_into(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64, prior: &mut ImmPrior) {
         let c = self.prior_probabilities(&posterior.probabilities);
-        let mixed = |mode: Mode| {
-            let beta = self.mixing_probabilities(&posterior.probabilities, &c, mode);
-            mix_positions(posterior, self.modes, &beta)
-        };
+        let positions = mode_positions(posterior, self.modes);
         let context = PredictContext { dt_s, displacement_m: None };
-        let mut state = *posterior;
+        let state = &mut prior.state;
         state.probabilities = c;
+        state.learned_velocity_mps = posterior.learned_velocity_mps;
         for mode in self.modes.iter() {
-            let start = mixed(mode);
+            let beta = self.mixing_probabilities(&posterior.probabilities, &c, mode);
+            let start = mix(&positions, self.modes, &beta);
             match mode {
                 Mode::Learned => {
-                    if state.learned.position() != start {
+                    state.learned = posterior.learned;
+                    if positions[mode.index()] != start {
                         replace_position(&mut state.learned, &start);
                     }
                 }
                 Mode::ConstantVelocity => {
-                    state.constant_velocity =
-                        mix_and_predict(&models.constant_velocity, &posterior.constant_velocity, &start, &context)
+                    mix_and_predict(&models.constant_velocity, &posterior.constant_velocity, &start, &context, &mut state.constant_velocity)
                 }
                 Mode::ConstantAcceleration => {
-                    state.constant_acceleration =
-                        mix_and_predict(&models.constant_acceleration, &posterior.constant_acceleration, &start, &context)
+                    mix_and_predict(
+                        &models.constant_acceleration,
+                        &posterior.constant_acceleration,
+                        &start,
+                        &context,
+                        &mut state.constant_acceleration,
+                    )
                 }
                 Mode::CoordinatedTurn => {
-                    state.coordinated_turn =
-                        mix_and_predict(&models.coordinated_turn, &posterior.coordinated_turn, &start, &context)
+                    mix_and_predict(&models.coordinated_turn, &posterior.coordinated_turn, &start, &context, &mut state.coordinated_turn)
                 }
             }
         }
-        PendingPrior { state, dt_s }
+        // Inactive modes are carried along unchanged, so that no stale values linger.
+        for mode in ModeSet::ALL.iter().filter(|mode| !self.modes.contains(*mode)) {
+            match mode {
+                Mode::Learned => state.learned = posterior.learned,
+                Mode::ConstantVelocity => state.constant_velocity = posterior.constant_velocity,
+                Mode::ConstantAcceleration => state.constant_acceleration = posterior.constant_acceleration,
+                Mode::CoordinatedTurn => state.coordinated_turn = posterior.coordinated_turn,
+            }
+        }
+        prior.available = self.modes;
     }
 
     /// Second half of the prediction: the PR prior from the learned displacement
     /// (`eq:pr_prior`, `eq:pr_cov`) and the fused prior (`eq:prior_fusion`). Without a
     /// displacement the PR mode sits the step out (see the module documentation).
     pub fn complete_prior(&self, models: &ModeModels, pending: &PendingPrior, displacement_m: Option<DVec2>) -> ImmPrior {
-        let mut state = pending.state;
+        let mut prior = pending.prior;
+        self.complete_prior_in_place(models, &mut prior, pending.dt_s, displacement_m);
+        prior
+    }
+
+    /// [`complete_prior`](Self::complete_prior) on a prior filled by
+    /// [`predict_physics_into`](Self::predict_physics_into) for the same `dt_s`.
+    pub fn complete_prior_in_place(&self, models: &ModeModels, prior: &mut ImmPrior, dt_s: f64, displacement_m: Option<DVec2>) {
+        let state = &mut prior.state;
         if self.modes.contains(Mode::Learned) {
-            let context = PredictContext { dt_s: pending.dt_s, displacement_m };
+            let context = PredictContext { dt_s, displacement_m };
             state.learned = models.learned.predict(&state.learned, &context);
             if let Some(displacement) = displacement_m {
-                state.learned_velocity_mps = displacement / pending.dt_s;
+                state.learned_velocity_mps = displacement / dt_s;
             }
         }
         let mut available = self.modes;
         if displacement_m.is_none() && self.modes.len() > 1 {
             available = available.without(Mode::Learned);
         }
-        let c = state.probabilities;
-        let fused = mix_positions(&state, available, &renormalised(&c, available));
-        ImmPrior { state, available, fused }
+        prior.available = available;
+        prior.fused = mix_positions(state, available, &renormalised(&state.probabilities, available));
     }
 
     /// Kalman update of every active mode with measurement `z`, tempered mode-probability
     /// update and floor. On a numerical failure of any mode the prior is left as it was.
     pub fn update(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2) -> Result<ImmState, UpdateError> {
-        let mut state = prior.state;
-        let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
-        for mode in self.modes.iter() {
-            log_likelihood[mode.index()] = match mode {
-                Mode::Learned => update_mode(&mut state.learned, &models.learned, z)?,
-                Mode::ConstantVelocity => update_mode(&mut state.constant_velocity, &models.constant_velocity, z)?,
-                Mode::ConstantAcceleration => {
-                    update_mode(&mut state.constant_acceleration, &models.constant_acceleration, z)?
-                }
-                Mode::CoordinatedTurn => update_mode(&mut state.coordinated_turn, &models.coordinated_turn, z)?,
-            };
-        }
-        state.probabilities = self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
+        let mut state = ImmState::default();
+        self.update_into(models, prior, z, &mut state)?;
         Ok(state)
+    }
+
+    /// [`update`](Self::update) written into `posterior` in place. On error `posterior` holds
+    /// the prior's state (the track coasts; nothing half-updated is left behind).
+    pub fn update_into(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2, posterior: &mut ImmState) -> Result<(), UpdateError> {
+        match self.update_modes(models, prior, z, posterior) {
+            Ok(log_likelihood) => {
+                posterior.probabilities =
+                    self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
+                posterior.learned_velocity_mps = prior.state.learned_velocity_mps;
+                Ok(())
+            }
+            Err(error) => {
+                *posterior = prior.state;
+                Err(error)
+            }
+        }
+    }
+
+    /// Each mode's Kalman update from `prior` into `posterior` (inactive modes are copied);
+    /// the log-likelihoods. Stops at the first failing mode.
+    fn update_modes(
+        &self,
+        models: &ModeModels,
+        prior: &ImmPrior,
+        z: DVec2,
+        posterior: &mut ImmState,
+    ) -> Result<ModeProbabilities, UpdateError> {
+        let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
+        let (from, to) = (&prior.state, posterior);
+        for mode in ModeSet::ALL.iter() {
+            let active = self.modes.contains(mode);
+            let i = mode.index();
+            match mode {
+                Mode::Learned => update_mode(&from.learned, &mut to.learned, &models.learned, z, active, &mut log_likelihood[i])?,
+                Mode::ConstantVelocity => update_mode(
+                    &from.constant_velocity,
+                    &mut to.constant_velocity,
+                    &models.constant_velocity,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+                Mode::ConstantAcceleration => update_mode(
+                    &from.constant_acceleration,
+                    &mut to.constant_acceleration,
+                    &models.constant_acceleration,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+                Mode::CoordinatedTurn => update_mode(
+                    &from.coordinated_turn,
+                    &mut to.coordinated_turn,
+                    &models.coordinated_turn,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+            }
+        }
+        Ok(log_likelihood)
     }
 
     /// `μ_i ∝ Λ_i^τ c_i` over the available modes (`eq:mode_update`), in log space; a mode that
@@ -311,21 +419,24 @@ impl Imm {
         log_likelihood: &ModeProbabilities,
     ) -> ModeProbabilities {
         let weights = renormalised(prior, available);
-        let mut log_weight = [f64::NEG_INFINITY; MODE_COUNT];
+        // μ_i ∝ exp(τ ℓ_i − max_j τ ℓ_j) · c_i: the shift by the largest tempered
+        // log-likelihood keeps the exponentials in range, and the mode attaining it keeps a
+        // positive weight, so the sum cannot vanish.
         let mut largest = f64::NEG_INFINITY;
         for mode in available.iter() {
             let i = mode.index();
             if weights[i] > 0.0 {
-                log_weight[i] = self.temperature * log_likelihood[i] + weights[i].ln();
-                largest = largest.max(log_weight[i]);
+                largest = largest.max(self.temperature * log_likelihood[i]);
             }
         }
         let mut mu = [0.0; MODE_COUNT];
         let mut sum = 0.0;
         for mode in available.iter() {
             let i = mode.index();
-            mu[i] = (log_weight[i] - largest).exp();
-            sum += mu[i];
+            if weights[i] > 0.0 {
+                mu[i] = (self.temperature * log_likelihood[i] - largest).exp() * weights[i];
+                sum += mu[i];
+            }
         }
         let sitting_out: f64 = self.modes.iter().filter(|m| !available.contains(*m)).map(|m| prior[m.index()]).sum();
         for mode in self.modes.iter() {
@@ -356,7 +467,7 @@ impl Imm {
     /// Raises every active mode's probability to at least the floor and renormalises, keeping
     /// the floored modes at exactly the floor.
     pub fn apply_floor(&self, mut mu: ModeProbabilities) -> ModeProbabilities {
-        if self.floor <= 0.0 {
+        if self.floor <= 0.0 || self.modes.iter().all(|mode| mu[mode.index()] >= self.floor) {
             return mu;
         }
         let mut floored = ModeSet::EMPTY;

@@ -9,7 +9,7 @@
 use crate::association::assignment::AssignmentError;
 use crate::association::associator::Associator;
 use crate::config::{Config, ConfigError};
-use crate::imm::{Imm, ImmPrior, PendingPrior};
+use crate::imm::{Imm, ImmPrior};
 use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::motion::ModeModels;
 use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
@@ -104,8 +104,10 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
     displacements: Box<[Option<DVec2>; MAX_TRACKS]>,
-    pending: Box<ArrayVec<PendingPrior, MAX_TRACKS>>,
-    priors: Box<ArrayVec<ImmPrior, MAX_TRACKS>>,
+    /// Each track's prior of the current frame (the first `table.len()` entries).
+    priors: Box<[ImmPrior]>,
+    /// Interval of the current frame, s.
+    dt_s: f64,
     track_to_measurement: Box<[Option<u16>; MAX_TRACKS]>,
     rows: Box<[RowRecord; MAX_TRACKS]>,
     fates: Box<[MeasurementFate; MAX_MEASUREMENTS_PER_FRAME]>,
@@ -135,8 +137,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             stats: TrackerStats::default(),
             requests: Box::new(ArrayVec::new()),
             displacements: Box::new([None; MAX_TRACKS]),
-            pending: Box::new(ArrayVec::new()),
-            priors: Box::new(ArrayVec::new()),
+            priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
+            dt_s: 0.0,
             track_to_measurement: Box::new([None; MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
@@ -246,10 +248,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Mixing and the CV, CA and CT predictions, while the predictor works.
     fn predict_physics(&mut self, dt_s: f64) {
-        self.pending.clear();
-        for track in self.table.tracks() {
+        self.dt_s = dt_s;
+        for (track, prior) in self.table.tracks().iter().zip(self.priors.iter_mut()) {
             let models = &self.models[track.class.index()];
-            self.pending.push(self.imm.predict_physics(models, &track.estimate, dt_s));
+            self.imm.predict_physics_into(models, &track.estimate, dt_s, prior);
         }
     }
 
@@ -265,10 +267,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.stats.learned_predictions_missing += missing;
             self.stats.frames_with_learned_predictions_missing += u64::from(missing > 0);
         }
-        self.priors.clear();
-        for (i, track) in self.table.tracks().iter().enumerate() {
+        for (i, (track, prior)) in self.table.tracks().iter().zip(self.priors.iter_mut()).enumerate() {
             let models = &self.models[track.class.index()];
-            self.priors.push(self.imm.complete_prior(models, &self.pending[i], displacements[i]));
+            self.imm.complete_prior_in_place(models, prior, self.dt_s, displacements[i]);
         }
     }
 
@@ -276,7 +277,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     fn associate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<(), StepError> {
         self.associator.associate(
             self.table.tracks(),
-            &self.priors,
+            &self.priors[..self.table.len()],
             frame,
             &self.accepted[..frame.len()],
             &self.config,
@@ -291,11 +292,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
         for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
             let Some(index) = self.track_to_measurement[i] else { continue };
             let index = usize::from(index);
-            let Ok(measurement) = frame.measurement(index) else { continue };
+            let Ok(measurement) = frame.measurement(index) else {
+                // Cannot happen for an accepted measurement; coast rather than keep a stale state.
+                self.track_to_measurement[i] = None;
+                continue;
+            };
             let models = &self.models[track.class.index()];
-            match self.imm.update(models, &self.priors[i], measurement.position()) {
-                Ok(posterior) => {
-                    track.estimate = posterior;
+            match self.imm.update_into(models, &self.priors[i], measurement.position(), &mut track.estimate) {
+                Ok(()) => {
                     let was_confirmed = track.status == TrackStatus::Confirmed;
                     track.record_hit(&measurement, t, confirmation_hits);
                     self.stats.tracks_confirmed += u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);

@@ -190,3 +190,50 @@ fn initial_velocity_lies_along_the_line_of_sight_with_the_measured_radial_speed(
     assert!(((along.transpose() * velocity_covariance * along)[(0, 0)] - config.classes.car.radial_velocity_std_mps.powi(2)).abs() < 1e-12);
     assert!(((across.transpose() * velocity_covariance * across)[(0, 0)] - config.classes.car.initial_tangential_speed_std_mps.powi(2)).abs() < 1e-9);
 }
+
+/// A random symmetric positive definite matrix.
+fn spd<const N: usize>(rng: &mut rand_chacha::ChaCha8Rng) -> SMatrix<f64, N, N> {
+    use rand::Rng;
+    let a = SMatrix::<f64, N, N>::from_fn(|_, _| rng.random_range(-1.0..1.0));
+    a * a.transpose() + SMatrix::<f64, N, N>::identity() * 0.1
+}
+
+#[test]
+fn linear_predictions_equal_the_dense_textbook_products() {
+    use primm::motion::ConstantAcceleration;
+    let mut rng = common::rng(77);
+    let config = common::config();
+    let models = ModeModels::from_config(&config.classes.car);
+    for dt in [0.0, 0.015, 0.07, 0.4] {
+        let context = PredictContext { dt_s: dt, displacement_m: None };
+        let cv = Gaussian::new(Vector4::new(1.0, -2.0, 3.0, 0.5), spd::<4>(&mut rng));
+        let f = ConstantVelocity::transition(dt);
+        let expected = f * cv.covariance * f.transpose() + models.constant_velocity.process_noise(dt);
+        let predicted = models.constant_velocity.predict(&cv, &context);
+        assert!((predicted.covariance - expected).abs().max() < 1e-12, "CV dt {dt}");
+        assert!((predicted.mean - f * cv.mean).abs().max() < 1e-12, "CV dt {dt}");
+
+        let ca = Gaussian::new(SMatrix::<f64, 6, 1>::new(1.0, -2.0, 3.0, 0.5, -0.2, 0.1), spd::<6>(&mut rng));
+        let f = ConstantAcceleration::transition(dt);
+        let expected = f * ca.covariance * f.transpose() + models.constant_acceleration.process_noise(dt);
+        let predicted = models.constant_acceleration.predict(&ca, &context);
+        assert!((predicted.covariance - expected).abs().max() < 1e-12, "CA dt {dt}");
+        assert!((predicted.mean - f * ca.mean).abs().max() < 1e-12, "CA dt {dt}");
+    }
+}
+
+#[test]
+fn coordinated_turn_prediction_equals_the_dense_jacobian_product() {
+    let mut rng = common::rng(78);
+    let config = common::config();
+    let models = ModeModels::from_config(&config.classes.car);
+    for (omega, dt) in [(0.0, 0.05), (1e-5, 0.05), (0.4, 0.015), (-1.2, 0.3)] {
+        let posterior = Gaussian::new(Vector5::new(1.0, -2.0, 8.0, 1.5, omega), spd::<5>(&mut rng));
+        let context = PredictContext { dt_s: dt, displacement_m: None };
+        let j = CoordinatedTurn::jacobian(&posterior.mean, dt);
+        let expected = j * posterior.covariance * j.transpose() + models.coordinated_turn.process_noise(dt);
+        let predicted = models.coordinated_turn.predict(&posterior, &context);
+        assert!((predicted.covariance - expected).abs().max() < 1e-12, "omega {omega} dt {dt}");
+        assert_eq!(predicted.mean, CoordinatedTurn::transition(&posterior.mean, dt));
+    }
+}

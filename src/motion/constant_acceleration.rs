@@ -89,10 +89,20 @@ impl MotionModel<6> for ConstantAcceleration {
     }
 
     fn predict(&self, posterior: &Gaussian<6>, context: &PredictContext) -> Gaussian<6> {
-        let f = Self::transition(context.dt_s);
-        let mut covariance = f * posterior.covariance * f.transpose() + self.process_noise(context.dt_s);
-        crate::gaussian::symmetrize(&mut covariance);
-        Gaussian::new(f * posterior.mean, covariance)
+        let mut prior = *posterior;
+        self.predict_in_place(&mut prior, context);
+        prior
+    }
+
+    fn predict_in_place(&self, estimate: &mut Gaussian<6>, context: &PredictContext) {
+        let dt = context.dt_s;
+        let half_dt2 = 0.5 * dt * dt;
+        // F = transition(dt), applied through its six off-diagonal terms.
+        let [[x, vx, ax], [y, vy, ay]] = AXES;
+        let terms = [(x, vx, dt), (x, ax, half_dt2), (vx, ax, dt), (y, vy, dt), (y, ay, half_dt2), (vy, ay, dt)];
+        super::propagate_linear_in_place(estimate, &terms);
+        estimate.covariance += self.process_noise(dt);
+        crate::gaussian::symmetrize(&mut estimate.covariance);
     }
 
     fn measurement_noise(&self) -> Matrix2<f64> {

@@ -63,10 +63,17 @@ impl MotionModel<4> for ConstantVelocity {
     }
 
     fn predict(&self, posterior: &Gaussian<4>, context: &PredictContext) -> Gaussian<4> {
-        let f = Self::transition(context.dt_s);
-        let mut covariance = f * posterior.covariance * f.transpose() + self.process_noise(context.dt_s);
-        crate::gaussian::symmetrize(&mut covariance);
-        Gaussian::new(f * posterior.mean, covariance)
+        let mut prior = *posterior;
+        self.predict_in_place(&mut prior, context);
+        prior
+    }
+
+    fn predict_in_place(&self, estimate: &mut Gaussian<4>, context: &PredictContext) {
+        let dt = context.dt_s;
+        // F = transition(dt), applied through its two off-diagonal terms.
+        super::propagate_linear_in_place(estimate, &[(index::X, index::VX, dt), (index::Y, index::VY, dt)]);
+        estimate.covariance += self.process_noise(dt);
+        crate::gaussian::symmetrize(&mut estimate.covariance);
     }
 
     fn measurement_noise(&self) -> Matrix2<f64> {

@@ -74,11 +74,79 @@ pub fn turn_functions_series(phi: f64) -> (f64, f64, f64, f64) {
 /// Closed forms of [`turn_functions`]; undefined at `φ = 0`.
 pub fn turn_functions_closed_form(phi: f64) -> (f64, f64, f64, f64) {
     let (sin, cos) = phi.sin_cos();
+    closed_form_from(phi, sin, cos)
+}
+
+/// The closed forms from `sin φ` and `cos φ` already at hand.
+fn closed_form_from(phi: f64, sin: f64, cos: f64) -> (f64, f64, f64, f64) {
     let s = sin / phi;
     let g = (1.0 - cos) / phi;
     let ds = (phi * cos - sin) / (phi * phi);
     let dg = (phi * sin - (1.0 - cos)) / (phi * phi);
     (s, g, ds, dg)
+}
+
+/// The trigonometric terms of one step, `φ = ωΔt`: `sin φ`, `cos φ`, `s(φ)`, `g(φ)` and
+/// their derivatives, computed once per prediction.
+#[derive(Debug, Clone, Copy)]
+struct TurnTerms {
+    sin: f64,
+    cos: f64,
+    s: f64,
+    g: f64,
+    ds: f64,
+    dg: f64,
+}
+
+impl TurnTerms {
+    fn new(state: &Vector5, dt: f64) -> Self {
+        let phi = state[index::OMEGA] * dt;
+        let (sin, cos) = phi.sin_cos();
+        let (s, g, ds, dg) =
+            if phi.abs() < TAYLOR_THRESHOLD { turn_functions_series(phi) } else { closed_form_from(phi, sin, cos) };
+        Self { sin, cos, s, g, ds, dg }
+    }
+
+    fn transition(&self, state: &Vector5, dt: f64) -> Vector5 {
+        let (vx, vy) = (state[index::VX], state[index::VY]);
+        let Self { sin, cos, s, g, .. } = *self;
+        Vector5::new(
+            state[index::X] + dt * (s * vx - g * vy),
+            state[index::Y] + dt * (g * vx + s * vy),
+            cos * vx - sin * vy,
+            sin * vx + cos * vy,
+            state[index::OMEGA],
+        )
+    }
+
+    /// The Jacobian's entries off the identity as `(row, column, J[row, column] − δ)`: rows x,
+    /// y, vx, vy against columns vx, vy, ω.
+    fn jacobian_off_identity(&self, state: &Vector5, dt: f64) -> [(usize, usize, f64); 12] {
+        let (vx, vy) = (state[index::VX], state[index::VY]);
+        let Self { sin, cos, s, g, ds, dg } = *self;
+        [
+            (index::X, index::VX, dt * s),
+            (index::X, index::VY, -dt * g),
+            (index::X, index::OMEGA, dt * dt * (ds * vx - dg * vy)),
+            (index::Y, index::VX, dt * g),
+            (index::Y, index::VY, dt * s),
+            (index::Y, index::OMEGA, dt * dt * (dg * vx + ds * vy)),
+            (index::VX, index::VX, cos - 1.0),
+            (index::VX, index::VY, -sin),
+            (index::VX, index::OMEGA, dt * (-sin * vx - cos * vy)),
+            (index::VY, index::VX, sin),
+            (index::VY, index::VY, cos - 1.0),
+            (index::VY, index::OMEGA, dt * (cos * vx - sin * vy)),
+        ]
+    }
+
+    fn jacobian(&self, state: &Vector5, dt: f64) -> Matrix5 {
+        let mut j = Matrix5::identity();
+        for (row, column, value) in self.jacobian_off_identity(state, dt) {
+            j[(row, column)] += value;
+        }
+        j
+    }
 }
 
 impl CoordinatedTurn {
@@ -101,39 +169,12 @@ impl CoordinatedTurn {
 
     /// The transition `f(x, Δt)`.
     pub fn transition(state: &Vector5, dt: f64) -> Vector5 {
-        let (vx, vy, omega) = (state[index::VX], state[index::VY], state[index::OMEGA]);
-        let phi = omega * dt;
-        let (s, g, _, _) = turn_functions(phi);
-        let (sin, cos) = phi.sin_cos();
-        Vector5::new(
-            state[index::X] + dt * (s * vx - g * vy),
-            state[index::Y] + dt * (g * vx + s * vy),
-            cos * vx - sin * vy,
-            sin * vx + cos * vy,
-            omega,
-        )
+        TurnTerms::new(state, dt).transition(state, dt)
     }
 
     /// The Jacobian `∂f/∂x` at `state`.
     pub fn jacobian(state: &Vector5, dt: f64) -> Matrix5 {
-        let (vx, vy, omega) = (state[index::VX], state[index::VY], state[index::OMEGA]);
-        let phi = omega * dt;
-        let (s, g, ds, dg) = turn_functions(phi);
-        let (sin, cos) = phi.sin_cos();
-        let mut j = Matrix5::identity();
-        j[(index::X, index::VX)] = dt * s;
-        j[(index::X, index::VY)] = -dt * g;
-        j[(index::X, index::OMEGA)] = dt * dt * (ds * vx - dg * vy);
-        j[(index::Y, index::VX)] = dt * g;
-        j[(index::Y, index::VY)] = dt * s;
-        j[(index::Y, index::OMEGA)] = dt * dt * (dg * vx + ds * vy);
-        j[(index::VX, index::VX)] = cos;
-        j[(index::VX, index::VY)] = -sin;
-        j[(index::VX, index::OMEGA)] = dt * (-sin * vx - cos * vy);
-        j[(index::VY, index::VX)] = sin;
-        j[(index::VY, index::VY)] = cos;
-        j[(index::VY, index::OMEGA)] = dt * (cos * vx - sin * vy);
-        j
+        TurnTerms::new(state, dt).jacobian(state, dt)
     }
 
     /// The process noise `Q(Δt)`.
@@ -161,10 +202,16 @@ impl MotionModel<5> for CoordinatedTurn {
 
     fn predict(&self, posterior: &Gaussian<5>, context: &PredictContext) -> Gaussian<5> {
         let dt = context.dt_s;
-        let f = Self::jacobian(&posterior.mean, dt);
-        let mut covariance = f * posterior.covariance * f.transpose() + self.process_noise(dt);
-        crate::gaussian::symmetrize(&mut covariance);
-        Gaussian::new(Self::transition(&posterior.mean, dt), covariance)
+        // One evaluation of sin/cos serves both the mean and the Jacobian.
+        let terms = TurnTerms::new(&posterior.mean, dt);
+        // J P Jᵀ through J's twelve entries off the identity (rows x, y, vx, vy; columns vx,
+        // vy, ω; see `jacobian`); the mean goes through the nonlinear transition.
+        let off_identity = terms.jacobian_off_identity(&posterior.mean, dt);
+        let mut prior = super::propagate_linear(posterior, &off_identity);
+        prior.mean = terms.transition(&posterior.mean, dt);
+        prior.covariance += self.process_noise(dt);
+        crate::gaussian::symmetrize(&mut prior.covariance);
+        prior
     }
 
     fn measurement_noise(&self) -> Matrix2<f64> {

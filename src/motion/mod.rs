@@ -47,6 +47,11 @@ pub trait MotionModel<const N: usize> {
     fn initiate(&self, measurement: &Measurement) -> Gaussian<N>;
     /// The prior after `context.dt_s` (`eq:kf_state_pred`, `eq:kf_cov_pred`).
     fn predict(&self, posterior: &Gaussian<N>, context: &PredictContext) -> Gaussian<N>;
+    /// [`predict`](Self::predict) in place: turns a posterior into the prior. Linear models
+    /// override it to avoid temporary copies of the state.
+    fn predict_in_place(&self, estimate: &mut Gaussian<N>, context: &PredictContext) {
+        *estimate = self.predict(estimate, context);
+    }
     /// The measurement noise covariance `R` of this mode, m².
     fn measurement_noise(&self) -> Matrix2<f64>;
 }
@@ -146,6 +151,51 @@ pub(crate) fn initiate_position_velocity<const N: usize>(
 }
 
 /// Continuous white-noise acceleration covariance of one axis' `[position, velocity]`, per unit PSD.
+/// `F x` and `F P Fᵀ` for a transition `F = I + Σ c·e_target·e_sourceᵀ` given as its
+/// off-diagonal terms `(target, source, c)`, in `O(N·terms)` instead of the `O(N³)` of two
+/// dense products (CV has 2 such terms, CA 6, CT's Jacobian 12). Every term reads the
+/// unpropagated values.
+pub fn propagate_linear<const N: usize>(gaussian: &Gaussian<N>, terms: &[(usize, usize, f64)]) -> Gaussian<N> {
+    let (mean, p) = (&gaussian.mean, &gaussian.covariance);
+    let mut new_mean = *mean;
+    let mut fp = *p;
+    for &(target, source, c) in terms {
+        new_mean[target] += c * mean[source];
+        for column in 0..N {
+            fp[(target, column)] += c * p[(source, column)];
+        }
+    }
+    let mut covariance = fp;
+    for &(target, source, c) in terms {
+        for row in 0..N {
+            covariance[(row, target)] += c * fp[(row, source)];
+        }
+    }
+    Gaussian::new(new_mean, covariance)
+}
+
+/// [`propagate_linear`] in place, for terms in which no source is the target of an earlier
+/// term (then every term still reads unpropagated values; true for CV and CA in their natural
+/// order: position from velocity and acceleration first, then velocity from acceleration).
+pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, terms: &[(usize, usize, f64)]) {
+    debug_assert!(
+        terms.iter().enumerate().all(|(i, &(_, source, _))| terms[..i].iter().all(|&(target, _, _)| target != source)),
+        "a term reads a value an earlier term changed"
+    );
+    let (mean, p) = (&mut gaussian.mean, &mut gaussian.covariance);
+    for &(target, source, c) in terms {
+        mean[target] += c * mean[source];
+        for column in 0..N {
+            p[(target, column)] += c * p[(source, column)];
+        }
+    }
+    for &(target, source, c) in terms {
+        for row in 0..N {
+            p[(row, target)] += c * p[(row, source)];
+        }
+    }
+}
+
 pub(crate) fn white_acceleration_block(dt: f64) -> [[f64; 2]; 2] {
     let dt2 = dt * dt;
     [[dt2 * dt / 3.0, dt2 / 2.0], [dt2 / 2.0, dt]]

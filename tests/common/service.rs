@@ -105,6 +105,21 @@ impl TestClient {
         self.notifier.notify().unwrap();
     }
 
+    /// [`next_answer`](Self::next_answer) spinning on the subscriber instead of sleeping on
+    /// the event service (for busy-poll latency measurements).
+    pub fn next_answer_spinning<R>(&self, timeout: Duration, read: impl FnOnce(&TrackFrame) -> R) -> Option<R> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(sample) = self.answers.receive().unwrap() {
+                return Some(read(&sample));
+            }
+            if Instant::now() >= deadline {
+                return None;
+            }
+            std::hint::spin_loop();
+        }
+    }
+
     /// The next track frame, waiting up to `timeout`; calls `read` on it.
     pub fn next_answer<R>(&self, timeout: Duration, read: impl FnOnce(&TrackFrame) -> R) -> Option<R> {
         let deadline = Instant::now() + timeout;

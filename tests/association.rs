@@ -1,0 +1,179 @@
+//! The sparse, cluster-by-cluster association finds the same optimum as one dense solve per
+//! class.
+
+use glam::DVec2;
+use primm::association::assignment::AssignmentSolver;
+use primm::association::associator::Associator;
+use primm::association::cost::association_cost;
+use primm::config::Config;
+use primm::imm::{Imm, ImmPrior};
+use primm::measurement::{Frame, Measurement, ObjectClass};
+use primm::motion::{ModeModels, PredictContext};
+use primm::track::Track;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+struct Scene {
+    tracks: Vec<Track>,
+    priors: Vec<ImmPrior>,
+    frame: Frame,
+    accepted: Vec<bool>,
+}
+
+fn measurement(rng: &mut ChaCha8Rng, centre: DVec2, spread: f64, class: ObjectClass) -> Measurement {
+    Measurement {
+        x_m: centre.x + rng.random_range(-spread..spread),
+        y_m: centre.y + rng.random_range(-spread..spread),
+        radial_velocity_mps: rng.random_range(-15.0..15.0),
+        rcs_dbsm: 0.0,
+        class,
+        sensor_id: None,
+        ground_truth_id: None,
+    }
+}
+
+/// Tracks and measurements in a few crowded spots, so that clusters of several tracks and
+/// measurements form, plus scattered ones; some measurements are marked as rejected.
+fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
+    let imm = Imm::new(&config.imm);
+    let spots: Vec<DVec2> = (0..rng.random_range(1..6))
+        .map(|_| DVec2::new(rng.random_range(-60.0..60.0), rng.random_range(-60.0..60.0)))
+        .collect();
+    let spread = rng.random_range(1.0..12.0);
+    let class_of = |i: usize| if i % 3 == 0 { ObjectClass::Pedestrian } else { ObjectClass::Car };
+    let (track_count, measurement_count) = (rng.random_range(0..40), rng.random_range(0..40));
+    let mut tracks = Vec::new();
+    let mut priors = Vec::new();
+    for i in 0..track_count {
+        let class = class_of(i);
+        let first = measurement(rng, spots[i % spots.len()], spread, class);
+        let models = ModeModels::from_config(config.classes.get(class));
+        let state = imm.initiate(&models, &first);
+        let mut prior = imm.predict(&models, &state, &PredictContext { dt_s: 0.05, displacement_m: None });
+        prior.fused.mean = measurement(rng, spots[i % spots.len()], spread, class).position();
+        tracks.push(Track::new(i as u64, &first, 0.0, state));
+        priors.push(prior);
+    }
+    let mut frame = Frame::new(0.05);
+    let mut accepted = Vec::new();
+    for j in 0..measurement_count {
+        frame.measurements.push(measurement(rng, spots[(j * 7) % spots.len()], spread, class_of(j + 1)));
+        accepted.push(rng.random_bool(0.9));
+    }
+    Scene { tracks, priors, frame, accepted }
+}
+
+/// Number of pairs and total cost of an assignment.
+fn score(scene: &Scene, config: &Config, track_to_measurement: &[Option<u16>], class: ObjectClass) -> (usize, f64) {
+    let mut pairs = 0;
+    let mut total = 0.0;
+    for (i, assigned) in track_to_measurement.iter().enumerate() {
+        let Some(j) = assigned else { continue };
+        let track = &scene.tracks[i];
+        if track.class != class {
+            continue;
+        }
+        let measurement = scene.frame.measurements[usize::from(*j)];
+        assert_eq!(measurement.class, track.class, "a track got a measurement of another class");
+        assert!(scene.accepted[usize::from(*j)], "a rejected measurement was assigned");
+        let cost = association_cost(scene.priors[i].fused.mean, track.last_radial_velocity_mps, &measurement, &config.association);
+        assert!(cost <= config.classes.get(class).gate_m, "an assigned pair lies outside the gate");
+        pairs += 1;
+        total += cost;
+    }
+    (pairs, total)
+}
+
+/// The reference: one dense gated matrix per class, solved at once.
+fn dense_optimum(scene: &Scene, config: &Config, class: ObjectClass) -> (usize, f64) {
+    let rows: Vec<usize> = (0..scene.tracks.len()).filter(|&i| scene.tracks[i].class == class).collect();
+    let columns: Vec<usize> =
+        (0..scene.frame.measurements.len()).filter(|&j| scene.accepted[j] && scene.frame.measurements[j].class == class).collect();
+    if rows.is_empty() || columns.is_empty() {
+        return (0, 0.0);
+    }
+    let gate = config.classes.get(class).gate_m;
+    let mut costs = vec![f64::INFINITY; rows.len() * columns.len()];
+    for (r, &i) in rows.iter().enumerate() {
+        for (c, &j) in columns.iter().enumerate() {
+            let cost = association_cost(
+                scene.priors[i].fused.mean,
+                scene.tracks[i].last_radial_velocity_mps,
+                &scene.frame.measurements[j],
+                &config.association,
+            );
+            if cost <= gate {
+                costs[r * columns.len() + c] = cost;
+            }
+        }
+    }
+    let mut solver = AssignmentSolver::with_capacity(rows.len(), columns.len());
+    let mut row_to_column = vec![None; rows.len()];
+    let summary = solver.solve(rows.len(), columns.len(), &costs, &mut row_to_column).unwrap();
+    (summary.pairs, summary.total_cost)
+}
+
+#[test]
+fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
+    let config = Config::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(2024);
+    let mut associator = Associator::new();
+    let mut solved_clusters = 0;
+    for _ in 0..400 {
+        let scene = scene(&mut rng, &config);
+        let mut track_to_measurement = vec![Some(u16::MAX); scene.tracks.len()];
+        associator
+            .associate(&scene.tracks, &scene.priors, &scene.frame, &scene.accepted, &config, &mut track_to_measurement)
+            .unwrap();
+        let mut used = vec![false; scene.frame.measurements.len()];
+        for j in track_to_measurement.iter().flatten() {
+            assert!(!std::mem::replace(&mut used[usize::from(*j)], true), "a measurement was assigned twice");
+        }
+        for class in ObjectClass::ALL {
+            let (pairs, total) = score(&scene, &config, &track_to_measurement, class);
+            let (reference_pairs, reference_total) = dense_optimum(&scene, &config, class);
+            assert_eq!(pairs, reference_pairs, "{class:?}: number of pairs differs from the dense optimum");
+            assert!(
+                (total - reference_total).abs() <= 1e-9 * reference_total.max(1.0),
+                "{class:?}: total cost {total} differs from the dense optimum {reference_total}"
+            );
+        }
+        solved_clusters += associator.stats().solved_clusters;
+    }
+    // The scenes must exercise the solver path, not only lone pairs.
+    assert!(solved_clusters > 100, "only {solved_clusters} clusters needed the solver");
+}
+
+#[test]
+fn tracks_far_apart_are_paired_without_the_solver() {
+    let config = Config::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let imm = Imm::new(&config.imm);
+    let models = ModeModels::from_config(&config.classes.car);
+    let mut tracks = Vec::new();
+    let mut priors = Vec::new();
+    let mut frame = Frame::new(0.05);
+    for i in 0..50 {
+        let position = DVec2::new(-500.0 + 20.0 * i as f64, 3.0);
+        let mut first = measurement(&mut rng, position, 0.1, ObjectClass::Car);
+        first.radial_velocity_mps = 1.0;
+        let state = imm.initiate(&models, &first);
+        let mut prior = imm.predict(&models, &state, &PredictContext { dt_s: 0.05, displacement_m: None });
+        prior.fused.mean = position;
+        tracks.push(Track::new(i, &first, 0.0, state));
+        priors.push(prior);
+        frame.measurements.push(Measurement { radial_velocity_mps: 1.0, ..measurement(&mut rng, position, 0.5, ObjectClass::Car) });
+    }
+    // Reverse the measurement order so that index order does not line up with track order.
+    frame.measurements.reverse();
+    let accepted = vec![true; 50];
+    let mut associator = Associator::new();
+    let mut track_to_measurement = vec![None; 50];
+    associator.associate(&tracks, &priors, &frame, &accepted, &config, &mut track_to_measurement).unwrap();
+    for (i, assigned) in track_to_measurement.iter().enumerate() {
+        assert_eq!(*assigned, Some(49 - i as u16), "track {i}");
+    }
+    assert_eq!(associator.stats().single_pairs, 50);
+    assert_eq!(associator.stats().solved_clusters, 0);
+    assert_eq!(associator.stats().allowed_pairs, 50);
+}
