@@ -480,6 +480,6 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             s.tracks_deleted,
             c.publish_failures,
             self.histograms.table()
-        )
+        ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
     }
 }
