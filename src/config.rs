@@ -27,6 +27,36 @@ pub struct Config {
     pub tracker: TrackerConfig,
     /// Per-class parameters.
     pub classes: ClassTable,
+    /// How the service runs the learned predictor (absent: the defaults).
+    #[serde(default)]
+    pub predictor: PredictorConfig,
+}
+
+/// Runtime of the learned predictor in the tracking service (`primm serve`): the model runs on
+/// a dedicated inference thread while the tracker predicts the physics modes, and the tracker
+/// waits for its batch at most this long. Offline tracking (`primm track`, `primm eval`) runs
+/// the model synchronously and ignores the deadline, so that its results do not depend on
+/// timing.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PredictorConfig {
+    /// Longest wait for a frame's learned displacements, measured from the moment the batch is
+    /// handed to the inference thread, ms. A frame whose batch is late is tracked without the
+    /// PR mode (it sits the frame out; see `src/imm.rs`).
+    pub deadline_ms: f64,
+}
+
+impl Default for PredictorConfig {
+    fn default() -> Self {
+        Self { deadline_ms: 5.0 }
+    }
+}
+
+impl PredictorConfig {
+    /// The deadline as a duration.
+    pub fn deadline(&self) -> std::time::Duration {
+        std::time::Duration::from_secs_f64(self.deadline_ms / 1000.0)
+    }
 }
 
 /// IMM settings (paper, Sections III-D and III-F).
@@ -286,6 +316,10 @@ impl Config {
         }
         let tracker = &self.tracker;
         positive("tracker.max_frame_interval_s", tracker.max_frame_interval_s)?;
+        positive("predictor.deadline_ms", self.predictor.deadline_ms)?;
+        if self.predictor.deadline_ms > 1000.0 {
+            return Err(invalid("predictor.deadline_ms", "must be at most 1000 ms (one second)"));
+        }
         positive("tracker.max_coast_s", tracker.max_coast_s)?;
         positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
         if tracker.confirmation_hits == 0 {
@@ -382,5 +416,19 @@ mod tests {
     fn an_empty_mode_set_is_rejected() {
         let text = DEFAULT_CONFIG_TOML.replace(r#"modes = ["pr", "cv", "ca", "ct"]"#, "modes = []");
         assert_eq!(invalid_key(&text), "imm.modes");
+    }
+
+    #[test]
+    fn a_non_positive_or_huge_predictor_deadline_is_rejected_and_a_missing_section_takes_the_default() {
+        for bad in ["0.0", "-1.0", "nan", "5000.0"] {
+            let text = DEFAULT_CONFIG_TOML.replace("deadline_ms = 5.0", &format!("deadline_ms = {bad}"));
+            assert_eq!(invalid_key(&text), "predictor.deadline_ms", "deadline {bad}");
+        }
+        let start = DEFAULT_CONFIG_TOML.find("[predictor]").unwrap();
+        let end = DEFAULT_CONFIG_TOML.find("[classes.car]").unwrap();
+        let without = format!("{}{}", &DEFAULT_CONFIG_TOML[..start], &DEFAULT_CONFIG_TOML[end..]);
+        let config = Config::from_toml_str(&without).unwrap();
+        assert_eq!(config.predictor, PredictorConfig::default());
+        assert_eq!(config.predictor.deadline(), std::time::Duration::from_millis(5));
     }
 }

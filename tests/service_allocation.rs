@@ -7,6 +7,11 @@
 //! (48 bytes) per loaned sample; no public API avoids it. The bound below therefore allows at
 //! most one allocation per loaned sample (track frames and latency reports) and nothing else:
 //! a single allocation per frame anywhere else in the loop doubles the count and fails the test.
+//!
+//! With the learned predictor (PR-IMM) the PR model runs on its own inference thread; tract's
+//! allocations happen there, and the hand-over from the tracking thread allocates nothing.
+//!
+//! `cargo test --test service_allocation -- --nocapture` prints the counts.
 
 mod common;
 #[path = "common/counting_allocator.rs"]
@@ -18,6 +23,9 @@ use counting_allocator::{allocations, CountingAllocator};
 use primm::config::Config;
 use primm::measurement::Frame;
 use primm::mode::Method;
+use primm::predictor::onnx::OnnxPredictor;
+use primm::predictor::threaded::ThreadedPredictor;
+use primm::predictor::{DisplacementPredictor, NoPredictor};
 use primm::service::{ServiceNames, TrackingOptions, TrackingService, WaitMode};
 use primm::tracker::Tracker;
 use std::sync::mpsc;
@@ -29,7 +37,7 @@ static ALLOCATOR: CountingAllocator = CountingAllocator;
 const WARM_UP_FRAMES: u64 = 150;
 const COUNTED_FRAMES: u64 = 1000;
 
-fn run(wait: WaitMode) {
+fn run(wait: WaitMode, method: Method) {
     let names = ServiceNames::new(&unique_prefix("allocation"));
     let base = common::scene_frames(&common::lanes(64), 500, 0.04, 0.2, 21);
     let client = TestClient::new(&names);
@@ -37,7 +45,14 @@ fn run(wait: WaitMode) {
     let (ready_tx, ready_rx) = mpsc::channel();
     let tracker_names = names.clone();
     let tracking = std::thread::spawn(move || {
-        let tracker = Tracker::new(Config::default().with_modes(Method::Imm.modes())).unwrap();
+        // Built on the tracking thread, as `primm serve` does.
+        let predictor: Box<dyn DisplacementPredictor + Send> = if method.needs_predictor() {
+            let model = OnnxPredictor::load("models/pr.onnx").unwrap();
+            Box::new(ThreadedPredictor::new(model, Duration::from_secs(1)).unwrap())
+        } else {
+            Box::new(NoPredictor)
+        };
+        let tracker = Tracker::with_predictor(Config::default().with_modes(method.modes()), predictor).unwrap();
         let options = TrackingOptions {
             names: tracker_names,
             wait,
@@ -56,7 +71,8 @@ fn run(wait: WaitMode) {
         }
         let counted = allocations() - before;
         let loans = COUNTED_FRAMES + service.counters().latency_reports - reports_before;
-        (counted, loans, *service.counters(), service.tracker().stats().measurements_accepted)
+        let stats = service.tracker().stats();
+        (counted, loans, *service.counters(), stats.measurements_accepted, stats.learned_predictions_missing)
     });
     ready_rx.recv().unwrap();
     client.wait_for_tracker(Duration::from_secs(10));
@@ -76,7 +92,10 @@ fn run(wait: WaitMode) {
         assert_eq!(sequence, k);
         updated_tracks += updated as u64;
     }
-    let (counted, loans, counters, accepted) = tracking.join().unwrap();
+    let (counted, loans, counters, accepted, learned_missing) = tracking.join().unwrap();
+    println!(
+        "{method} {wait:?}: the tracking thread allocated {counted} times in {COUNTED_FRAMES} frames ({loans} loaned samples)"
+    );
     assert!(
         counted <= loans,
         "the tracking thread allocated {counted} times in {COUNTED_FRAMES} frames with {loans} loaned samples"
@@ -86,14 +105,22 @@ fn run(wait: WaitMode) {
     assert!(counters.latency_reports >= 10, "{counters:?}");
     assert_eq!(accepted, 64 * (WARM_UP_FRAMES + COUNTED_FRAMES));
     assert_eq!(updated_tracks, 64 * (WARM_UP_FRAMES + COUNTED_FRAMES));
+    if method.needs_predictor() {
+        assert_eq!(learned_missing, 0, "every track got its learned displacement");
+    }
 }
 
 #[test]
 fn the_event_driven_tracking_loop_allocates_nothing_beyond_the_sample_loans() {
-    run(WaitMode::Event);
+    run(WaitMode::Event, Method::Imm);
 }
 
 #[test]
 fn the_busy_polling_tracking_loop_allocates_nothing_beyond_the_sample_loans() {
-    run(WaitMode::BusyPoll);
+    run(WaitMode::BusyPoll, Method::Imm);
+}
+
+#[test]
+fn with_the_learned_predictor_the_tracking_loop_allocates_nothing_beyond_the_sample_loans() {
+    run(WaitMode::Event, Method::PrImm);
 }

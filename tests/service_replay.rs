@@ -49,3 +49,80 @@ fn every_frame_comes_back_in_order_with_the_offline_tracks() {
         assert!(stdout.contains(stage), "the final latency table lacks {stage}: {stdout}");
     }
 }
+
+/// A configuration file whose learned-predictor deadline is long enough that no frame can miss
+/// it on a loaded machine, so that the served run must equal the synchronous offline run.
+fn generous_deadline_config(prefix: &str) -> std::path::PathBuf {
+    let text = primm::config::DEFAULT_CONFIG_TOML.replace("deadline_ms = 5.0", "deadline_ms = 1000.0");
+    assert!(text.contains("deadline_ms = 1000.0"), "the default configuration names predictor.deadline_ms");
+    let path = std::env::temp_dir().join(format!("{prefix}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn with_the_learned_predictor_every_frame_comes_back_with_the_tracks_of_a_synchronous_offline_run() {
+    use primm::predictor::onnx::OnnxPredictor;
+    let prefix = unique_prefix("replay-pr");
+    let config_path = generous_deadline_config(&prefix);
+    let client = TestClient::new(&ServiceNames::new(&prefix));
+    let serve = spawn_serve(&prefix, &["--method", "pr-imm", "--config", config_path.to_str().unwrap()]);
+    client.wait_for_tracker(Duration::from_secs(60));
+
+    let frames = common::scene_frames(&common::lanes(8), 60, 0.05, 0.2, 6);
+    let predictor = OnnxPredictor::load("models/pr.onnx").unwrap();
+    let mut offline = Tracker::with_predictor(Config::default().with_modes(Method::PrImm.modes()), predictor).unwrap();
+    let mut learned_weight_seen = false;
+    for (k, frame) in frames.iter().enumerate() {
+        let sequence = k as u64;
+        client.send(frame, sequence, 0);
+        let expected: Vec<WireTrack> = {
+            let wire = wire_frame(frame, sequence);
+            offline.step(&*wire).unwrap().iter().map(WireTrack::from_output).collect()
+        };
+        let (answer_sequence, status, tracks) = client
+            .next_answer(Duration::from_secs(10), |answer| {
+                (answer.input_sequence, answer.frame_status(), answer.valid_tracks().to_vec())
+            })
+            .unwrap_or_else(|| panic!("no answer to frame {k}"));
+        assert_eq!((answer_sequence, status), (sequence, Some(FrameStatus::Tracked)));
+        assert_eq!(tracks, expected, "frame {k}: served tracks differ from the offline run");
+        // Without learned displacements the PR mode would sit every frame out at its prior weight;
+        // a PR probability that moves away from the initial value shows its likelihood took part.
+        learned_weight_seen |= tracks.iter().any(|t| (t.mode_probabilities[0] - tracks[0].mode_probabilities[0]).abs() > 1e-6);
+    }
+    assert!(learned_weight_seen || frames.len() < 2, "PR mode probabilities never moved");
+
+    serve.signal(libc::SIGINT);
+    let (status, stdout) = serve.wait(Duration::from_secs(10));
+    std::fs::remove_file(&config_path).ok();
+    assert!(status.success(), "{status}: {stdout}");
+    assert!(stdout.contains("frames: 60 received, 60 tracked, 0 rejected, 0 lost"), "{stdout}");
+    // The first frame has no tracks yet, so there is nothing to predict for it.
+    assert!(stdout.contains("learned predictor (inference thread, deadline 1000.0 ms): 59 batches, 59 on time, 0 deadline misses"), "{stdout}");
+    assert!(stdout.contains("learned_wait"), "{stdout}");
+}
+
+#[test]
+fn a_missing_model_file_stops_the_tracker_with_an_error_naming_it() {
+    let prefix = unique_prefix("missing-model");
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_primm"))
+        .args(["serve", "--service-prefix", &prefix, "--method", "pr-imm", "--model", "no/such/model.onnx"])
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("no/such/model.onnx"), "{stderr}");
+}
+
+#[test]
+fn a_model_given_for_a_physics_only_method_is_refused() {
+    let prefix = unique_prefix("model-imm");
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_primm"))
+        .args(["serve", "--service-prefix", &prefix, "--method", "imm", "--model", "models/pr.onnx"])
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("does not use the learned predictor"), "{stderr}");
+}

@@ -27,7 +27,8 @@ pub struct Args {
     /// Replay speed factor.
     #[arg(long, default_value_t = 2.0, value_name = "FACTOR")]
     pub speed: f64,
-    /// Tracking method (cv, ca, ct, imm).
+    /// Tracking method: cv, ca, ct, imm, pr, pr-imm (the last two run the PR model
+    /// `models/pr.onnx` on the tracker's inference thread).
     #[arg(long, default_value = "imm")]
     pub method: Method,
     /// Let the tracker and subscriber spin instead of sleeping.

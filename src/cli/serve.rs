@@ -1,11 +1,15 @@
 //! `primm serve`: the tracker as a shared-memory service.
 
+use crate::cli::predictor::DEFAULT_MODEL_PATH;
 use crate::config::{Config, ConfigError};
 use crate::mode::Method;
+use crate::predictor::onnx::{ModelError, OnnxPredictor};
+use crate::predictor::threaded::ThreadedPredictor;
+use crate::predictor::{DisplacementPredictor, NoPredictor};
 use crate::service::catalog::SERVICE_PREFIX_ENV;
 use crate::service::{ConnectError, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService, WaitMode};
 use crate::tracker::Tracker;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// Arguments of `primm serve`.
@@ -15,11 +19,12 @@ pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults when absent.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Learned displacement predictor (ONNX). Not supported by this build yet.
+    /// Learned displacement predictor (ONNX) for the methods pr and pr-imm; default
+    /// models/pr.onnx. It runs on a dedicated inference thread with the configuration's
+    /// `predictor.deadline_ms`.
     #[arg(long, value_name = "FILE")]
     pub model: Option<PathBuf>,
-    /// Tracking method: cv, ca, ct, imm (pr and pr-imm need --model). Overrides the
-    /// configuration's `imm.modes`.
+    /// Tracking method: cv, ca, ct, imm, pr, pr-imm. Overrides the configuration's `imm.modes`.
     #[arg(long, default_value = "imm")]
     pub method: Method,
     /// Spin on the input instead of sleeping until a publisher notifies (lowest latency, one
@@ -40,18 +45,25 @@ pub enum ServeError {
     /// The configuration could not be loaded or is invalid.
     #[error(transparent)]
     Config(#[from] ConfigError),
-    /// `--model` was given, but this build has no runtime for the learned predictor.
-    #[error("--model {path}: this build has no runtime for the learned predictor yet; use --method cv, ca, ct or imm")]
-    ModelNotSupported {
+    /// `--model` was given for a method that does not use the learned predictor.
+    #[error("--model {path}: method '{method}' does not use the learned predictor; use --method pr or pr-imm, or leave out --model")]
+    ModelWithoutPredictor {
         /// The model path given.
         path: PathBuf,
-    },
-    /// The method needs the learned predictor, which needs a model.
-    #[error("method '{method}' needs the learned predictor (--model), which this build does not support yet; use --method cv, ca, ct or imm")]
-    MethodNeedsPredictor {
         /// The method asked for.
         method: Method,
     },
+    /// The learned predictor's model could not be loaded.
+    #[error("method '{method}': {source}")]
+    Model {
+        /// The method asked for.
+        method: Method,
+        /// What went wrong with the model file.
+        source: ModelError,
+    },
+    /// The inference thread could not be started.
+    #[error("cannot start the inference thread: {0}")]
+    InferenceThread(std::io::Error),
     /// The SIGINT/SIGTERM handlers could not be installed.
     #[error("cannot install signal handlers: {0}")]
     Signals(std::io::Error),
@@ -69,13 +81,30 @@ pub fn run(args: Args) -> Result<(), ServeError> {
         Some(path) => Config::from_file(path)?,
         None => Config::default(),
     };
-    if let Some(path) = args.model {
-        return Err(ServeError::ModelNotSupported { path });
+    if let (Some(path), false) = (&args.model, args.method.needs_predictor()) {
+        return Err(ServeError::ModelWithoutPredictor { path: path.clone(), method: args.method });
     }
+    let config = config.with_modes(args.method.modes());
     if args.method.needs_predictor() {
-        return Err(ServeError::MethodNeedsPredictor { method: args.method });
+        let path = args.model.clone().unwrap_or_else(|| PathBuf::from(DEFAULT_MODEL_PATH));
+        let predictor = learned_predictor(&path, &config, args.method)?;
+        serve(Tracker::with_predictor(config, predictor)?, &args)
+    } else {
+        serve(Tracker::with_predictor(config, NoPredictor)?, &args)
     }
-    let tracker = Tracker::new(config.with_modes(args.method.modes()))?;
+}
+
+/// The PR model on its own inference thread, built on the calling (tracking) thread so that the
+/// hand-over allocates nothing from the first frame on.
+fn learned_predictor(path: &Path, config: &Config, method: Method) -> Result<ThreadedPredictor, ServeError> {
+    let model = OnnxPredictor::load(path).map_err(|source| ServeError::Model { method, source })?;
+    let deadline = config.predictor.deadline();
+    tracing::info!(model = %path.display(), deadline_ms = config.predictor.deadline_ms, "learned predictor loaded");
+    ThreadedPredictor::new(model, deadline).map_err(ServeError::InferenceThread)
+}
+
+/// Serves with `tracker` until SIGINT or SIGTERM.
+fn serve<P: DisplacementPredictor>(tracker: Tracker<P>, args: &Args) -> Result<(), ServeError> {
     let shutdown = ShutdownFlag::on_signals().map_err(ServeError::Signals)?;
     let options = TrackingOptions {
         names: ServiceNames::new(&args.service_prefix),

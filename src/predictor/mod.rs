@@ -125,6 +125,11 @@ pub trait DisplacementPredictor {
         self.submit(requests);
         self.collect(displacements);
     }
+    /// A one-line summary of the predictor's own counters (batches, deadline misses, errors),
+    /// for a service's shutdown report; `None` when it keeps none.
+    fn report(&self) -> Option<String> {
+        None
+    }
 }
 
 /// A predictor that never predicts: the PR mode sits out every frame.
@@ -144,6 +149,9 @@ impl<P: DisplacementPredictor + ?Sized> DisplacementPredictor for Box<P> {
     }
     fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
         (**self).collect(displacements)
+    }
+    fn report(&self) -> Option<String> {
+        (**self).report()
     }
 }
 

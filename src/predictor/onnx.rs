@@ -447,4 +447,18 @@ impl DisplacementPredictor for OnnxPredictor {
             *out = *result;
         }
     }
+
+    fn report(&self) -> Option<String> {
+        let s = &self.stats;
+        Some(format!(
+            "learned predictor ({}): {} batches, {} rows, {} predictions, {} invalid requests, {} non-finite outputs, {} failed batches",
+            self.model.path().display(),
+            s.batches,
+            s.rows,
+            s.predictions,
+            s.invalid_requests,
+            s.non_finite_outputs,
+            s.failed_batches
+        ))
+    }
 }

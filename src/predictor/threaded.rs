@@ -279,6 +279,22 @@ impl DisplacementPredictor for ThreadedPredictor {
             }
         }
     }
+
+    fn report(&self) -> Option<String> {
+        let s = &self.stats;
+        Some(format!(
+            "learned predictor (inference thread, deadline {:.1} ms): {} batches, {} on time, {} deadline misses, \
+             {} stale discarded, {} without a free buffer, {} too large, {} inference panics",
+            self.deadline.as_secs_f64() * 1000.0,
+            s.batches_submitted,
+            s.batches_on_time,
+            s.deadline_misses,
+            s.stale_batches_discarded,
+            s.frames_without_free_buffer,
+            s.frames_too_large,
+            s.inference_panics
+        ))
+    }
 }
 
 impl Drop for ThreadedPredictor {

@@ -3,7 +3,8 @@
 //!
 //! primm's code on this path allocates nothing per frame (`tests/service_allocation.rs` counts
 //! it). What remains: iceoryx2 0.10's `Publisher::loan_uninit` allocates one 48-byte
-//! reference-counted handle per loaned sample (no public API avoids it), and, off the normal
+//! reference-counted handle per loaned sample (every loan path of 0.10 does; see
+//! `docs/service.md`), and, off the normal
 //! path, a logged warning (bounded by [`LogLimiter`]) and the setup of a connection when a port
 //! joins.
 //!
@@ -480,6 +481,6 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             s.tracks_deleted,
             c.publish_failures,
             self.histograms.table()
-        )
+        ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
     }
 }
