@@ -28,6 +28,8 @@ enum Command {
     Track(cli::track::Args),
     /// Evaluate methods on a data set and print the paper's tables.
     Eval(cli::eval::Args),
+    /// Score association CSV files written by any tracker with the metrics of `eval`.
+    Score(cli::score::Args),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +43,7 @@ fn main() -> ExitCode {
         Command::Generate(args) => cli::generate::run(&args),
         Command::Track(args) => cli::track::run(&args),
         Command::Eval(args) => cli::eval::run(&args),
+        Command::Score(args) => cli::score::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -72,6 +72,68 @@ fn eval_prints_the_tables_and_writes_json_and_figures() {
     assert!(plots.join("trajectories.svg").exists());
 }
 
+#[test]
+fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
+    let dir = tempdir("score");
+    generate(&dir);
+    let data = dir.join("evaluation");
+    let associations = dir.join("associations");
+    std::fs::create_dir_all(&associations).unwrap();
+    let mut timed_frames = 0;
+    for file in primm::io::dataset_files(&data).unwrap() {
+        let name = file.file_name().unwrap();
+        let output = primm(&[
+            "track",
+            "--input",
+            file.to_str().unwrap(),
+            "--output",
+            dir.join("tracks.csv").to_str().unwrap(),
+            "--method",
+            "imm",
+            "--associations",
+            associations.join(name).to_str().unwrap(),
+            "--timing",
+        ]);
+        let timing: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        let sequence = primm::io::read_sequence_file(&file).unwrap();
+        assert_eq!(timing["frames"].as_u64().unwrap() as usize, sequence.frames.len());
+        assert!(timing["frames_per_second"].as_f64().unwrap() > 0.0);
+        timed_frames += sequence.frames.len();
+    }
+    assert!(timed_frames > 0);
+    let score = primm(&["score", "--data", data.to_str().unwrap(), "--associations", associations.to_str().unwrap(), "--name", "imm"]);
+    let score: serde_json::Value = serde_json::from_slice(&score.stdout).unwrap();
+    let json = dir.join("eval.json");
+    primm(&["eval", "--data", data.to_str().unwrap(), "--methods", "imm", "--json", json.to_str().unwrap()]);
+    let eval: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let eval = &eval["methods"]["imm"];
+    assert_eq!(score["idsw"], eval["idsw"]);
+    for (scored, evaluated) in [("rmse_xy_m", "rmse_xy"), ("rmse_x_m", "rmse_x"), ("rmse_y_m", "rmse_y"), ("idf1", "idf1")] {
+        let (a, b) = (score[scored].as_f64().unwrap(), eval[evaluated].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "{scored}: score {a} vs eval {b}");
+    }
+}
+
+#[test]
+fn score_refuses_an_association_file_that_names_a_missing_measurement() {
+    let dir = tempdir("score-bad");
+    generate(&dir);
+    let data = dir.join("evaluation");
+    let associations = dir.join("associations");
+    std::fs::create_dir_all(&associations).unwrap();
+    for file in primm::io::dataset_files(&data).unwrap() {
+        let text = format!("{}\n0,9999,1,,\n", primm::io::association_csv::ASSOCIATION_CSV_HEADER);
+        std::fs::write(associations.join(file.file_name().unwrap()), text).unwrap();
+    }
+    let output = Command::new(env!("CARGO_BIN_EXE_primm"))
+        .args(["score", "--data", data.to_str().unwrap(), "--associations", associations.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("no such measurement"), "{stderr}");
+}
+
 fn tempdir(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("primm-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);

@@ -6,6 +6,7 @@ pub mod eval;
 pub mod generate;
 pub mod predictor;
 pub mod publish;
+pub mod score;
 pub mod serve;
 pub mod subscribe;
 pub mod track;

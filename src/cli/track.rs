@@ -3,9 +3,9 @@
 use crate::cli::predictor::predictor_for;
 use crate::config::Config;
 use crate::io::read_sequence_file;
+use crate::io::association_csv::AssociationCsvWriter;
 use crate::io::track_csv::TrackCsvWriter;
 use crate::mode::Method;
-use crate::offline::track_sequence;
 use crate::tracker::Tracker;
 use clap::Args as ClapArgs;
 use std::path::PathBuf;
@@ -29,6 +29,14 @@ pub struct Args {
     /// ONNX model of the learned predictor.
     #[arg(long, value_name = "FILE")]
     pub model: Option<PathBuf>,
+    /// Also write the association CSV (which track took each measurement; scored by
+    /// `primm score`).
+    #[arg(long, value_name = "FILE")]
+    pub associations: Option<PathBuf>,
+    /// Time every tracker step (the CSV reading and writing excluded) and print frames per
+    /// second and step-time percentiles as one JSON line on stdout.
+    #[arg(long)]
+    pub timing: bool,
 }
 
 /// Runs `primm track`.
@@ -44,14 +52,32 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let file = std::fs::File::create(&args.output)
         .map_err(|e| format!("cannot create {}: {e}", args.output.display()))?;
     let mut writer = TrackCsvWriter::new(std::io::BufWriter::new(file))?;
-    let mut result = Ok(());
-    track_sequence(&mut tracker, &sequence, |recorded, outputs| {
-        if result.is_ok() {
-            result = writer.write_frame(recorded.index, recorded.timestamp_s, outputs);
+    let mut associations = match &args.associations {
+        Some(path) => {
+            let file = std::fs::File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+            Some(AssociationCsvWriter::new(std::io::BufWriter::new(file))?)
         }
-    })?;
-    result?;
+        None => None,
+    };
+    let frames = sequence.to_frames()?;
+    let mut step_ns: Vec<u64> = Vec::with_capacity(frames.len());
+    tracker.reset();
+    for (recorded, frame) in sequence.frames.iter().zip(&frames) {
+        let start = std::time::Instant::now();
+        let outputs = tracker.step(frame).map_err(|e| format!("frame {}: {e}", recorded.index))?;
+        step_ns.push(start.elapsed().as_nanos() as u64);
+        writer.write_frame(recorded.index, recorded.timestamp_s, outputs)?;
+        if let Some(associations) = associations.as_mut() {
+            associations.write_frame(recorded.index, recorded.measurements.len(), outputs)?;
+        }
+    }
     writer.finish()?;
+    if let Some(associations) = associations {
+        associations.finish()?;
+    }
+    if args.timing {
+        println!("{}", timing_json(args.method, &mut step_ns));
+    }
     let stats = tracker.stats();
     eprintln!(
         "{}: {} frames, {} measurements, {} tracks started, {} deleted -> {}",
@@ -63,4 +89,27 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         args.output.display()
     );
     Ok(())
+}
+
+/// Frames per second of the tracker steps alone and their percentiles, as JSON.
+fn timing_json(method: crate::mode::Method, step_ns: &mut [u64]) -> String {
+    step_ns.sort_unstable();
+    let total_ns: u64 = step_ns.iter().sum();
+    let percentile = |q: f64| -> f64 {
+        if step_ns.is_empty() {
+            return 0.0;
+        }
+        let rank = ((q * step_ns.len() as f64).ceil() as usize).clamp(1, step_ns.len());
+        step_ns[rank - 1] as f64 / 1000.0
+    };
+    serde_json::json!({
+        "tracker": format!("primm {method}"),
+        "frames": step_ns.len(),
+        "step_seconds": total_ns as f64 * 1e-9,
+        "frames_per_second": if total_ns > 0 { step_ns.len() as f64 / (total_ns as f64 * 1e-9) } else { 0.0 },
+        "step_p50_us": percentile(0.5),
+        "step_p99_us": percentile(0.99),
+        "step_max_us": percentile(1.0),
+    })
+    .to_string()
 }

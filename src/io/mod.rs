@@ -4,6 +4,7 @@
 //! reader returns; [`RecordedFrame::to_frame`] turns a recorded frame into the tracker's
 //! [`Frame`](crate::measurement::Frame).
 
+pub mod association_csv;
 pub mod measurement_csv;
 pub mod track_csv;
 mod recording;
