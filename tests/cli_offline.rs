@@ -93,6 +93,7 @@ fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
             "--associations",
             associations.join(name).to_str().unwrap(),
             "--timing",
+            dir.join("steps.txt").to_str().unwrap(),
         ]);
         let timing: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
         let sequence = primm::io::read_sequence_file(&file).unwrap();
@@ -101,6 +102,9 @@ fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
         timed_frames += sequence.frames.len();
     }
     assert!(timed_frames > 0);
+    let lines = std::fs::read_to_string(dir.join("steps.txt")).unwrap();
+    assert_eq!(lines.lines().count(), timed_frames, "one step time per frame, appended over the files");
+    assert!(lines.lines().all(|line| line.parse::<u64>().is_ok()));
     let score = primm(&["score", "--data", data.to_str().unwrap(), "--associations", associations.to_str().unwrap(), "--name", "imm"]);
     let score: serde_json::Value = serde_json::from_slice(&score.stdout).unwrap();
     let json = dir.join("eval.json");

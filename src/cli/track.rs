@@ -33,10 +33,11 @@ pub struct Args {
     /// `primm score`).
     #[arg(long, value_name = "FILE")]
     pub associations: Option<PathBuf>,
-    /// Time every tracker step (the CSV reading and writing excluded) and print frames per
-    /// second and step-time percentiles as one JSON line on stdout.
-    #[arg(long)]
-    pub timing: bool,
+    /// Time every tracker step (the CSV reading and writing excluded) and append one line per
+    /// frame with its step time in nanoseconds to FILE; prints a one-line JSON summary (frames
+    /// per second, percentiles) on stdout.
+    #[arg(long, value_name = "FILE")]
+    pub timing: Option<PathBuf>,
 }
 
 /// Runs `primm track`.
@@ -75,7 +76,18 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(associations) = associations {
         associations.finish()?;
     }
-    if args.timing {
+    if let Some(path) = &args.timing {
+        use std::io::Write as _;
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+            .map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        let mut out = std::io::BufWriter::new(file);
+        for ns in &step_ns {
+            writeln!(out, "{ns}")?;
+        }
+        out.flush()?;
         println!("{}", timing_json(args.method, &mut step_ns));
     }
     let stats = tracker.stats();

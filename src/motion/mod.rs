@@ -150,7 +150,6 @@ pub(crate) fn initiate_position_velocity<const N: usize>(
     gaussian
 }
 
-/// Continuous white-noise acceleration covariance of one axis' `[position, velocity]`, per unit PSD.
 /// `F x` and `F P Fᵀ` for a transition `F = I + Σ c·e_target·e_sourceᵀ` given as its
 /// off-diagonal terms `(target, source, c)`, in `O(N·terms)` instead of the `O(N³)` of two
 /// dense products (CV has 2 such terms, CA 6, CT's Jacobian 12). Every term reads the
@@ -196,6 +195,7 @@ pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, ter
     }
 }
 
+/// Continuous white-noise acceleration covariance of one axis' `[position, velocity]`, per unit PSD.
 pub(crate) fn white_acceleration_block(dt: f64) -> [[f64; 2]; 2] {
     let dt2 = dt * dt;
     [[dt2 * dt / 3.0, dt2 / 2.0], [dt2 / 2.0, dt]]
