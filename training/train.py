@@ -36,6 +36,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dataset import CLASSES, MAX_HISTORY, Windows, load_split, truncate  # noqa: E402
 from model import ExportGraph, PRModel, score_bound  # noqa: E402
+import onnx_graph  # noqa: E402
 
 OPSET = 17
 INPUT_NAMES = ["features", "valid"]
@@ -335,9 +336,11 @@ def train(args) -> None:
 
 
 def export(model: PRModel, path: str, check: Windows) -> float:
-    """Exports :class:`ExportGraph` of the trained model with the legacy TorchScript-based
-    exporter, opset 17, dynamic batch axis only. Checks that it computes the trained function and
-    that no attention score can overflow ``exp``; returns the score bound."""
+    """Writes the trained model as the ONNX graph of :mod:`onnx_graph` (opset 17, dynamic batch
+    axis only). Checks that the graph's NumPy reference computes the trained function and that
+    no attention score can overflow ``exp``; returns the score bound."""
+    import onnx
+
     bound = ExportGraph(model).logit_bound()
     subtract_max = bound > SCORE_BOUND_WITHOUT_MAX
     print(
@@ -345,29 +348,16 @@ def export(model: PRModel, path: str, check: Windows) -> float:
         f"softmax {'subtracts' if subtract_max else 'needs no'} row maximum",
         flush=True,
     )
-    graph = ExportGraph(model, subtract_max=subtract_max).eval()
+    weights = {name: value.detach().cpu().numpy() for name, value in model.state_dict().items()}
+    heads = model.layers[0].attention.heads
+    f, v = check.features[:4096], check.valid[:4096]
     with torch.no_grad():
-        f, v = torch.from_numpy(check.features[:4096]), torch.from_numpy(check.valid[:4096])
-        difference = float((graph(f, v) - model(f, v)).abs().max())
-    print(f"export graph vs trained model: max abs difference {difference:.2e} m", flush=True)
+        trained = model(torch.from_numpy(f), torch.from_numpy(v)).numpy()
+    difference = float(np.abs(onnx_graph.reference_forward(weights, f, v, heads) - trained).max())
+    print(f"graph reference vs trained model: max abs difference {difference:.2e} m", flush=True)
     if difference > 1e-4:
         raise RuntimeError("the export graph does not compute the trained function")
-    features = torch.zeros(3, MAX_HISTORY, 5)
-    valid = torch.ones(3, MAX_HISTORY)
-    torch.onnx.export(
-        graph,
-        (features, valid),
-        path,
-        input_names=INPUT_NAMES,
-        output_names=OUTPUT_NAMES,
-        dynamic_axes={name: {0: BATCH_AXIS} for name in INPUT_NAMES + OUTPUT_NAMES},
-        opset_version=OPSET,
-        do_constant_folding=True,
-        dynamo=False,
-    )
-    import onnx
-
-    onnx.checker.check_model(onnx.load(path), full_check=True)
+    onnx.save(onnx_graph.build_graph(weights, heads, subtract_max=subtract_max), path)
     print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
     return bound
 
@@ -429,8 +419,8 @@ def write_metadata(args, model, mean, std, scale, train_windows, train_files, va
         "model_sha256": file_digest(onnx_path),
         "format": {
             "onnx_opset": OPSET,
-            "exporter": f"torch.onnx.export (dynamo=False), torch {torch.__version__}",
-            "graph": "training/model.py ExportGraph: heads merged into one product, softmax as exp / (exp @ ones)",
+            "exporter": onnx_graph.EXPORTER,
+            "graph": onnx_graph.GRAPH_DESCRIPTION,
             "attention_score_bound": logit_bound,
         },
         "inputs": [

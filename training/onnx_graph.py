@@ -1,0 +1,281 @@
+"""The PR model's ONNX graph, written node by node for tract (primm's runtime).
+
+``build_graph`` takes the trained weights (the ``PRModel`` state dict as NumPy arrays) and writes
+the same function as :class:`model.PRModel` in the operator forms tract executes fastest, measured
+with ``cargo bench --bench inference_profile`` (``benches/results/pr_inference.md``):
+
+* **Heads without transposes.** Head ``h``'s queries are the full-width query vector with the
+  other heads' channels zeroed (query weights masked per head and stacked side by side), so one
+  product ``[B, Tq, d] @ [d, H*d]`` gives every head's query, and a *reshape* (no transpose) to
+  ``[B, Tq*H, d]`` puts one (token, head) pair per row. Scores, softmax and the value mix then
+  run on all heads at once, and the reshape back to ``[B, Tq, H*d]`` feeds an output projection
+  whose per-head blocks (each head's input channels kept) sum the heads.
+* **Key mask after the exponential.** ``exp(scores) * key_valid`` with ``key_valid`` ``[B, 1, 7]``
+  (1 for valid history rows and the two query tokens, 0 for padding): masked keys get weight
+  exactly 0, as the additive -1e9 mask of the trained model gives, without an extra key
+  channel (which tract split into a second product and an add).
+* **Softmax** as ``e / (e @ ones[7, 7])``: one element-wise ``Exp``, one ``MatMul`` for the row
+  sums (already broadcast to every column), one ``Div``. No row maximum is subtracted while the
+  weight-derived score bound (``model.score_bound``) stays below ``SCORE_BOUND_WITHOUT_MAX``;
+  above it the graph subtracts each row's maximum.
+* Normalisation, embedding, LayerNorms (``LayerNormalization``, opset 17), feed-forward blocks,
+  residuals and the two heads as in the trained model; the last layer computes only the two
+  query tokens.
+
+``weights_from_onnx`` reads the weights back from an exported file of either graph form, so a
+model can be re-exported without retraining; ``reference_forward`` is the plain NumPy forward
+pass of the trained model (the check for both).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+MAX_HISTORY = 5
+FEATURES = 5
+QUERIES = 2
+TOKENS = MAX_HISTORY + QUERIES
+OPSET = 17
+SCORE_BOUND_WITHOUT_MAX = 60.0
+EXPORTER = "training/onnx_graph.py build_graph (onnx.helper, node by node)"
+GRAPH_DESCRIPTION = (
+    "heads as reshaped rows of one product (no transposes), key mask multiplied after exp, "
+    "softmax as exp / (exp @ ones); see training/onnx_graph.py"
+)
+INPUT_NAMES = ["features", "valid"]
+OUTPUT_NAMES = ["displacement"]
+
+
+def layer_count(weights: dict) -> int:
+    return len({key.split(".")[1] for key in weights if key.startswith("layers.")})
+
+
+def reference_forward(weights: dict, features: np.ndarray, valid: np.ndarray, heads: int) -> np.ndarray:
+    """The trained model's forward pass in float64 NumPy (``model.PRModel.forward``)."""
+    w = {k: np.asarray(v, np.float64) for k, v in weights.items()}
+    x = (features.astype(np.float64) - w["feature_mean"]) * w["feature_inv_std"]
+    x = np.concatenate([x, np.zeros((x.shape[0], QUERIES, FEATURES))], axis=1)
+    tokens = x @ w["embedding.weight"].T + w["token_table"]
+    key_valid = np.concatenate([valid, np.ones((valid.shape[0], QUERIES))], axis=1)
+    key_bias = (key_valid - 1.0)[:, None, None, :] * 1e9
+
+    def layer_norm(v, name):
+        mean = v.mean(-1, keepdims=True)
+        var = ((v - mean) ** 2).mean(-1, keepdims=True)
+        return (v - mean) / np.sqrt(var + 1e-5) * w[name + ".weight"] + w[name + ".bias"]
+
+    def linear(v, name):
+        return v @ w[name + ".weight"].T + w[name + ".bias"]
+
+    layers = layer_count(weights)
+    for index in range(layers):
+        p = f"layers.{index}."
+        normed = layer_norm(tokens, p + "norm_attention")
+        queries = normed[:, MAX_HISTORY:] if index == layers - 1 else normed
+        if index == layers - 1:
+            tokens = tokens[:, MAX_HISTORY:]
+        d = normed.shape[-1]
+        dh = d // heads
+        tq = queries.shape[1]
+        q = linear(queries, p + "attention.query").reshape(-1, tq, heads, dh).transpose(0, 2, 1, 3)
+        k = linear(normed, p + "attention.key").reshape(-1, TOKENS, heads, dh).transpose(0, 2, 3, 1)
+        v = linear(normed, p + "attention.value").reshape(-1, TOKENS, heads, dh).transpose(0, 2, 1, 3)
+        scores = q @ k / np.sqrt(dh) + key_bias
+        scores = scores - scores.max(-1, keepdims=True)
+        e = np.exp(scores)
+        mixed = (e / e.sum(-1, keepdims=True)) @ v
+        mixed = mixed.transpose(0, 2, 1, 3).reshape(-1, tq, d)
+        tokens = tokens + linear(mixed, p + "attention.output")
+        hidden = np.maximum(linear(layer_norm(tokens, p + "norm_ff"), p + "ff_in"), 0.0)
+        tokens = tokens + linear(hidden, p + "ff_out")
+    out = layer_norm(tokens, "final_norm").reshape(-1, QUERIES * tokens.shape[-1])
+    d = tokens.shape[-1]
+    head = np.zeros((2 * d, 2))
+    head[:d, 0] = w["head_x.weight"][0]
+    head[d:, 1] = w["head_y.weight"][0]
+    bias = np.array([w["head_x.bias"][0], w["head_y.bias"][0]])
+    return (out @ head + bias) * w["output_scale"]
+
+
+def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str = ""):
+    """The ONNX model (opset 17, symbolic batch axis ``batch``) of the trained ``weights``."""
+    import onnx
+    from onnx import TensorProto, helper, numpy_helper
+
+    w = {k: np.asarray(v, np.float32) for k, v in weights.items()}
+    d = w["token_table"].shape[1]
+    dh = d // heads
+    scale = np.float32(1.0 / np.sqrt(dh))
+    nodes, initializers = [], []
+
+    def const(name, value):
+        initializers.append(numpy_helper.from_array(np.asarray(value), name))
+        return name
+
+    def node(op, inputs, name, **attributes):
+        nodes.append(helper.make_node(op, inputs, [name], name=name, **attributes))
+        return name
+
+    def layer_norm(x, prefix, out):
+        return node("LayerNormalization", [x, const(prefix + ".weight", w[prefix + ".weight"]), const(prefix + ".bias", w[prefix + ".bias"])], out, axis=-1, epsilon=1e-5)
+
+    def linear(x, prefix, out, weight=None, bias=None):
+        weight = w[prefix + ".weight"].T if weight is None else weight
+        bias = w[prefix + ".bias"] if bias is None else bias
+        product = node("MatMul", [x, const(prefix + ".weight_t", np.ascontiguousarray(weight))], out + "_product")
+        return node("Add", [product, const(prefix + ".bias_row", bias)], out)
+
+    # Normalisation, two zero query rows, embedding plus the token table.
+    x = node("Sub", ["features", const("feature_mean", w["feature_mean"])], "centred")
+    x = node("Mul", [x, const("feature_inv_std", w["feature_inv_std"])], "normalised")
+    x = node("Pad", [x, const("token_pad", np.array([0, 0, 0, 0, QUERIES, 0], np.int64))], "padded")
+    x = node("MatMul", [x, const("embedding.weight_t", np.ascontiguousarray(w["embedding.weight"].T))], "embedded")
+    tokens = node("Add", [x, const("token_table", w["token_table"])], "tokens_0")
+    # Key weights: 1 for valid history rows and the queries, 0 for padding; [B, 1, 7].
+    key_valid = node("Pad", ["valid", const("key_pad", np.array([0, 0, 0, QUERIES], np.int64)), const("one", np.float32(1.0))], "key_valid_rows")
+    key_valid = node("Unsqueeze", [key_valid, const("axis_1", np.array([1], np.int64))], "key_valid")
+    ones = const("ones_7x7", np.ones((TOKENS, TOKENS), np.float32))
+    head_mask = np.zeros((heads, d), np.float32)
+    for h in range(heads):
+        head_mask[h, h * dh : (h + 1) * dh] = 1.0
+
+    layers = layer_count(weights)
+    for index in range(layers):
+        p = f"layers.{index}"
+        last = index == layers - 1
+        tq = QUERIES if last else TOKENS
+        normed = layer_norm(tokens, f"{p}.norm_attention", f"{p}.normed")
+        if last:
+            starts, ends, axes = (const(f"{p}.q_start", np.array([MAX_HISTORY], np.int64)), const(f"{p}.q_end", np.array([TOKENS], np.int64)), const(f"{p}.q_axis", np.array([1], np.int64)))
+            queries = node("Slice", [normed, starts, ends, axes], f"{p}.query_rows")
+            tokens = node("Slice", [tokens, starts, ends, axes], f"{p}.query_tokens")
+        else:
+            queries = normed
+        wq = w[f"{p}.attention.query.weight"].T * scale  # [d_in, d_out]
+        bq = w[f"{p}.attention.query.bias"] * scale
+        stacked_w = np.concatenate([wq * head_mask[h][None, :] for h in range(heads)], axis=1)  # [d, H*d]
+        stacked_b = np.concatenate([bq * head_mask[h] for h in range(heads)])
+        q = linear(queries, f"{p}.attention.query_heads", f"{p}.q", stacked_w, stacked_b)
+        q = node("Reshape", [q, const(f"{p}.q_shape", np.array([-1, tq * heads, d], np.int64))], f"{p}.q_rows")
+        k = linear(normed, f"{p}.attention.key", f"{p}.k")
+        k = node("Transpose", [k], f"{p}.k_t", perm=[0, 2, 1])
+        v = linear(normed, f"{p}.attention.value", f"{p}.v")
+        scores = node("MatMul", [q, k], f"{p}.scores")
+        if subtract_max:
+            peak = node("ReduceMax", [scores, const(f"{p}.last_axis", np.array([-1], np.int64))], f"{p}.peak", keepdims=1)
+            scores = node("Sub", [scores, peak], f"{p}.shifted")
+        e = node("Exp", [scores], f"{p}.exp")
+        e = node("Mul", [e, key_valid], f"{p}.exp_masked")
+        total = node("MatMul", [e, ones], f"{p}.row_sums")
+        attention = node("Div", [e, total], f"{p}.weights")
+        mixed = node("MatMul", [attention, v], f"{p}.mixed")
+        mixed = node("Reshape", [mixed, const(f"{p}.mixed_shape", np.array([-1, tq, heads * d], np.int64))], f"{p}.mixed_heads")
+        wo = w[f"{p}.attention.output.weight"].T  # [d_in, d_out]
+        stacked_o = np.concatenate([wo * head_mask[h][:, None] for h in range(heads)], axis=0)  # [H*d, d]
+        attended = linear(mixed, f"{p}.attention.output", f"{p}.attended", stacked_o, w[f"{p}.attention.output.bias"])
+        tokens = node("Add", [tokens, attended], f"{p}.residual_attention")
+        hidden = linear(layer_norm(tokens, f"{p}.norm_ff", f"{p}.normed_ff"), f"{p}.ff_in", f"{p}.ff_hidden")
+        hidden = node("Relu", [hidden], f"{p}.ff_relu")
+        tokens = node("Add", [tokens, linear(hidden, f"{p}.ff_out", f"{p}.ff_output")], f"{p}.residual_ff")
+
+    out = layer_norm(tokens, "final_norm", "final_normed")
+    out = node("Reshape", [out, const("flat_shape", np.array([-1, QUERIES * d], np.int64))], "flat")
+    head = np.zeros((QUERIES * d, 2), np.float32)
+    head[:d, 0] = w["head_x.weight"][0]
+    head[d:, 1] = w["head_y.weight"][0]
+    bias = np.array([w["head_x.bias"][0], w["head_y.bias"][0]], np.float32)
+    out = linear(out, "head", "head_output", head, bias)
+    node("Mul", [out, const("output_scale", w["output_scale"])], "displacement")
+
+    batch = "batch"
+    graph = helper.make_graph(
+        nodes,
+        "pr",
+        [
+            helper.make_tensor_value_info("features", TensorProto.FLOAT, [batch, MAX_HISTORY, FEATURES]),
+            helper.make_tensor_value_info("valid", TensorProto.FLOAT, [batch, MAX_HISTORY]),
+        ],
+        [helper.make_tensor_value_info("displacement", TensorProto.FLOAT, [batch, 2])],
+        initializers,
+    )
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="primm training/onnx_graph.py", doc_string=doc)
+    model.ir_version = 8
+    onnx.checker.check_model(model, full_check=True)
+    return model
+
+
+def weights_from_onnx(path: str, heads: int) -> dict:
+    """The trained weights (``PRModel`` state-dict names, NumPy) from an exported PR model: this
+    module's graph, or the earlier ``ExportGraph`` export of ``torch.onnx.export``."""
+    import onnx
+    from onnx import numpy_helper
+
+    model = onnx.load(path)
+    init = {i.name: numpy_helper.to_array(i) for i in model.graph.initializer}
+    if "embedding.weight_t" in init:
+        return _weights_from_this_graph(init, heads)
+    return _weights_from_torch_export(model, init, heads)
+
+
+def _weights_from_this_graph(init: dict, heads: int) -> dict:
+    w = {name: init[name] for name in ["feature_mean", "feature_inv_std", "output_scale", "token_table", "final_norm.weight", "final_norm.bias"]}
+    w["embedding.weight"] = init["embedding.weight_t"].T
+    d = w["token_table"].shape[1]
+    dh = d // heads
+    scale = 1.0 / np.sqrt(dh)
+    index = 0
+    while f"layers.{index}.norm_attention.weight" in init:
+        p = f"layers.{index}"
+        for name in ["norm_attention", "norm_ff"]:
+            w[f"{p}.{name}.weight"], w[f"{p}.{name}.bias"] = init[f"{p}.{name}.weight"], init[f"{p}.{name}.bias"]
+        for name in ["attention.key", "attention.value", "ff_in", "ff_out"]:
+            w[f"{p}.{name}.weight"], w[f"{p}.{name}.bias"] = init[f"{p}.{name}.weight_t"].T, init[f"{p}.{name}.bias_row"]
+        stacked = init[f"{p}.attention.query_heads.weight_t"]  # [d, H*d], head h's block keeps its channels
+        stacked_b = init[f"{p}.attention.query_heads.bias_row"]
+        w[f"{p}.attention.query.weight"] = (sum(stacked[:, h * d : (h + 1) * d] for h in range(heads)) / scale).T
+        w[f"{p}.attention.query.bias"] = sum(stacked_b[h * d : (h + 1) * d] for h in range(heads)) / scale
+        stacked_o = init[f"{p}.attention.output.weight_t"]  # [H*d, d]
+        w[f"{p}.attention.output.weight"] = sum(stacked_o[h * d : (h + 1) * d] for h in range(heads)).T
+        w[f"{p}.attention.output.bias"] = init[f"{p}.attention.output.bias_row"]
+        index += 1
+    head = init["head.weight_t"]
+    w["head_x.weight"], w["head_y.weight"] = head[:d, 0][None, :], head[d:, 1][None, :]
+    w["head_x.bias"], w["head_y.bias"] = init["head.bias_row"][:1], init["head.bias_row"][1:]
+    return w
+
+
+def _weights_from_torch_export(model, init: dict, heads: int) -> dict:
+    """``torch.onnx.export`` of ``ExportGraph`` keeps the LayerNorm and bias parameters under
+    their state-dict names and folds the other matrices into anonymous constants; they are
+    recovered from the MatMul / Mul nodes that consume them, in graph order."""
+    w = {k[len("model."):]: v for k, v in init.items() if k.startswith("model.")}
+    w.setdefault("feature_inv_std", init.get("model.feature_inv_std"))
+    consumers = []
+    for node in model.graph.node:
+        for name in node.input:
+            if name.startswith("onnx::") and name in init and name not in [c[1] for c in consumers]:
+                consumers.append((node.op_type, name))
+    anonymous = [init[name] for _, name in consumers]
+    # Order of first use: embedding^T; per layer: query weight and bias (both already multiplied
+    # by the attention scale 1/sqrt(head_dim)), key^T, value^T, ff_in^T, ff_out^T; then the
+    # block-diagonal head [2d, 2] and its bias.
+    scale = 1.0 / np.sqrt(w["token_table"].shape[1] // heads)
+    position = 0
+    w["embedding.weight"] = anonymous[position].T
+    position += 1
+    index = 0
+    while f"layers.{index}.norm_attention.weight" in w:
+        p = f"layers.{index}"
+        w[f"{p}.attention.query.weight"] = anonymous[position] / scale
+        w[f"{p}.attention.query.bias"] = anonymous[position + 1] / scale
+        w[f"{p}.attention.key.weight"] = anonymous[position + 2].T
+        w[f"{p}.attention.value.weight"] = anonymous[position + 3].T
+        w[f"{p}.ff_in.weight"] = anonymous[position + 4].T
+        w[f"{p}.ff_out.weight"] = anonymous[position + 5].T
+        position += 6
+        index += 1
+    d = w["token_table"].shape[1]
+    head, bias = anonymous[position], anonymous[position + 1]
+    w["head_x.weight"], w["head_y.weight"] = head[:d, 0][None, :], head[d:, 1][None, :]
+    w["head_x.bias"], w["head_y.bias"] = bias[:1], bias[1:]
+    return w
