@@ -185,7 +185,16 @@ fn plot(rows: &[Row], path: &Path) -> Result<(), Box<dyn std::error::Error>> {
         .x_label_area_size(40)
         .y_label_area_size(60)
         .build_cartesian_2d((6.0f64..max_objects * 1.1).log_scale(), (5.0f64..max_us).log_scale())?;
-    chart.configure_mesh().x_desc("objects").y_desc("step time, µs (log)").draw()?;
+    chart
+        .configure_mesh()
+        .x_labels(5)
+        .y_labels(5)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .light_line_style(WHITE)
+        .x_desc("objects (log)")
+        .y_desc("step time, µs (log)")
+        .draw()?;
     let methods: Vec<String> = {
         let mut m: Vec<String> = rows.iter().map(|r| r.method.clone()).collect();
         m.dedup();

@@ -184,7 +184,8 @@ impl Drop for ChildGuard {
 /// `primm serve` under `prefix`, stdout captured.
 pub fn spawn_serve(prefix: &str, extra: &[&str]) -> ChildGuard {
     let child = Command::new(env!("CARGO_BIN_EXE_primm"))
-        .args(["serve", "--service-prefix", prefix, "--latency-every", "20"])
+        .args(["serve", "--service-prefix", prefix])
+        .args(if extra.contains(&"--latency-every") { &[][..] } else { &["--latency-every", "20"][..] })
         .args(extra)
         .env("RUST_LOG", "warn")
         .stdout(Stdio::piped())
