@@ -228,3 +228,67 @@ pub fn association_records_from_rows(
     }
     Ok(records)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::{RecordedFrame, RecordedMeasurement};
+    use crate::measurement::{Measurement, ObjectClass};
+
+    fn sequence() -> Sequence {
+        let mut sequence = Sequence::new("s");
+        for index in 0..2u64 {
+            let mut frame = RecordedFrame::new(index, index as f64 * 0.1);
+            for j in 0..2 {
+                frame.measurements.push(RecordedMeasurement {
+                    measurement: Measurement {
+                        x_m: 10.0 + j as f64,
+                        y_m: 0.0,
+                        radial_velocity_mps: 0.0,
+                        rcs_dbsm: 0.0,
+                        class: ObjectClass::Car,
+                        sensor_id: None,
+                        ground_truth_id: Some(j),
+                    },
+                    true_position: None,
+                });
+            }
+            sequence.frames.push(frame);
+        }
+        sequence
+    }
+
+    fn rows(text: &str) -> Result<Vec<AssociationRow>, AssociationCsvError> {
+        read_association_rows(format!("{ASSOCIATION_CSV_HEADER}\n{text}").as_bytes())
+    }
+
+    #[test]
+    fn rows_read_back_into_records_in_measurement_order() {
+        let rows = rows("1,1,7,10.5,0.25\n0,0,7,,\n0,1,,,\n").unwrap();
+        let records = association_records_from_rows(&sequence(), &rows).unwrap();
+        assert_eq!(records.len(), 4);
+        assert_eq!((records[0].track_id, records[0].prior), (Some(7), None));
+        assert_eq!(records[1].track_id, None);
+        assert_eq!(records[2].track_id, None, "a measurement without a row was taken by no track");
+        assert_eq!((records[3].track_id, records[3].prior), (Some(7), Some(DVec2::new(10.5, 0.25))));
+    }
+
+    #[test]
+    fn a_wrong_header_a_bad_number_or_half_a_prior_is_an_error() {
+        assert!(matches!(read_association_rows("frame,track\n".as_bytes()), Err(AssociationCsvError::Header(_))));
+        assert!(matches!(rows("0,0,x,,"), Err(AssociationCsvError::Field { column: "track_id", .. })));
+        assert!(matches!(rows("0,0,1,nan,1"), Err(AssociationCsvError::Field { column: "prior_x", .. })));
+        assert!(matches!(rows("0,0,1,1.0,"), Err(AssociationCsvError::Field { .. })));
+    }
+
+    #[test]
+    fn a_measurement_listed_twice_or_a_track_taking_two_measurements_of_a_frame_is_refused() {
+        let twice = rows("0,0,1,,\n0,0,2,,\n").unwrap();
+        assert!(matches!(association_records_from_rows(&sequence(), &twice), Err(AssociationCsvError::Duplicate { .. })));
+        let greedy = rows("0,0,1,,\n0,1,1,,\n").unwrap();
+        assert!(matches!(
+            association_records_from_rows(&sequence(), &greedy),
+            Err(AssociationCsvError::TrackTwiceInFrame { frame: 0, track_id: 1 })
+        ));
+    }
+}
