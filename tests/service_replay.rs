@@ -103,26 +103,26 @@ fn with_the_learned_predictor_every_frame_comes_back_with_the_tracks_of_a_synchr
     assert!(stdout.contains("learned_wait"), "{stdout}");
 }
 
-#[test]
-fn a_missing_model_file_stops_the_tracker_with_an_error_naming_it() {
-    let prefix = unique_prefix("missing-model");
+/// Runs `primm serve` with `args`, expects it to refuse to start, returns its standard error.
+fn refused_serve(name: &str, args: &[&str]) -> String {
+    let prefix = unique_prefix(name);
     let output = std::process::Command::new(env!("CARGO_BIN_EXE_primm"))
-        .args(["serve", "--service-prefix", &prefix, "--method", "pr-imm", "--model", "no/such/model.onnx"])
+        .args(["serve", "--service-prefix", &prefix])
+        .args(args)
         .output()
         .unwrap();
-    assert!(!output.status.success());
-    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "serve {args:?} started");
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+#[test]
+fn a_missing_model_file_stops_the_tracker_with_an_error_naming_it() {
+    let stderr = refused_serve("missing-model", &["--method", "pr-imm", "--model", "no/such/model.onnx"]);
     assert!(stderr.contains("no/such/model.onnx"), "{stderr}");
 }
 
 #[test]
 fn a_model_given_for_a_physics_only_method_is_refused() {
-    let prefix = unique_prefix("model-imm");
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_primm"))
-        .args(["serve", "--service-prefix", &prefix, "--method", "imm", "--model", "models/pr.onnx"])
-        .output()
-        .unwrap();
-    assert!(!output.status.success());
-    let stderr = String::from_utf8_lossy(&output.stderr);
+    let stderr = refused_serve("model-imm", &["--method", "imm", "--model", "models/pr.onnx"]);
     assert!(stderr.contains("does not use the learned predictor"), "{stderr}");
 }

@@ -192,17 +192,7 @@ pub fn association_records_from_rows(
     for recorded in &sequence.frames {
         for (position, m) in recorded.measurements.iter().enumerate() {
             index.insert((recorded.index, position as u16), records.len());
-            records.push(AssociationRecord {
-                frame: recorded.index,
-                timestamp_s: recorded.timestamp_s,
-                ground_truth_id: m.measurement.ground_truth_id,
-                class: m.measurement.class,
-                measured: m.measurement.position(),
-                true_position: m.true_position,
-                track_id: None,
-                prior: None,
-                mode_probabilities: None,
-            });
+            records.push(crate::offline::unassigned_record(recorded, m));
         }
     }
     let mut seen = vec![false; records.len()];
