@@ -27,9 +27,10 @@ object from the latest history measurement to the prediction time (the time the 
 5. a final LayerNorm, ``dx`` from ``q_x``'s output and ``dy`` from ``q_y``'s output (one linear
    head each), scaled to metres.
 
-:class:`ExportGraph` computes the same function from the same weights in a form that tract
-(primm's ONNX runtime) executes quickly; it is what ``train.py`` exports. See its
-documentation.
+:class:`ExportGraph` computes the same function from the same weights with the heads merged
+and the softmax rewritten; ``train.py`` uses it for the weight-derived attention-score bound.
+The ONNX graph itself is written by ``onnx_graph.py`` in the forms tract (primm's ONNX runtime)
+executes fastest.
 """
 
 from __future__ import annotations
