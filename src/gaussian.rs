@@ -102,10 +102,10 @@ pub fn symmetric_pseudo_inverse(m: &Matrix2<f64>) -> Matrix2<f64> {
 /// keeps the mode's own value, exactly as the paper writes it. The conditional distribution of
 /// `h` given the position (gain `B`, covariance `C`) is therefore unchanged.
 pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &PositionEstimate) {
-    let p = &gaussian.covariance;
     let p_pp = gaussian.position_covariance();
     let p_pp_pinv = symmetric_pseudo_inverse(&p_pp);
     let p_bar = to_nalgebra(&mixed.covariance);
+    let p = &mut gaussian.covariance;
     // The blocks of eq:reconstructed_cov, written out so that only O(N²) products remain:
     // top-left P̄; off-diagonal B P̄; bottom-right C + B P̄ Bᵀ = P_hh + B (P̄ − P_pp) Bᵀ,
     // with B = P_hp P_pp^† in rows 2.. of `b`.
@@ -120,29 +120,30 @@ pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &Posi
         [p_bar[(0, 0)] - p_pp[(0, 0)], p_bar_01 - 0.5 * (p_pp[(0, 1)] + p_pp[(1, 0)])],
         [0.0, p_bar[(1, 1)] - p_pp[(1, 1)]],
     ];
-    let mut reconstructed = SMatrix::<f64, N, N>::zeros();
-    reconstructed[(0, 0)] = p_bar[(0, 0)];
-    reconstructed[(1, 1)] = p_bar[(1, 1)];
-    reconstructed[(0, 1)] = p_bar_01;
-    reconstructed[(1, 0)] = p_bar_01;
+    // Written in place: row r's pass reads the position columns only through `b` (computed
+    // above) and reads P_hh entries (r, c) and (c, r) with c ≥ r, none of which an earlier
+    // row's pass has written.
+    p[(0, 0)] = p_bar[(0, 0)];
+    p[(1, 1)] = p_bar[(1, 1)];
+    p[(0, 1)] = p_bar_01;
+    p[(1, 0)] = p_bar_01;
     for r in 2..N {
         let (b0, b1) = (b[(r, 0)], b[(r, 1)]);
         // Row r of B P̄ (P̄ symmetric).
         let cross0 = b0 * p_bar[(0, 0)] + b1 * p_bar_01;
         let cross1 = b0 * p_bar_01 + b1 * p_bar[(1, 1)];
-        reconstructed[(r, 0)] = cross0;
-        reconstructed[(0, r)] = cross0;
-        reconstructed[(r, 1)] = cross1;
-        reconstructed[(1, r)] = cross1;
+        p[(r, 0)] = cross0;
+        p[(0, r)] = cross0;
+        p[(r, 1)] = cross1;
+        p[(1, r)] = cross1;
         // Row r of B Δ (Δ symmetric).
         let (d0, d1) = (b0 * delta[0][0] + b1 * delta[0][1], b0 * delta[0][1] + b1 * delta[1][1]);
         for c in r..N {
             let value = 0.5 * (p[(r, c)] + p[(c, r)]) + d0 * b[(c, 0)] + d1 * b[(c, 1)];
-            reconstructed[(r, c)] = value;
-            reconstructed[(c, r)] = value;
+            p[(r, c)] = value;
+            p[(c, r)] = value;
         }
     }
-    gaussian.covariance = reconstructed;
     gaussian.mean[0] = mixed.mean.x;
     gaussian.mean[1] = mixed.mean.y;
 }

@@ -60,6 +60,13 @@ impl ConstantAcceleration {
 
     /// The process noise `Q(Δt)`.
     pub fn process_noise(&self, dt: f64) -> Matrix6<f64> {
+        let mut m = Matrix6::zeros();
+        self.add_process_noise(&mut m, dt);
+        m
+    }
+
+    /// `covariance += Q(Δt)`, touching only `Q`'s eighteen non-zero entries.
+    pub fn add_process_noise(&self, covariance: &mut Matrix6<f64>, dt: f64) {
         let q = self.jerk_psd_m2_per_s5;
         let (dt2, dt3) = (dt * dt, dt * dt * dt);
         let block = [
@@ -67,15 +74,13 @@ impl ConstantAcceleration {
             [dt2 * dt2 / 8.0, dt3 / 3.0, dt2 / 2.0],
             [dt3 / 6.0, dt2 / 2.0, dt],
         ];
-        let mut m = Matrix6::zeros();
         for axis in AXES {
             for (r, &row) in axis.iter().enumerate() {
                 for (c, &col) in axis.iter().enumerate() {
-                    m[(row, col)] = q * block[r][c];
+                    covariance[(row, col)] += q * block[r][c];
                 }
             }
         }
-        m
     }
 }
 
@@ -101,7 +106,7 @@ impl MotionModel<6> for ConstantAcceleration {
         let [[x, vx, ax], [y, vy, ay]] = AXES;
         let terms = [(x, vx, dt), (x, ax, half_dt2), (vx, ax, dt), (y, vy, dt), (y, ay, half_dt2), (vy, ay, dt)];
         super::propagate_linear_in_place(estimate, &terms);
-        estimate.covariance += self.process_noise(dt);
+        self.add_process_noise(&mut estimate.covariance, dt);
         crate::gaussian::symmetrize(&mut estimate.covariance);
     }
 

@@ -1,6 +1,6 @@
 //! Constant-velocity model (`eq:cv_F`), state `[x, y, vx, vy]`.
 
-use super::{initiate_position_velocity, white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
+use super::{initiate_position_velocity, InitialVelocity, MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use nalgebra::{Matrix2, Matrix4};
@@ -44,16 +44,14 @@ impl ConstantVelocity {
 
     /// The process noise `Q(Δt)`.
     pub fn process_noise(&self, dt: f64) -> Matrix4<f64> {
-        let block = white_acceleration_block(dt);
-        let q = self.acceleration_psd_m2_per_s3;
         let mut m = Matrix4::zeros();
-        for (position, velocity) in [(index::X, index::VX), (index::Y, index::VY)] {
-            m[(position, position)] = q * block[0][0];
-            m[(position, velocity)] = q * block[0][1];
-            m[(velocity, position)] = q * block[1][0];
-            m[(velocity, velocity)] = q * block[1][1];
-        }
+        self.add_process_noise(&mut m, dt);
         m
+    }
+
+    /// `covariance += Q(Δt)`, touching only `Q`'s eight non-zero entries.
+    pub fn add_process_noise(&self, covariance: &mut Matrix4<f64>, dt: f64) {
+        super::add_white_acceleration(covariance, self.acceleration_psd_m2_per_s3, dt);
     }
 }
 
@@ -72,7 +70,7 @@ impl MotionModel<4> for ConstantVelocity {
         let dt = context.dt_s;
         // F = transition(dt), applied through its two off-diagonal terms.
         super::propagate_linear_in_place(estimate, &[(index::X, index::VX, dt), (index::Y, index::VY, dt)]);
-        estimate.covariance += self.process_noise(dt);
+        self.add_process_noise(&mut estimate.covariance, dt);
         crate::gaussian::symmetrize(&mut estimate.covariance);
     }
 

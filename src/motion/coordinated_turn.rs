@@ -9,7 +9,7 @@
 //! come from Taylor series whose truncation error (`< φ⁶/5040`) is far below double precision,
 //! so the switch has no visible discontinuity and nothing divides by a vanishing `ω`.
 
-use super::{initiate_position_velocity, white_acceleration_block, InitialVelocity, MotionModel, PredictContext};
+use super::{add_white_acceleration, initiate_position_velocity, InitialVelocity, MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use nalgebra::{Matrix2, SMatrix, SVector};
@@ -119,33 +119,57 @@ impl TurnTerms {
         )
     }
 
-    /// The Jacobian's entries off the identity as `(row, column, J[row, column] − δ)`: rows x,
-    /// y, vx, vy against columns vx, vy, ω.
-    fn jacobian_off_identity(&self, state: &Vector5, dt: f64) -> [(usize, usize, f64); 12] {
+    /// The Jacobian's rows x, y, vx and vy over the columns vx, vy and ω (its other entries
+    /// are those of the identity).
+    fn jacobian_rows(&self, state: &Vector5, dt: f64) -> JacobianRows {
         let (vx, vy) = (state[index::VX], state[index::VY]);
         let Self { sin, cos, s, g, ds, dg } = *self;
-        [
-            (index::X, index::VX, dt * s),
-            (index::X, index::VY, -dt * g),
-            (index::X, index::OMEGA, dt * dt * (ds * vx - dg * vy)),
-            (index::Y, index::VX, dt * g),
-            (index::Y, index::VY, dt * s),
-            (index::Y, index::OMEGA, dt * dt * (dg * vx + ds * vy)),
-            (index::VX, index::VX, cos - 1.0),
-            (index::VX, index::VY, -sin),
-            (index::VX, index::OMEGA, dt * (-sin * vx - cos * vy)),
-            (index::VY, index::VX, sin),
-            (index::VY, index::VY, cos - 1.0),
-            (index::VY, index::OMEGA, dt * (cos * vx - sin * vy)),
-        ]
+        JacobianRows([
+            [dt * s, -dt * g, dt * dt * (ds * vx - dg * vy)],
+            [dt * g, dt * s, dt * dt * (dg * vx + ds * vy)],
+            [cos, -sin, dt * (-sin * vx - cos * vy)],
+            [sin, cos, dt * (cos * vx - sin * vy)],
+        ])
     }
 
     fn jacobian(&self, state: &Vector5, dt: f64) -> Matrix5 {
         let mut j = Matrix5::identity();
-        for (row, column, value) in self.jacobian_off_identity(state, dt) {
-            j[(row, column)] += value;
+        let rows = self.jacobian_rows(state, dt);
+        for (row, values) in rows.0.iter().enumerate() {
+            for (column, &value) in [index::VX, index::VY, index::OMEGA].iter().zip(values) {
+                j[(row, *column)] = value;
+            }
         }
         j
+    }
+}
+
+/// Rows x, y, vx, vy of the CT Jacobian over the columns vx, vy, ω: `J = [[I₂, A], [0, B]]`
+/// with `A` the first two rows here and `B` (rows vx, vy, ω) the rotation, its ω column and
+/// `[0 0 1]`.
+struct JacobianRows([[f64; 3]; 4]);
+
+impl JacobianRows {
+    /// `P ← J P Jᵀ` in place: rows first (`J P`), then columns (`(J P) Jᵀ`). Each pass reads a
+    /// row's (column's) vx, vy and ω entries before writing any of them, and x, y, vx, vy are
+    /// the only ones written; 2 × 5 × 12 multiply-adds.
+    fn propagate_covariance(&self, p: &mut Matrix5) {
+        let j = &self.0;
+        let (vx, vy, w) = (index::VX, index::VY, index::OMEGA);
+        for column in 0..5 {
+            let (a, b, c) = (p[(vx, column)], p[(vy, column)], p[(w, column)]);
+            p[(index::X, column)] += j[0][0] * a + j[0][1] * b + j[0][2] * c;
+            p[(index::Y, column)] += j[1][0] * a + j[1][1] * b + j[1][2] * c;
+            p[(vx, column)] = j[2][0] * a + j[2][1] * b + j[2][2] * c;
+            p[(vy, column)] = j[3][0] * a + j[3][1] * b + j[3][2] * c;
+        }
+        for row in 0..5 {
+            let (a, b, c) = (p[(row, vx)], p[(row, vy)], p[(row, w)]);
+            p[(row, index::X)] += j[0][0] * a + j[0][1] * b + j[0][2] * c;
+            p[(row, index::Y)] += j[1][0] * a + j[1][1] * b + j[1][2] * c;
+            p[(row, vx)] = j[2][0] * a + j[2][1] * b + j[2][2] * c;
+            p[(row, vy)] = j[3][0] * a + j[3][1] * b + j[3][2] * c;
+        }
     }
 }
 
@@ -179,17 +203,15 @@ impl CoordinatedTurn {
 
     /// The process noise `Q(Δt)`.
     pub fn process_noise(&self, dt: f64) -> Matrix5 {
-        let block = white_acceleration_block(dt);
-        let q = self.acceleration_psd_m2_per_s3;
         let mut m = Matrix5::zeros();
-        for (position, velocity) in [(index::X, index::VX), (index::Y, index::VY)] {
-            m[(position, position)] = q * block[0][0];
-            m[(position, velocity)] = q * block[0][1];
-            m[(velocity, position)] = q * block[1][0];
-            m[(velocity, velocity)] = q * block[1][1];
-        }
-        m[(index::OMEGA, index::OMEGA)] = self.turn_rate_psd_rad2_per_s3 * dt;
+        self.add_process_noise(&mut m, dt);
         m
+    }
+
+    /// `covariance += Q(Δt)`, touching only `Q`'s nine non-zero entries.
+    pub fn add_process_noise(&self, covariance: &mut Matrix5, dt: f64) {
+        add_white_acceleration(covariance, self.acceleration_psd_m2_per_s3, dt);
+        covariance[(index::OMEGA, index::OMEGA)] += self.turn_rate_psd_rad2_per_s3 * dt;
     }
 }
 
@@ -201,17 +223,20 @@ impl MotionModel<5> for CoordinatedTurn {
     }
 
     fn predict(&self, posterior: &Gaussian<5>, context: &PredictContext) -> Gaussian<5> {
+        let mut prior = *posterior;
+        self.predict_in_place(&mut prior, context);
+        prior
+    }
+
+    fn predict_in_place(&self, estimate: &mut Gaussian<5>, context: &PredictContext) {
         let dt = context.dt_s;
         // One evaluation of sin/cos serves both the mean and the Jacobian.
-        let terms = TurnTerms::new(&posterior.mean, dt);
-        // J P Jᵀ through J's twelve entries off the identity (rows x, y, vx, vy; columns vx,
-        // vy, ω; see `jacobian`); the mean goes through the nonlinear transition.
-        let off_identity = terms.jacobian_off_identity(&posterior.mean, dt);
-        let mut prior = super::propagate_linear(posterior, &off_identity);
-        prior.mean = terms.transition(&posterior.mean, dt);
-        prior.covariance += self.process_noise(dt);
-        crate::gaussian::symmetrize(&mut prior.covariance);
-        prior
+        let terms = TurnTerms::new(&estimate.mean, dt);
+        let jacobian = terms.jacobian_rows(&estimate.mean, dt);
+        jacobian.propagate_covariance(&mut estimate.covariance);
+        estimate.mean = terms.transition(&estimate.mean, dt);
+        self.add_process_noise(&mut estimate.covariance, dt);
+        crate::gaussian::symmetrize(&mut estimate.covariance);
     }
 
     fn measurement_noise(&self) -> Matrix2<f64> {

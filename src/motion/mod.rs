@@ -150,31 +150,10 @@ pub(crate) fn initiate_position_velocity<const N: usize>(
     gaussian
 }
 
-/// `F x` and `F P Fᵀ` for a transition `F = I + Σ c·e_target·e_sourceᵀ` given as its
+/// `F x` and `F P Fᵀ` in place for a transition `F = I + Σ c·e_target·e_sourceᵀ` given as its
 /// off-diagonal terms `(target, source, c)`, in `O(N·terms)` instead of the `O(N³)` of two
-/// dense products (CV has 2 such terms, CA 6, CT's Jacobian 12). Every term reads the
-/// unpropagated values.
-pub fn propagate_linear<const N: usize>(gaussian: &Gaussian<N>, terms: &[(usize, usize, f64)]) -> Gaussian<N> {
-    let (mean, p) = (&gaussian.mean, &gaussian.covariance);
-    let mut new_mean = *mean;
-    let mut fp = *p;
-    for &(target, source, c) in terms {
-        new_mean[target] += c * mean[source];
-        for column in 0..N {
-            fp[(target, column)] += c * p[(source, column)];
-        }
-    }
-    let mut covariance = fp;
-    for &(target, source, c) in terms {
-        for row in 0..N {
-            covariance[(row, target)] += c * fp[(row, source)];
-        }
-    }
-    Gaussian::new(new_mean, covariance)
-}
-
-/// [`propagate_linear`] in place, for terms in which no source is the target of an earlier
-/// term (then every term still reads unpropagated values; true for CV and CA in their natural
+/// dense products (CV has 2 such terms, CA 6), for terms in which no source is the target of an
+/// earlier term (then every term still reads unpropagated values; true for CV and CA in their natural
 /// order: position from velocity and acceleration first, then velocity from acceleration).
 pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, terms: &[(usize, usize, f64)]) {
     debug_assert!(
@@ -192,6 +171,18 @@ pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, ter
         for row in 0..N {
             p[(row, target)] += c * p[(row, source)];
         }
+    }
+}
+
+/// `covariance += q·Q_axis(Δt)` on both axes' `[position, velocity]` pairs (indices 0/2 and
+/// 1/3, as CV and CT lay out their states), for acceleration PSD `q` m²/s³.
+pub(crate) fn add_white_acceleration<const N: usize>(covariance: &mut nalgebra::SMatrix<f64, N, N>, q: f64, dt: f64) {
+    let block = white_acceleration_block(dt);
+    for (position, velocity) in [(0, 2), (1, 3)] {
+        covariance[(position, position)] += q * block[0][0];
+        covariance[(position, velocity)] += q * block[0][1];
+        covariance[(velocity, position)] += q * block[1][0];
+        covariance[(velocity, velocity)] += q * block[1][1];
     }
 }
 
