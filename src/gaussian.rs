@@ -80,6 +80,7 @@ pub fn to_nalgebra(m: &DMat2) -> Matrix2<f64> {
 /// Moore–Penrose pseudo-inverse of a symmetric positive semi-definite 2×2 matrix, in closed
 /// form. Full rank (the determinant above `PSEUDO_INVERSE_RELATIVE_TOLERANCE` × trace²): the
 /// ordinary inverse. Rank one (`M = λvvᵀ`, `λ` = trace): `M / λ²`. Zero: zero.
+#[inline]
 pub fn symmetric_pseudo_inverse(m: &Matrix2<f64>) -> Matrix2<f64> {
     let (a, b, d) = (m[(0, 0)], 0.5 * (m[(0, 1)] + m[(1, 0)]), m[(1, 1)]);
     let trace = a + d;
@@ -101,6 +102,7 @@ pub fn symmetric_pseudo_inverse(m: &Matrix2<f64>) -> Matrix2<f64> {
 /// `[[P̄, P̄Bᵀ], [BP̄, C + BP̄Bᵀ]]`. The mean's position becomes `p̄` and the non-position mean
 /// keeps the mode's own value, exactly as the paper writes it. The conditional distribution of
 /// `h` given the position (gain `B`, covariance `C`) is therefore unchanged.
+#[inline(always)]
 pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &PositionEstimate) {
     let p_pp = gaussian.position_covariance();
     let p_pp_pinv = symmetric_pseudo_inverse(&p_pp);
@@ -149,6 +151,7 @@ pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &Posi
 }
 
 /// Makes a covariance exactly symmetric by averaging it with its transpose.
+#[inline]
 pub fn symmetrize<const N: usize>(m: &mut SMatrix<f64, N, N>) {
     for r in 0..N {
         for c in (r + 1)..N {
@@ -209,6 +212,7 @@ pub struct UpdateTerms {
 
 /// [`kalman_update`] written straight into `posterior` (no temporary copies of the state), for
 /// the hot path. On error `posterior` holds unspecified values and must be discarded.
+#[inline(always)]
 pub fn kalman_update_into<const N: usize>(
     prior: &Gaussian<N>,
     z: DVec2,

@@ -102,11 +102,13 @@ pub struct Imm {
 
 /// Weighted mean and covariance with the spread-of-means term
 /// (`eq:mixed_pos`, `eq:mixed_pos_cov`); weights must sum to 1 over `modes`.
+#[inline]
 pub fn mix_positions(state: &ImmState, modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
     mix(&mode_positions(state, modes), modes, weights)
 }
 
 /// Every mode's position estimate (entries of modes outside `modes` are left at zero).
+#[inline]
 fn mode_positions(state: &ImmState, modes: ModeSet) -> [PositionEstimate; MODE_COUNT] {
     let mut positions = [PositionEstimate::default(); MODE_COUNT];
     for mode in modes.iter() {
@@ -116,6 +118,7 @@ fn mode_positions(state: &ImmState, modes: ModeSet) -> [PositionEstimate; MODE_C
 }
 
 /// [`mix_positions`] on positions already extracted.
+#[inline]
 fn mix(positions: &[PositionEstimate; MODE_COUNT], modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
     let mut mean = DVec2::ZERO;
     for mode in modes.iter() {
@@ -136,6 +139,7 @@ fn outer(a: DVec2, b: DVec2) -> DMat2 {
 
 /// One mode's Kalman update from `prior` into `posterior` and its log-likelihood; an inactive
 /// mode is copied unchanged.
+#[inline(always)]
 fn update_mode<const N: usize, M: MotionModel<N>>(
     prior: &Gaussian<N>,
     posterior: &mut Gaussian<N>,
@@ -154,6 +158,7 @@ fn update_mode<const N: usize, M: MotionModel<N>>(
 
 /// One mode's start (its posterior with the mixed position written in, `eq:mixed_state` …
 /// `eq:reconstructed_cov`) predicted into `prior`.
+#[inline(always)]
 fn mix_and_predict<const N: usize, M: MotionModel<N>>(
     model: &M,
     posterior: &Gaussian<N>,
@@ -222,6 +227,7 @@ impl Imm {
     }
 
     /// Prior mode probabilities `c_j = Σ_i π_ij μ_i` (`eq:prior_mode_prob`).
+    #[inline]
     pub fn prior_probabilities(&self, posterior: &ModeProbabilities) -> ModeProbabilities {
         let mut c = [0.0; MODE_COUNT];
         for to in self.modes.iter() {
@@ -231,6 +237,7 @@ impl Imm {
     }
 
     /// Mixing probabilities `β_ij = π_ij μ_i / c_j` (`eq:mixing_prob`) into mode `to`.
+    #[inline]
     pub fn mixing_probabilities(&self, posterior: &ModeProbabilities, prior: &ModeProbabilities, to: Mode) -> ModeProbabilities {
         let mut beta = [0.0; MODE_COUNT];
         let c = prior[to.index()];
@@ -266,6 +273,7 @@ impl Imm {
     /// [`predict_physics`](Self::predict_physics) written into `prior` in place (no copy of the
     /// multi-mode state). `prior.available` and `prior.fused` are only meaningful after
     /// [`complete_prior_in_place`](Self::complete_prior_in_place).
+    #[inline(always)]
     pub fn predict_physics_into(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64, prior: &mut ImmPrior) {
         let c = self.prior_probabilities(&posterior.probabilities);
         let positions = mode_positions(posterior, self.modes);
@@ -323,6 +331,7 @@ impl Imm {
 
     /// [`complete_prior`](Self::complete_prior) on a prior filled by
     /// [`predict_physics_into`](Self::predict_physics_into) for the same `dt_s`.
+    #[inline(always)]
     pub fn complete_prior_in_place(&self, models: &ModeModels, prior: &mut ImmPrior, dt_s: f64, displacement_m: Option<DVec2>) {
         let state = &mut prior.state;
         if self.modes.contains(Mode::Learned) {
@@ -350,6 +359,7 @@ impl Imm {
 
     /// [`update`](Self::update) written into `posterior` in place. On error `posterior` holds
     /// the prior's state (the track coasts; nothing half-updated is left behind).
+    #[inline(always)]
     pub fn update_into(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2, posterior: &mut ImmState) -> Result<(), UpdateError> {
         match self.update_modes(models, prior, z, posterior) {
             Ok(log_likelihood) => {
@@ -367,6 +377,7 @@ impl Imm {
 
     /// Each mode's Kalman update from `prior` into `posterior` (inactive modes are copied);
     /// the log-likelihoods. Stops at the first failing mode.
+    #[inline(always)]
     fn update_modes(
         &self,
         models: &ModeModels,
@@ -412,6 +423,7 @@ impl Imm {
 
     /// `μ_i ∝ Λ_i^τ c_i` over the available modes (`eq:mode_update`), in log space; a mode that
     /// sat the step out keeps its prior probability; then the floor.
+    #[inline(always)]
     pub fn updated_probabilities(
         &self,
         prior: &ModeProbabilities,
@@ -466,6 +478,7 @@ impl Imm {
 
     /// Raises every active mode's probability to at least the floor and renormalises, keeping
     /// the floored modes at exactly the floor.
+    #[inline]
     pub fn apply_floor(&self, mut mu: ModeProbabilities) -> ModeProbabilities {
         if self.floor <= 0.0 || self.modes.iter().all(|mode| mu[mode.index()] >= self.floor) {
             return mu;
@@ -494,6 +507,7 @@ impl Imm {
 }
 
 /// `weights` restricted to `modes` and renormalised to sum to 1 (uniform if they sum to 0).
+#[inline]
 pub fn renormalised(weights: &ModeProbabilities, modes: ModeSet) -> ModeProbabilities {
     let sum: f64 = modes.iter().map(|m| weights[m.index()]).sum();
     let mut result = [0.0; MODE_COUNT];

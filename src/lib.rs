@@ -7,6 +7,7 @@ pub mod eval;
 pub mod gaussian;
 pub mod imm;
 pub mod io;
+pub mod kernels;
 pub mod measurement;
 pub mod mode;
 pub mod motion;

@@ -9,7 +9,9 @@
 use crate::association::assignment::AssignmentError;
 use crate::association::associator::Associator;
 use crate::config::{Config, ConfigError};
+use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
+use crate::kernels;
 use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::motion::ModeModels;
 use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
@@ -109,6 +111,10 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// Interval of the current frame, s.
     dt_s: f64,
     track_to_measurement: Box<[Option<u16>; MAX_TRACKS]>,
+    /// Each track's measured position of the current frame, m (`None`: no measurement).
+    measured_positions: Box<[Option<DVec2>; MAX_TRACKS]>,
+    /// Each track's update outcome of the current frame.
+    update_outcomes: Box<[Result<(), UpdateError>; MAX_TRACKS]>,
     rows: Box<[RowRecord; MAX_TRACKS]>,
     fates: Box<[MeasurementFate; MAX_MEASUREMENTS_PER_FRAME]>,
     accepted: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
@@ -140,6 +146,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
             dt_s: 0.0,
             track_to_measurement: Box::new([None; MAX_TRACKS]),
+            measured_positions: Box::new([None; MAX_TRACKS]),
+            update_outcomes: Box::new([Ok(()); MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
             accepted: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
@@ -249,10 +257,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// Mixing and the CV, CA and CT predictions, while the predictor works.
     fn predict_physics(&mut self, dt_s: f64) {
         self.dt_s = dt_s;
-        for (track, prior) in self.table.tracks().iter().zip(self.priors.iter_mut()) {
-            let models = &self.models[track.class.index()];
-            self.imm.predict_physics_into(models, &track.estimate, dt_s, prior);
-        }
+        kernels::predict_physics(&self.imm, &self.models, self.table.tracks(), dt_s, &mut self.priors[..]);
     }
 
     /// Collects the displacements; the PR priors and the fused priors (`eq:prior_fusion`).
@@ -267,10 +272,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.stats.learned_predictions_missing += missing;
             self.stats.frames_with_learned_predictions_missing += u64::from(missing > 0);
         }
-        for (i, (track, prior)) in self.table.tracks().iter().zip(self.priors.iter_mut()).enumerate() {
-            let models = &self.models[track.class.index()];
-            self.imm.complete_prior_in_place(models, prior, self.dt_s, displacements[i]);
-        }
+        kernels::complete_priors(&self.imm, &self.models, self.table.tracks(), self.dt_s, displacements, &mut self.priors[..]);
     }
 
     /// Per-class gated optimal assignment (`eq:association_cost`).
@@ -288,24 +290,39 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Kalman and mode-probability update of every assigned track.
     fn update<F: FrameView + ?Sized>(&mut self, frame: &F, t: f64) {
+        let count = self.table.len();
+        for i in 0..count {
+            let measurement = self.track_to_measurement[i].map(|index| frame.measurement(usize::from(index)));
+            self.measured_positions[i] = match measurement {
+                None => None,
+                Some(Ok(measurement)) => Some(measurement.position()),
+                Some(Err(_)) => {
+                    // Cannot happen for an accepted measurement; coast rather than keep a stale state.
+                    self.track_to_measurement[i] = None;
+                    None
+                }
+            };
+        }
+        kernels::update(
+            &self.imm,
+            &self.models,
+            self.table.tracks_mut(),
+            &self.priors[..count],
+            &self.measured_positions[..count],
+            &mut self.update_outcomes[..count],
+        );
         let confirmation_hits = self.config.tracker.confirmation_hits;
         for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
             let Some(index) = self.track_to_measurement[i] else { continue };
             let index = usize::from(index);
-            let Ok(measurement) = frame.measurement(index) else {
-                // Cannot happen for an accepted measurement; coast rather than keep a stale state.
-                self.track_to_measurement[i] = None;
-                continue;
-            };
-            let models = &self.models[track.class.index()];
-            match self.imm.update_into(models, &self.priors[i], measurement.position(), &mut track.estimate) {
-                Ok(()) => {
+            match (self.update_outcomes[i], frame.measurement(index)) {
+                (Ok(()), Ok(measurement)) => {
                     let was_confirmed = track.status == TrackStatus::Confirmed;
                     track.record_hit(&measurement, t, confirmation_hits);
                     self.stats.tracks_confirmed += u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);
                     self.fates[index] = MeasurementFate::Assigned;
                 }
-                Err(_) => {
+                _ => {
                     // Numerically unusable: the track coasts and the measurement is free to
                     // start a track of its own.
                     self.stats.update_failures += 1;

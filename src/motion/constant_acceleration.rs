@@ -66,6 +66,7 @@ impl ConstantAcceleration {
     }
 
     /// `covariance += Q(Δt)`, touching only `Q`'s eighteen non-zero entries.
+    #[inline]
     pub fn add_process_noise(&self, covariance: &mut Matrix6<f64>, dt: f64) {
         let q = self.jerk_psd_m2_per_s5;
         let (dt2, dt3) = (dt * dt, dt * dt * dt);
@@ -99,6 +100,7 @@ impl MotionModel<6> for ConstantAcceleration {
         prior
     }
 
+    #[inline(always)]
     fn predict_in_place(&self, estimate: &mut Gaussian<6>, context: &PredictContext) {
         let dt = context.dt_s;
         let half_dt2 = 0.5 * dt * dt;

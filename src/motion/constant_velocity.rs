@@ -50,6 +50,7 @@ impl ConstantVelocity {
     }
 
     /// `covariance += Q(Δt)`, touching only `Q`'s eight non-zero entries.
+    #[inline]
     pub fn add_process_noise(&self, covariance: &mut Matrix4<f64>, dt: f64) {
         super::add_white_acceleration(covariance, self.acceleration_psd_m2_per_s3, dt);
     }
@@ -66,6 +67,7 @@ impl MotionModel<4> for ConstantVelocity {
         prior
     }
 
+    #[inline(always)]
     fn predict_in_place(&self, estimate: &mut Gaussian<4>, context: &PredictContext) {
         let dt = context.dt_s;
         // F = transition(dt), applied through its two off-diagonal terms.

@@ -62,6 +62,7 @@ pub fn turn_functions(phi: f64) -> (f64, f64, f64, f64) {
 }
 
 /// Taylor series of [`turn_functions`] around `φ = 0` (exact to `O(φ⁶)`).
+#[inline]
 pub fn turn_functions_series(phi: f64) -> (f64, f64, f64, f64) {
     let p2 = phi * phi;
     let s = 1.0 - p2 / 6.0 + p2 * p2 / 120.0;
@@ -78,6 +79,7 @@ pub fn turn_functions_closed_form(phi: f64) -> (f64, f64, f64, f64) {
 }
 
 /// The closed forms from `sin φ` and `cos φ` already at hand.
+#[inline]
 fn closed_form_from(phi: f64, sin: f64, cos: f64) -> (f64, f64, f64, f64) {
     let s = sin / phi;
     let g = (1.0 - cos) / phi;
@@ -99,6 +101,7 @@ struct TurnTerms {
 }
 
 impl TurnTerms {
+    #[inline]
     fn new(state: &Vector5, dt: f64) -> Self {
         let phi = state[index::OMEGA] * dt;
         let (sin, cos) = phi.sin_cos();
@@ -107,6 +110,7 @@ impl TurnTerms {
         Self { sin, cos, s, g, ds, dg }
     }
 
+    #[inline]
     fn transition(&self, state: &Vector5, dt: f64) -> Vector5 {
         let (vx, vy) = (state[index::VX], state[index::VY]);
         let Self { sin, cos, s, g, .. } = *self;
@@ -121,6 +125,7 @@ impl TurnTerms {
 
     /// The Jacobian's rows x, y, vx and vy over the columns vx, vy and ω (its other entries
     /// are those of the identity).
+    #[inline]
     fn jacobian_rows(&self, state: &Vector5, dt: f64) -> JacobianRows {
         let (vx, vy) = (state[index::VX], state[index::VY]);
         let Self { sin, cos, s, g, ds, dg } = *self;
@@ -153,6 +158,7 @@ impl JacobianRows {
     /// `P ← J P Jᵀ` in place: rows first (`J P`), then columns (`(J P) Jᵀ`). Each pass reads a
     /// row's (column's) vx, vy and ω entries before writing any of them, and x, y, vx, vy are
     /// the only ones written; 2 × 5 × 12 multiply-adds.
+    #[inline(always)]
     fn propagate_covariance(&self, p: &mut Matrix5) {
         let j = &self.0;
         let (vx, vy, w) = (index::VX, index::VY, index::OMEGA);
@@ -209,6 +215,7 @@ impl CoordinatedTurn {
     }
 
     /// `covariance += Q(Δt)`, touching only `Q`'s nine non-zero entries.
+    #[inline]
     pub fn add_process_noise(&self, covariance: &mut Matrix5, dt: f64) {
         add_white_acceleration(covariance, self.acceleration_psd_m2_per_s3, dt);
         covariance[(index::OMEGA, index::OMEGA)] += self.turn_rate_psd_rad2_per_s3 * dt;
@@ -228,6 +235,7 @@ impl MotionModel<5> for CoordinatedTurn {
         prior
     }
 
+    #[inline(always)]
     fn predict_in_place(&self, estimate: &mut Gaussian<5>, context: &PredictContext) {
         let dt = context.dt_s;
         // One evaluation of sin/cos serves both the mean and the Jacobian.

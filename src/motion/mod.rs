@@ -155,6 +155,7 @@ pub(crate) fn initiate_position_velocity<const N: usize>(
 /// dense products (CV has 2 such terms, CA 6), for terms in which no source is the target of an
 /// earlier term (then every term still reads unpropagated values; true for CV and CA in their natural
 /// order: position from velocity and acceleration first, then velocity from acceleration).
+#[inline(always)]
 pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, terms: &[(usize, usize, f64)]) {
     debug_assert!(
         terms.iter().enumerate().all(|(i, &(_, source, _))| terms[..i].iter().all(|&(target, _, _)| target != source)),
@@ -176,6 +177,7 @@ pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, ter
 
 /// `covariance += q·Q_axis(Δt)` on both axes' `[position, velocity]` pairs (indices 0/2 and
 /// 1/3, as CV and CT lay out their states), for acceleration PSD `q` m²/s³.
+#[inline]
 pub(crate) fn add_white_acceleration<const N: usize>(covariance: &mut nalgebra::SMatrix<f64, N, N>, q: f64, dt: f64) {
     let block = white_acceleration_block(dt);
     for (position, velocity) in [(0, 2), (1, 3)] {
@@ -187,6 +189,7 @@ pub(crate) fn add_white_acceleration<const N: usize>(covariance: &mut nalgebra::
 }
 
 /// Continuous white-noise acceleration covariance of one axis' `[position, velocity]`, per unit PSD.
+#[inline]
 pub(crate) fn white_acceleration_block(dt: f64) -> [[f64; 2]; 2] {
     let dt2 = dt * dt;
     [[dt2 * dt / 3.0, dt2 / 2.0], [dt2 / 2.0, dt]]
