@@ -23,7 +23,7 @@ fn load(path: &str, batch: Option<usize>) -> TractResult<std::sync::Arc<TypedSim
         subs.insert(sym, (n as i64).to_dim());
         typed = typed.set_symbols(&subs)?;
     }
-    Ok(typed.into_optimized()?.into_runnable()?)
+    typed.into_optimized()?.into_runnable()
 }
 
 fn main() -> TractResult<()> {
@@ -50,7 +50,7 @@ fn main() -> TractResult<()> {
     let total = start.elapsed() / runs;
     let model = plan.model();
     let mut rows: Vec<(usize, Duration)> = per_node.into_iter().collect();
-    rows.sort_by(|a, b| b.1.cmp(&a.1));
+    rows.sort_by_key(|row| std::cmp::Reverse(row.1));
     let sum: Duration = rows.iter().map(|r| r.1).sum::<Duration>() / runs;
     println!("model {path}, batch {batch}: {} nodes, {:.1} us per run ({:.2} us/sample), nodes sum {:.1} us", model.nodes().len(), total.as_secs_f64() * 1e6, total.as_secs_f64() * 1e6 / batch as f64, sum.as_secs_f64() * 1e6);
     let mut by_op: HashMap<String, (Duration, usize)> = HashMap::new();
@@ -60,7 +60,7 @@ fn main() -> TractResult<()> {
         e.1 += 1;
     }
     let mut ops: Vec<_> = by_op.into_iter().collect();
-    ops.sort_by(|a, b| b.1 .0.cmp(&a.1 .0));
+    ops.sort_by_key(|op| std::cmp::Reverse(op.1 .0));
     println!("by op type (us per run, count):");
     for (op, (d, n)) in ops.iter().take(15) {
         println!("  {:>8.1}  {:>3}  {}", d.as_secs_f64() * 1e6, n, op);
