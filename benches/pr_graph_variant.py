@@ -27,82 +27,49 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "training"))
 import onnx  # noqa: E402
 import onnx_graph as og  # noqa: E402
-from onnx import TensorProto, helper, numpy_helper  # noqa: E402
 
-MAXH, F, Q, T = og.MAX_HISTORY, og.FEATURES, og.QUERIES, og.TOKENS
+QUERIES, TOKENS = og.QUERIES, og.TOKENS
 
 
 def build(weights, heads):
-    w = {k: np.asarray(v, np.float32) for k, v in weights.items()}
-    d = w["token_table"].shape[1]; dh = d // heads
+    """The batch-folded graph of the trained ``weights`` (same inputs and output as the shipped one)."""
+    g = og.GraphBuilder(weights)
+    w, d, node, const = g.w, g.d, g.node, g.const
+    dh = d // heads
     scale = np.float32(1 / np.sqrt(dh))
-    nodes, inits = [], []
-    def const(name, value):
-        inits.append(numpy_helper.from_array(np.asarray(value), name)); return name
-    def node(op, inputs, name, **a):
-        nodes.append(helper.make_node(op, inputs, [name], name=name, **a)); return name
-    def ln(x, p, out):
-        return node("LayerNormalization", [x, const(p+".weight", w[p+".weight"]), const(p+".bias", w[p+".bias"])], out, axis=-1, epsilon=1e-5)
-    def linear(x, p, out, weight=None, bias=None):
-        weight = w[p+".weight"].T if weight is None else weight
-        bias = w[p+".bias"] if bias is None else bias
-        pr = node("MatMul", [x, const(p+".weight_t", np.ascontiguousarray(weight))], out+"_product")
-        return node("Add", [pr, const(p+".bias_row", np.asarray(bias, np.float32))], out)
-    x = node("Sub", ["features", const("feature_mean", w["feature_mean"])], "centred")
-    x = node("Mul", [x, const("feature_inv_std", w["feature_inv_std"])], "normalised")
-    x = node("Pad", [x, const("token_pad", np.array([0,0,0,0,Q,0], np.int64))], "padded")
-    x = node("MatMul", [x, const("embedding.weight_t", np.ascontiguousarray(w["embedding.weight"].T))], "embedded")
-    tokens = node("Add", [x, const("token_table", w["token_table"])], "tokens_0")
-    kv = node("Pad", ["valid", const("key_pad", np.array([0,0,0,Q], np.int64)), const("one", np.float32(1))], "key_valid_rows")
-    kv = node("Transpose", [kv], "key_valid_t", perm=[1,0])  # [7,B]
-    kv = node("Unsqueeze", [kv, const("axes_23", np.array([2,3], np.int64))], "key_valid")  # [7,B,1,1]
-    head_sum = np.zeros((d, heads), np.float32)
-    for h in range(heads): head_sum[h*dh:(h+1)*dh, h] = 1
-    L = og.layer_count(weights)
-    for i in range(L):
-        p = f"layers.{i}"; last = i == L-1; tq = Q if last else T
-        normed = ln(tokens, f"{p}.norm_attention", f"{p}.normed")
-        if last:
-            s, e, ax = const(f"{p}.qs", np.array([MAXH], np.int64)), const(f"{p}.qe", np.array([T], np.int64)), const(f"{p}.qa", np.array([1], np.int64))
-            queries = node("Slice", [normed, s, e, ax], f"{p}.query_rows")
-            tokens = node("Slice", [tokens, s, e, ax], f"{p}.query_tokens")
-        else:
-            queries = normed
-        q = linear(queries, f"{p}.attention.query", f"{p}.q", w[f"{p}.attention.query.weight"].T*scale, w[f"{p}.attention.query.bias"]*scale)  # [B,tq,d]
-        nt = node("Transpose", [normed], f"{p}.normed_t", perm=[1,0,2])  # [7,B,d]
-        k = linear(nt, f"{p}.attention.key", f"{p}.k")  # [7,B,d]
-        v = linear(nt, f"{p}.attention.value", f"{p}.v")
-        k = node("Unsqueeze", [k, const(f"{p}.ax2", np.array([2], np.int64))], f"{p}.k4")  # [7,B,1,d]
+    tokens = g.embedded_tokens()
+    key_valid = node("Transpose", [g.key_valid_rows()], "key_valid_t", perm=[1, 0])  # [7, B]
+    key_valid = node("Unsqueeze", [key_valid, const("axes_23", np.array([2, 3], np.int64))], "key_valid")  # [7, B, 1, 1]
+    head_sum = np.zeros((d, heads), np.float32)  # channel -> its head
+    for h in range(heads):
+        head_sum[h * dh : (h + 1) * dh, h] = 1
+    layers = og.layer_count(weights)
+    for index in range(layers):
+        p = f"layers.{index}"
+        normed = g.layer_norm(tokens, f"{p}.norm_attention", f"{p}.normed")
+        queries, tokens = g.query_rows(normed, tokens, p) if index == layers - 1 else (normed, tokens)
+        q = g.linear(queries, f"{p}.attention.query", f"{p}.q", w[f"{p}.attention.query.weight"].T * scale, w[f"{p}.attention.query.bias"] * scale)  # [B, Tq, d]
+        key_first = node("Transpose", [normed], f"{p}.normed_t", perm=[1, 0, 2])  # [7, B, d]
+        k = g.linear(key_first, f"{p}.attention.key", f"{p}.k")
+        v = g.linear(key_first, f"{p}.attention.value", f"{p}.v")
+        k = node("Unsqueeze", [k, const(f"{p}.ax2", np.array([2], np.int64))], f"{p}.k4")  # [7, B, 1, d]
         v = node("Unsqueeze", [v, const(f"{p}.ax2v", np.array([2], np.int64))], f"{p}.v4")
         # Keys and values repeated once per query row: [7, B, Tq, d].
         shape = node("Shape", [q], f"{p}.qshape")  # [B, Tq, d]
-        full = node("Concat", [const(f"{p}.seven", np.array([T], np.int64)), shape], f"{p}.repshape", axis=0)
+        full = node("Concat", [const(f"{p}.seven", np.array([TOKENS], np.int64)), shape], f"{p}.repshape", axis=0)
         k = node("Expand", [k, full], f"{p}.k_rep")
         v = node("Expand", [v, full], f"{p}.v_rep")
-        prod = node("Mul", [k, q], f"{p}.qk")  # [7,B,tq,d]
-        scores = node("MatMul", [prod, const(f"{p}.head_sum", head_sum)], f"{p}.scores")  # [7,B,tq,H]
-        ex = node("Exp", [scores], f"{p}.exp")
-        ex = node("Mul", [ex, kv], f"{p}.exp_masked")
-        tot = node("ReduceSum", [ex, const(f"{p}.ax0", np.array([0], np.int64))], f"{p}.total", keepdims=1)
-        att = node("Div", [ex, tot], f"{p}.weights")
-        att = node("MatMul", [att, const(f"{p}.head_expand", np.ascontiguousarray(head_sum.T))], f"{p}.weights_c")  # [7,B,tq,d]
-        mixed = node("Mul", [att, v], f"{p}.weighted_values")
-        mixed = node("ReduceSum", [mixed, const(f"{p}.ax0b", np.array([0], np.int64))], f"{p}.mixed4", keepdims=0)  # [B,tq,d]
-        attended = linear(mixed, f"{p}.attention.output", f"{p}.attended")
-        tokens = node("Add", [tokens, attended], f"{p}.residual_attention")
-        hidden = linear(ln(tokens, f"{p}.norm_ff", f"{p}.normed_ff"), f"{p}.ff_in", f"{p}.ff_hidden")
-        hidden = node("Relu", [hidden], f"{p}.ff_relu")
-        tokens = node("Add", [tokens, linear(hidden, f"{p}.ff_out", f"{p}.ff_output")], f"{p}.residual_ff")
-    out = ln(tokens, "final_norm", "final_normed")
-    out = node("Reshape", [out, const("flat_shape", np.array([-1, Q*d], np.int64))], "flat")
-    head = np.zeros((Q*d, 2), np.float32); head[:d,0] = w["head_x.weight"][0]; head[d:,1] = w["head_y.weight"][0]
-    bias = np.array([w["head_x.bias"][0], w["head_y.bias"][0]], np.float32)
-    out = linear(out, "head", "head_output", head, bias)
-    node("Mul", [out, const("output_scale", w["output_scale"])], "displacement")
-    g = helper.make_graph(nodes, "pr", [helper.make_tensor_value_info("features", TensorProto.FLOAT, ["batch", MAXH, F]), helper.make_tensor_value_info("valid", TensorProto.FLOAT, ["batch", MAXH])], [helper.make_tensor_value_info("displacement", TensorProto.FLOAT, ["batch", 2])], inits)
-    m = helper.make_model(g, opset_imports=[helper.make_opsetid("", 17)]); m.ir_version = 8
-    onnx.checker.check_model(m, full_check=True)
-    return m
+        product = node("Mul", [k, q], f"{p}.qk")  # [7, B, Tq, d]
+        scores = node("MatMul", [product, const(f"{p}.head_sum", head_sum)], f"{p}.scores")  # [7, B, Tq, H]
+        e = node("Exp", [scores], f"{p}.exp")
+        e = node("Mul", [e, key_valid], f"{p}.exp_masked")
+        total = node("ReduceSum", [e, const(f"{p}.ax0", np.array([0], np.int64))], f"{p}.total", keepdims=1)
+        attention = node("Div", [e, total], f"{p}.weights")
+        attention = node("MatMul", [attention, const(f"{p}.head_expand", np.ascontiguousarray(head_sum.T))], f"{p}.weights_c")  # [7, B, Tq, d]
+        mixed = node("Mul", [attention, v], f"{p}.weighted_values")
+        mixed = node("ReduceSum", [mixed, const(f"{p}.ax0b", np.array([0], np.int64))], f"{p}.mixed4", keepdims=0)  # [B, Tq, d]
+        tokens = g.feed_forward(tokens, g.linear(mixed, f"{p}.attention.output", f"{p}.attended"), p)
+    return g.model(tokens)
 
 
 def main() -> int:

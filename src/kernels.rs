@@ -10,7 +10,7 @@
 
 use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
-use crate::measurement::ObjectClass;
+use crate::measurement::{Measurement, ObjectClass};
 use crate::motion::ModeModels;
 use crate::track::Track;
 use glam::DVec2;
@@ -43,7 +43,7 @@ pub fn complete_priors(
     }
 }
 
-/// The IMM update of every track that has a measured position in `positions_m` (same order as
+/// The IMM update of every track that has a measurement in `measurements` (same order as
 /// `tracks`); `outcomes[i]` is the result for track `i` (`Ok` for tracks without measurement,
 /// which are left untouched). A failed update leaves the track at its prior.
 #[multiversion(targets("x86_64+avx+avx2+fma"))]
@@ -52,12 +52,12 @@ pub fn update(
     models: &ClassModels,
     tracks: &mut [Track],
     priors: &[ImmPrior],
-    positions_m: &[Option<DVec2>],
+    measurements: &[Option<Measurement>],
     outcomes: &mut [Result<(), UpdateError>],
 ) {
-    for (((track, prior), position), outcome) in tracks.iter_mut().zip(priors).zip(positions_m).zip(outcomes.iter_mut()) {
-        *outcome = match position {
-            Some(z) => imm.update_into(&models[track.class.index()], prior, *z, &mut track.estimate),
+    for (((track, prior), measurement), outcome) in tracks.iter_mut().zip(priors).zip(measurements).zip(outcomes.iter_mut()) {
+        *outcome = match measurement {
+            Some(z) => imm.update_into(&models[track.class.index()], prior, z.position(), &mut track.estimate),
             None => Ok(()),
         };
     }

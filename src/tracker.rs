@@ -12,7 +12,7 @@ use crate::config::{Config, ConfigError};
 use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
 use crate::kernels;
-use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::motion::ModeModels;
 use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::track::{Track, TrackOutput, TrackStatus};
@@ -111,8 +111,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// Interval of the current frame, s.
     dt_s: f64,
     track_to_measurement: Box<[Option<u16>; MAX_TRACKS]>,
-    /// Each track's measured position of the current frame, m (`None`: no measurement).
-    measured_positions: Box<[Option<DVec2>; MAX_TRACKS]>,
+    /// Each track's assigned measurement of the current frame (`None`: none).
+    assigned_measurements: Box<[Option<Measurement>; MAX_TRACKS]>,
     /// Each track's update outcome of the current frame.
     update_outcomes: Box<[Result<(), UpdateError>; MAX_TRACKS]>,
     rows: Box<[RowRecord; MAX_TRACKS]>,
@@ -146,7 +146,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
             dt_s: 0.0,
             track_to_measurement: Box::new([None; MAX_TRACKS]),
-            measured_positions: Box::new([None; MAX_TRACKS]),
+            assigned_measurements: Box::new([None; MAX_TRACKS]),
             update_outcomes: Box::new([Ok(()); MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
@@ -292,42 +292,37 @@ impl<P: DisplacementPredictor> Tracker<P> {
     fn update<F: FrameView + ?Sized>(&mut self, frame: &F, t: f64) {
         let count = self.table.len();
         for i in 0..count {
-            let measurement = self.track_to_measurement[i].map(|index| frame.measurement(usize::from(index)));
-            self.measured_positions[i] = match measurement {
-                None => None,
-                Some(Ok(measurement)) => Some(measurement.position()),
-                Some(Err(_)) => {
-                    // Cannot happen for an accepted measurement; coast rather than keep a stale state.
-                    self.track_to_measurement[i] = None;
-                    None
-                }
-            };
+            // An accepted measurement always reads back; if one did not, the track coasts rather
+            // than keep a stale state.
+            self.assigned_measurements[i] =
+                self.track_to_measurement[i].and_then(|index| frame.measurement(usize::from(index)).ok());
+            if self.assigned_measurements[i].is_none() {
+                self.track_to_measurement[i] = None;
+            }
         }
         kernels::update(
             &self.imm,
             &self.models,
             self.table.tracks_mut(),
             &self.priors[..count],
-            &self.measured_positions[..count],
+            &self.assigned_measurements[..count],
             &mut self.update_outcomes[..count],
         );
         let confirmation_hits = self.config.tracker.confirmation_hits;
         for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
-            let Some(index) = self.track_to_measurement[i] else { continue };
-            let index = usize::from(index);
-            match (self.update_outcomes[i], frame.measurement(index)) {
-                (Ok(()), Ok(measurement)) => {
-                    let was_confirmed = track.status == TrackStatus::Confirmed;
-                    track.record_hit(&measurement, t, confirmation_hits);
-                    self.stats.tracks_confirmed += u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);
-                    self.fates[index] = MeasurementFate::Assigned;
-                }
-                _ => {
-                    // Numerically unusable: the track coasts and the measurement is free to
-                    // start a track of its own.
-                    self.stats.update_failures += 1;
-                    self.track_to_measurement[i] = None;
-                }
+            let (Some(index), Some(measurement)) = (self.track_to_measurement[i], self.assigned_measurements[i]) else {
+                continue;
+            };
+            if self.update_outcomes[i].is_ok() {
+                let was_confirmed = track.status == TrackStatus::Confirmed;
+                track.record_hit(&measurement, t, confirmation_hits);
+                self.stats.tracks_confirmed += u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);
+                self.fates[usize::from(index)] = MeasurementFate::Assigned;
+            } else {
+                // Numerically unusable: the track coasts and the measurement is free to start a
+                // track of its own.
+                self.stats.update_failures += 1;
+                self.track_to_measurement[i] = None;
             }
         }
     }

@@ -5,13 +5,13 @@
 
 mod common;
 
-use common::{lanes, scene_frames};
+use common::{lanes, measurement, scene_frames};
 use glam::DVec2;
 use primm::config::Config;
 use primm::gaussian::UpdateError;
 use primm::imm::{Imm, ImmPrior};
 use primm::kernels::{self, ClassModels};
-use primm::measurement::ObjectClass;
+use primm::measurement::{Measurement, ObjectClass};
 use primm::mode::Method;
 use primm::motion::ModeModels;
 use primm::track::Track;
@@ -65,18 +65,18 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
         assert_eq!(bits(&dispatched), bits(&plain), "{method}: complete_priors");
 
         // Every fourth track without a measurement; the others measured 0.3 m off their prior.
-        let positions: Vec<Option<DVec2>> = plain
+        let measurements: Vec<Option<Measurement>> = plain
             .iter()
             .enumerate()
-            .map(|(i, prior)| (i % 4 != 0).then(|| prior.fused.mean + DVec2::new(0.3, -0.2)))
+            .map(|(i, prior)| (i % 4 != 0).then(|| measurement(prior.fused.mean.x + 0.3, prior.fused.mean.y - 0.2, 1.0)))
             .collect();
         let mut dispatched_tracks = tracks.clone();
         let mut outcomes = vec![Err(UpdateError); tracks.len()];
-        kernels::update(&imm, &models, &mut dispatched_tracks, &dispatched, &positions, &mut outcomes);
+        kernels::update(&imm, &models, &mut dispatched_tracks, &dispatched, &measurements, &mut outcomes);
         let mut plain_tracks = tracks.clone();
         for (i, track) in plain_tracks.iter_mut().enumerate() {
-            let expected = match positions[i] {
-                Some(z) => imm.update_into(&models[track.class.index()], &plain[i], z, &mut track.estimate),
+            let expected = match measurements[i] {
+                Some(z) => imm.update_into(&models[track.class.index()], &plain[i], z.position(), &mut track.estimate),
                 None => Ok(()),
             };
             assert_eq!(outcomes[i], expected, "{method}: outcome of track {i}");

@@ -97,43 +97,107 @@ def reference_forward(weights: dict, features: np.ndarray, valid: np.ndarray, he
     return (out @ head + bias) * w["output_scale"]
 
 
+class GraphBuilder:
+    """Nodes and initializers of a PR graph under construction, plus the parts every graph form
+    shares: input normalisation and embedding, LayerNorm, linear layers, the feed-forward half of
+    an encoder layer, the output heads and the finished, checked model."""
+
+    def __init__(self, weights: dict):
+        self.w = {k: np.asarray(v, np.float32) for k, v in weights.items()}
+        self.d = self.w["token_table"].shape[1]
+        self.nodes, self.initializers = [], []
+
+    def const(self, name, value):
+        from onnx import numpy_helper
+
+        self.initializers.append(numpy_helper.from_array(np.asarray(value), name))
+        return name
+
+    def node(self, op, inputs, name, **attributes):
+        from onnx import helper
+
+        self.nodes.append(helper.make_node(op, inputs, [name], name=name, **attributes))
+        return name
+
+    def layer_norm(self, x, prefix, out):
+        w = self.w
+        return self.node("LayerNormalization", [x, self.const(prefix + ".weight", w[prefix + ".weight"]), self.const(prefix + ".bias", w[prefix + ".bias"])], out, axis=-1, epsilon=1e-5)
+
+    def linear(self, x, prefix, out, weight=None, bias=None):
+        weight = self.w[prefix + ".weight"].T if weight is None else weight
+        bias = self.w[prefix + ".bias"] if bias is None else bias
+        product = self.node("MatMul", [x, self.const(prefix + ".weight_t", np.ascontiguousarray(weight))], out + "_product")
+        return self.node("Add", [product, self.const(prefix + ".bias_row", bias)], out)
+
+    def embedded_tokens(self):
+        """Normalisation, two zero query rows, embedding plus the token table: ``[B, 7, d]``."""
+        w, node, const = self.w, self.node, self.const
+        x = node("Sub", ["features", const("feature_mean", w["feature_mean"])], "centred")
+        x = node("Mul", [x, const("feature_inv_std", w["feature_inv_std"])], "normalised")
+        x = node("Pad", [x, const("token_pad", np.array([0, 0, 0, 0, QUERIES, 0], np.int64))], "padded")
+        x = node("MatMul", [x, const("embedding.weight_t", np.ascontiguousarray(w["embedding.weight"].T))], "embedded")
+        return node("Add", [x, const("token_table", w["token_table"])], "tokens_0")
+
+    def key_valid_rows(self):
+        """1 for valid history rows and the two queries, 0 for padding: ``[B, 7]``."""
+        return self.node("Pad", ["valid", self.const("key_pad", np.array([0, 0, 0, QUERIES], np.int64)), self.const("one", np.float32(1.0))], "key_valid_rows")
+
+    def query_rows(self, normed, tokens, p):
+        """The last layer's two query rows of ``normed`` and ``tokens`` (axis 1)."""
+        starts, ends, axes = (self.const(f"{p}.q_start", np.array([MAX_HISTORY], np.int64)), self.const(f"{p}.q_end", np.array([TOKENS], np.int64)), self.const(f"{p}.q_axis", np.array([1], np.int64)))
+        queries = self.node("Slice", [normed, starts, ends, axes], f"{p}.query_rows")
+        return queries, self.node("Slice", [tokens, starts, ends, axes], f"{p}.query_tokens")
+
+    def feed_forward(self, tokens, attended, p):
+        """The attention residual, then LayerNorm, feed-forward block and its residual."""
+        node, linear = self.node, self.linear
+        tokens = node("Add", [tokens, attended], f"{p}.residual_attention")
+        hidden = linear(self.layer_norm(tokens, f"{p}.norm_ff", f"{p}.normed_ff"), f"{p}.ff_in", f"{p}.ff_hidden")
+        hidden = node("Relu", [hidden], f"{p}.ff_relu")
+        return node("Add", [tokens, linear(hidden, f"{p}.ff_out", f"{p}.ff_output")], f"{p}.residual_ff")
+
+    def model(self, tokens, doc: str = ""):
+        """Final LayerNorm, the two heads, the output scale; the checked opset-17 model with a
+        symbolic batch axis ``batch``."""
+        import onnx
+        from onnx import TensorProto, helper
+
+        w, d = self.w, self.d
+        out = self.layer_norm(tokens, "final_norm", "final_normed")
+        out = self.node("Reshape", [out, self.const("flat_shape", np.array([-1, QUERIES * d], np.int64))], "flat")
+        head = np.zeros((QUERIES * d, 2), np.float32)
+        head[:d, 0] = w["head_x.weight"][0]
+        head[d:, 1] = w["head_y.weight"][0]
+        bias = np.array([w["head_x.bias"][0], w["head_y.bias"][0]], np.float32)
+        out = self.linear(out, "head", "head_output", head, bias)
+        self.node("Mul", [out, self.const("output_scale", w["output_scale"])], "displacement")
+        batch = "batch"
+        graph = helper.make_graph(
+            self.nodes,
+            "pr",
+            [
+                helper.make_tensor_value_info("features", TensorProto.FLOAT, [batch, MAX_HISTORY, FEATURES]),
+                helper.make_tensor_value_info("valid", TensorProto.FLOAT, [batch, MAX_HISTORY]),
+            ],
+            [helper.make_tensor_value_info("displacement", TensorProto.FLOAT, [batch, 2])],
+            self.initializers,
+        )
+        model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="primm training/onnx_graph.py", doc_string=doc)
+        model.ir_version = 8
+        onnx.checker.check_model(model, full_check=True)
+        return model
+
+
 def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str = ""):
     """The ONNX model (opset 17, symbolic batch axis ``batch``) of the trained ``weights``."""
-    import onnx
-    from onnx import TensorProto, helper, numpy_helper
-
-    w = {k: np.asarray(v, np.float32) for k, v in weights.items()}
-    d = w["token_table"].shape[1]
+    g = GraphBuilder(weights)
+    w, d, node, const = g.w, g.d, g.node, g.const
     dh = d // heads
     scale = np.float32(1.0 / np.sqrt(dh))
-    nodes, initializers = [], []
 
-    def const(name, value):
-        initializers.append(numpy_helper.from_array(np.asarray(value), name))
-        return name
-
-    def node(op, inputs, name, **attributes):
-        nodes.append(helper.make_node(op, inputs, [name], name=name, **attributes))
-        return name
-
-    def layer_norm(x, prefix, out):
-        return node("LayerNormalization", [x, const(prefix + ".weight", w[prefix + ".weight"]), const(prefix + ".bias", w[prefix + ".bias"])], out, axis=-1, epsilon=1e-5)
-
-    def linear(x, prefix, out, weight=None, bias=None):
-        weight = w[prefix + ".weight"].T if weight is None else weight
-        bias = w[prefix + ".bias"] if bias is None else bias
-        product = node("MatMul", [x, const(prefix + ".weight_t", np.ascontiguousarray(weight))], out + "_product")
-        return node("Add", [product, const(prefix + ".bias_row", bias)], out)
-
-    # Normalisation, two zero query rows, embedding plus the token table.
-    x = node("Sub", ["features", const("feature_mean", w["feature_mean"])], "centred")
-    x = node("Mul", [x, const("feature_inv_std", w["feature_inv_std"])], "normalised")
-    x = node("Pad", [x, const("token_pad", np.array([0, 0, 0, 0, QUERIES, 0], np.int64))], "padded")
-    x = node("MatMul", [x, const("embedding.weight_t", np.ascontiguousarray(w["embedding.weight"].T))], "embedded")
-    tokens = node("Add", [x, const("token_table", w["token_table"])], "tokens_0")
-    # Key weights: 1 for valid history rows and the queries, 0 for padding; [B, 1, 7].
-    key_valid = node("Pad", ["valid", const("key_pad", np.array([0, 0, 0, QUERIES], np.int64)), const("one", np.float32(1.0))], "key_valid_rows")
-    key_valid = node("Unsqueeze", [key_valid, const("axis_1", np.array([1], np.int64))], "key_valid")
+    tokens = g.embedded_tokens()
+    # Key weights: [B, 1, 7].
+    key_valid = node("Unsqueeze", [g.key_valid_rows(), const("axis_1", np.array([1], np.int64))], "key_valid")
     ones = const("ones_7x7", np.ones((TOKENS, TOKENS), np.float32))
     head_mask = np.zeros((heads, d), np.float32)
     for h in range(heads):
@@ -144,22 +208,17 @@ def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str 
         p = f"layers.{index}"
         last = index == layers - 1
         tq = QUERIES if last else TOKENS
-        normed = layer_norm(tokens, f"{p}.norm_attention", f"{p}.normed")
-        if last:
-            starts, ends, axes = (const(f"{p}.q_start", np.array([MAX_HISTORY], np.int64)), const(f"{p}.q_end", np.array([TOKENS], np.int64)), const(f"{p}.q_axis", np.array([1], np.int64)))
-            queries = node("Slice", [normed, starts, ends, axes], f"{p}.query_rows")
-            tokens = node("Slice", [tokens, starts, ends, axes], f"{p}.query_tokens")
-        else:
-            queries = normed
+        normed = g.layer_norm(tokens, f"{p}.norm_attention", f"{p}.normed")
+        queries, tokens = g.query_rows(normed, tokens, p) if last else (normed, tokens)
         wq = w[f"{p}.attention.query.weight"].T * scale  # [d_in, d_out]
         bq = w[f"{p}.attention.query.bias"] * scale
         stacked_w = np.concatenate([wq * head_mask[h][None, :] for h in range(heads)], axis=1)  # [d, H*d]
         stacked_b = np.concatenate([bq * head_mask[h] for h in range(heads)])
-        q = linear(queries, f"{p}.attention.query_heads", f"{p}.q", stacked_w, stacked_b)
+        q = g.linear(queries, f"{p}.attention.query_heads", f"{p}.q", stacked_w, stacked_b)
         q = node("Reshape", [q, const(f"{p}.q_shape", np.array([-1, tq * heads, d], np.int64))], f"{p}.q_rows")
-        k = linear(normed, f"{p}.attention.key", f"{p}.k")
+        k = g.linear(normed, f"{p}.attention.key", f"{p}.k")
         k = node("Transpose", [k], f"{p}.k_t", perm=[0, 2, 1])
-        v = linear(normed, f"{p}.attention.value", f"{p}.v")
+        v = g.linear(normed, f"{p}.attention.value", f"{p}.v")
         scores = node("MatMul", [q, k], f"{p}.scores")
         if subtract_max:
             peak = node("ReduceMax", [scores, const(f"{p}.last_axis", np.array([-1], np.int64))], f"{p}.peak", keepdims=1)
@@ -172,36 +231,9 @@ def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str 
         mixed = node("Reshape", [mixed, const(f"{p}.mixed_shape", np.array([-1, tq, heads * d], np.int64))], f"{p}.mixed_heads")
         wo = w[f"{p}.attention.output.weight"].T  # [d_in, d_out]
         stacked_o = np.concatenate([wo * head_mask[h][:, None] for h in range(heads)], axis=0)  # [H*d, d]
-        attended = linear(mixed, f"{p}.attention.output", f"{p}.attended", stacked_o, w[f"{p}.attention.output.bias"])
-        tokens = node("Add", [tokens, attended], f"{p}.residual_attention")
-        hidden = linear(layer_norm(tokens, f"{p}.norm_ff", f"{p}.normed_ff"), f"{p}.ff_in", f"{p}.ff_hidden")
-        hidden = node("Relu", [hidden], f"{p}.ff_relu")
-        tokens = node("Add", [tokens, linear(hidden, f"{p}.ff_out", f"{p}.ff_output")], f"{p}.residual_ff")
-
-    out = layer_norm(tokens, "final_norm", "final_normed")
-    out = node("Reshape", [out, const("flat_shape", np.array([-1, QUERIES * d], np.int64))], "flat")
-    head = np.zeros((QUERIES * d, 2), np.float32)
-    head[:d, 0] = w["head_x.weight"][0]
-    head[d:, 1] = w["head_y.weight"][0]
-    bias = np.array([w["head_x.bias"][0], w["head_y.bias"][0]], np.float32)
-    out = linear(out, "head", "head_output", head, bias)
-    node("Mul", [out, const("output_scale", w["output_scale"])], "displacement")
-
-    batch = "batch"
-    graph = helper.make_graph(
-        nodes,
-        "pr",
-        [
-            helper.make_tensor_value_info("features", TensorProto.FLOAT, [batch, MAX_HISTORY, FEATURES]),
-            helper.make_tensor_value_info("valid", TensorProto.FLOAT, [batch, MAX_HISTORY]),
-        ],
-        [helper.make_tensor_value_info("displacement", TensorProto.FLOAT, [batch, 2])],
-        initializers,
-    )
-    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="primm training/onnx_graph.py", doc_string=doc)
-    model.ir_version = 8
-    onnx.checker.check_model(model, full_check=True)
-    return model
+        attended = g.linear(mixed, f"{p}.attention.output", f"{p}.attended", stacked_o, w[f"{p}.attention.output.bias"])
+        tokens = g.feed_forward(tokens, attended, p)
+    return g.model(tokens, doc)
 
 
 def weights_from_onnx(path: str, heads: int) -> dict:
