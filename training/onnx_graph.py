@@ -221,7 +221,8 @@ def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str 
         v = g.linear(normed, f"{p}.attention.value", f"{p}.v")
         scores = node("MatMul", [q, k], f"{p}.scores")
         if subtract_max:
-            peak = node("ReduceMax", [scores, const(f"{p}.last_axis", np.array([-1], np.int64))], f"{p}.peak", keepdims=1)
+            # Opset 17's ReduceMax takes its axes as an attribute (an input only from opset 18).
+            peak = node("ReduceMax", [scores], f"{p}.peak", axes=[-1], keepdims=1)
             scores = node("Sub", [scores, peak], f"{p}.shifted")
         e = node("Exp", [scores], f"{p}.exp")
         e = node("Mul", [e, key_valid], f"{p}.exp_masked")
