@@ -4,9 +4,8 @@
 //! primm's code on this path allocates nothing per frame (`tests/service_allocation.rs` counts
 //! it). What remains: iceoryx2 0.10's `Publisher::loan_uninit` allocates one 48-byte
 //! reference-counted handle per loaned sample (every loan path of 0.10 does; see
-//! `docs/service.md`), and, off the normal
-//! path, a logged warning (bounded by [`LogLimiter`]) and the setup of a connection when a port
-//! joins.
+//! `docs/service.md`), and, off the normal path, a logged warning (bounded by [`LogLimiter`])
+//! and the setup of a connection when a port joins.
 //!
 //! The loop waits on the measurement stream's iceoryx2 listener (event-driven, the default) or
 //! spins on the subscriber ([`WaitMode::BusyPoll`]). It does not use a `WaitSet` because
