@@ -1,17 +1,13 @@
 //! The IMM allocates nothing per step.
 
-mod common;
-#[path = "common/counting_allocator.rs"]
-mod counting_allocator;
+use crate::common;
+use crate::common::counting_allocator;
 
-use counting_allocator::{count_allocations, CountingAllocator};
+use counting_allocator::count_allocations;
 use glam::DVec2;
 use primm::config::Config;
 use primm::imm::Imm;
 use primm::motion::{ModeModels, PredictContext};
-
-#[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 #[test]
 fn ten_thousand_imm_cycles_allocate_nothing() {

@@ -1,6 +1,6 @@
 //! Filter consistency (NEES) and IMM behaviour on manoeuvres.
 
-mod common;
+use crate::common;
 
 use glam::DVec2;
 use nalgebra::Vector4;

@@ -2,7 +2,7 @@
 //! mode probabilities stay normalised above the floor, mixing and the position write-back do
 //! what `eq:mixed_pos` … `eq:reconstructed_cov` say.
 
-mod common;
+use crate::common;
 
 use glam::{DMat2, DVec2};
 use nalgebra::{Matrix2, SMatrix, SVector};

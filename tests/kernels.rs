@@ -3,7 +3,7 @@
 //! taken from a running tracker. On a CPU with AVX2 the kernels run their AVX2 version while
 //! the reference loops below are compiled for the baseline, so the comparison covers both.
 
-mod common;
+use crate::common;
 
 use common::{lanes, measurement, scene_frames};
 use glam::DVec2;

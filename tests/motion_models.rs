@@ -1,7 +1,7 @@
 //! The motion models' mathematics: CT's small-turn limit and Jacobian, CV convergence, and the
 //! Kalman update against the textbook closed form.
 
-mod common;
+use crate::common;
 
 use glam::DVec2;
 use nalgebra::{Matrix2, Matrix4, SMatrix, Vector4};

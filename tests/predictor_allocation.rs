@@ -1,11 +1,10 @@
 //! With the PR model on its inference thread, the tracking thread allocates nothing per frame;
 //! tract's per-run allocations happen, and are counted, on the inference thread.
 
-mod common;
-#[path = "common/counting_allocator.rs"]
-mod counting_allocator;
+use crate::common;
+use crate::common::counting_allocator;
 
-use counting_allocator::{allocations, count_allocations, CountingAllocator};
+use counting_allocator::{allocations, count_allocations};
 use glam::DVec2;
 use primm::config::Config;
 use primm::measurement::Frame;
@@ -17,9 +16,6 @@ use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
-
-#[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// Counts the allocations the wrapped predictor makes (on whatever thread runs it).
 struct CountingPredictor {

@@ -11,15 +11,13 @@
 //! With the learned predictor (PR-IMM) the PR model runs on its own inference thread; tract's
 //! allocations happen there, and the hand-over from the tracking thread allocates nothing.
 //!
-//! `cargo test --test service_allocation -- --nocapture` prints the counts.
+//! `cargo test --test integration service_allocation:: -- --nocapture` prints the counts.
 
-mod common;
-#[path = "common/counting_allocator.rs"]
-#[allow(dead_code)]
-mod counting_allocator;
+use crate::common;
+use crate::common::counting_allocator;
 
 use common::service::{unique_prefix, TestClient};
-use counting_allocator::{allocations, CountingAllocator};
+use counting_allocator::allocations;
 use primm::config::Config;
 use primm::measurement::Frame;
 use primm::mode::Method;
@@ -30,9 +28,6 @@ use primm::service::{ServiceNames, TrackingOptions, TrackingService, WaitMode};
 use primm::tracker::Tracker;
 use std::sync::mpsc;
 use std::time::Duration;
-
-#[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 const WARM_UP_FRAMES: u64 = 150;
 const COUNTED_FRAMES: u64 = 1000;

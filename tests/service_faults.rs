@@ -1,7 +1,7 @@
 //! The served tracker under faults: malformed frames, dead subscribers, a publisher killed and
 //! restarted, the tracker itself killed with SIGKILL and restarted.
 
-mod common;
+use crate::common;
 
 use common::service::{spawn_serve, unique_prefix, ChildGuard, TestClient};
 use primm::measurement::Frame;

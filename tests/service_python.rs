@@ -2,7 +2,7 @@
 //! declarations) reads the live track stream and sees exactly what a Rust subscriber sees.
 //! Needs `pip install -r tools/requirements-test.txt`.
 
-mod common;
+use crate::common;
 
 use common::service::{spawn_serve, unique_prefix, ChildGuard, TestClient};
 use primm::service::ServiceNames;

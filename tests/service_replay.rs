@@ -1,7 +1,7 @@
 //! A replay through the `primm serve` process comes back frame for frame, with the same tracks
 //! as the library's `Tracker` run offline on the same wire frames.
 
-mod common;
+use crate::common;
 
 use common::service::{spawn_serve, unique_prefix, wire_frame, TestClient};
 use primm::config::Config;

@@ -1,6 +1,6 @@
 //! The multi-object tracker on small hand-built scenes, and its handling of bad input.
 
-mod common;
+use crate::common;
 
 use common::{lanes, scene_frames, SceneObject};
 use primm::config::Config;

@@ -1,17 +1,13 @@
 //! The tracker allocates nothing per frame.
 
-mod common;
-#[path = "common/counting_allocator.rs"]
-mod counting_allocator;
+use crate::common;
+use crate::common::counting_allocator;
 
-use counting_allocator::{count_allocations, CountingAllocator};
+use counting_allocator::count_allocations;
 use primm::config::Config;
 use primm::measurement::Frame;
 use primm::mode::Method;
 use primm::tracker::Tracker;
-
-#[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// 10 000 frames of 64 objects, built before counting; frames cycle through 500 recorded ones
 /// with timestamps shifted so that time keeps advancing.

@@ -1,6 +1,6 @@
 //! A global allocator that counts allocations made by the current thread, so that a test can
-//! prove a code path allocates nothing. Install it in a test binary with
-//! `#[global_allocator] static ALLOCATOR: CountingAllocator = CountingAllocator;`.
+//! prove a code path allocates nothing while other test threads run beside it. The integration
+//! test binary installs it (`tests/main.rs`).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -9,20 +9,29 @@ thread_local! {
     static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
 }
 
-/// Counts `alloc`, `alloc_zeroed` and `realloc` calls per thread and forwards them to the system allocator.
+/// Counts `alloc`, `alloc_zeroed` and `realloc` calls per thread and forwards them to the system
+/// allocator.
+#[derive(Debug)]
 pub struct CountingAllocator;
 
+fn record_allocation() {
+    // `try_with`: the allocator may run while the thread's locals are being torn down.
+    let _ = ALLOCATIONS.try_with(|count| count.set(count.get() + 1));
+}
+
+// SAFETY: every method forwards to `System` with the caller's arguments unchanged; the counter
+// is a const-initialised thread-local `Cell`, which never allocates.
 unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|count| count.set(count.get() + 1));
+        record_allocation();
         unsafe { System.alloc(layout) }
     }
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|count| count.set(count.get() + 1));
+        record_allocation();
         unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|count| count.set(count.get() + 1));
+        record_allocation();
         unsafe { System.realloc(ptr, layout, new_size) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {

@@ -157,4 +157,5 @@ impl primm::predictor::DisplacementPredictor for LaneOracle {
         }
     }
 }
+pub mod counting_allocator;
 pub mod service;

@@ -1,0 +1,41 @@
+//! primm's integration tests, linked into one test binary.
+//!
+//! Each file beside this one is a module named after what it tests (`cargo test --test
+//! integration tracker_allocation::` runs one of them). One binary instead of one per file keeps
+//! the build small: every test binary links the whole library with its ONNX runtime, and two
+//! dozen of them took more than 10 GB of disk in a debug build.
+//!
+//! The binary's global allocator counts allocations per thread, so that the `*_allocation`
+//! modules can prove a code path allocates nothing while other tests run on other threads.
+
+mod common;
+
+use common::counting_allocator::CountingAllocator;
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+mod assignment;
+mod assignment_allocation;
+mod association;
+mod cli_offline;
+mod eval_metrics;
+mod eval_plots;
+mod imm_allocation;
+mod imm_behaviour;
+mod imm_properties;
+mod kernels;
+mod motion_models;
+mod predictor_allocation;
+mod predictor_onnx;
+mod predictor_request;
+mod predictor_threaded;
+mod predictor_usefulness;
+mod scenario;
+mod service_allocation;
+mod service_faults;
+mod service_python;
+mod service_replay;
+mod tracker;
+mod tracker_allocation;
+mod wire_layout;
