@@ -20,10 +20,7 @@ const GATE_RADIUS: f64 = 1.5;
 /// shuffled order, cost is the squared distance, and pairs beyond the gate radius are forbidden.
 fn gated_problem(rng: &mut ChaCha8Rng, n: usize) -> Vec<f64> {
     let tracks: Vec<f64> = (0..n).map(|_| rng.random_range(0.0..n as f64)).collect();
-    let mut measurements: Vec<f64> = tracks
-        .iter()
-        .map(|&x| x + rng.random_range(-0.5..0.5))
-        .collect();
+    let mut measurements: Vec<f64> = tracks.iter().map(|&x| x + rng.random_range(-0.5..0.5)).collect();
     for index in (1..n).rev() {
         measurements.swap(index, rng.random_range(0..=index));
     }
@@ -31,11 +28,7 @@ fn gated_problem(rng: &mut ChaCha8Rng, n: usize) -> Vec<f64> {
     for &track in &tracks {
         for &measurement in &measurements {
             let distance: f64 = track - measurement;
-            costs.push(if distance.abs() <= GATE_RADIUS {
-                distance * distance
-            } else {
-                f64::INFINITY
-            });
+            costs.push(if distance.abs() <= GATE_RADIUS { distance * distance } else { f64::INFINITY });
         }
     }
     costs
@@ -52,10 +45,7 @@ fn bench_assignment(c: &mut Criterion) {
     for n in SIZES {
         let mut solver = AssignmentSolver::with_capacity(n, n);
         let mut row_to_col = vec![None; n];
-        for (kind, costs) in [
-            ("gated", gated_problem(&mut rng, n)),
-            ("dense", dense_problem(&mut rng, n)),
-        ] {
+        for (kind, costs) in [("gated", gated_problem(&mut rng, n)), ("dense", dense_problem(&mut rng, n))] {
             group.bench_with_input(BenchmarkId::new(kind, n), &costs, |bencher, costs| {
                 bencher.iter(|| {
                     solver
@@ -133,7 +123,8 @@ fn bench_association(c: &mut Criterion) {
             bencher.iter(|| {
                 for class in ObjectClass::ALL {
                     let rows: Vec<usize> = (0..n).filter(|&i| tracks[i].class == class).collect();
-                    let columns: Vec<usize> = (0..n).filter(|&j| frame.measurements[j].class == class).collect();
+                    let columns: Vec<usize> =
+                        (0..n).filter(|&j| frame.measurements[j].class == class).collect();
                     let gate = config.classes.get(class).gate_m;
                     for (r, &i) in rows.iter().enumerate() {
                         for (k, &j) in columns.iter().enumerate() {

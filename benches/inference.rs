@@ -28,7 +28,8 @@ struct Parity {
 }
 
 fn parity_inputs(batch: usize) -> (Vec<f32>, Vec<f32>) {
-    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr_parity.json")).unwrap();
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr_parity.json")).unwrap();
     let parity: Parity = serde_json::from_str(&text).unwrap();
     let n = parity.features.len();
     let features = (0..batch).flat_map(|i| parity.features[i % n].as_flattened().to_vec()).collect();

@@ -29,7 +29,10 @@ fn load(path: &str, batch: Option<usize>) -> TractResult<std::sync::Arc<TypedSim
 fn main() -> TractResult<()> {
     // `cargo bench` passes `--bench`; positional arguments are the model and the batch size.
     let positional: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
-    let path = positional.first().cloned().unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/models/pr.onnx").into());
+    let path = positional
+        .first()
+        .cloned()
+        .unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/models/pr.onnx").into());
     let batch: usize = positional.get(1).map(|s| s.parse().expect("a batch size")).unwrap_or(64);
     let plan = load(&path, None)?;
     let mut state = plan.spawn()?;
@@ -52,7 +55,13 @@ fn main() -> TractResult<()> {
     let mut rows: Vec<(usize, Duration)> = per_node.into_iter().collect();
     rows.sort_by_key(|row| std::cmp::Reverse(row.1));
     let sum: Duration = rows.iter().map(|r| r.1).sum::<Duration>() / runs;
-    println!("model {path}, batch {batch}: {} nodes, {:.1} us per run ({:.2} us/sample), nodes sum {:.1} us", model.nodes().len(), total.as_secs_f64() * 1e6, total.as_secs_f64() * 1e6 / batch as f64, sum.as_secs_f64() * 1e6);
+    println!(
+        "model {path}, batch {batch}: {} nodes, {:.1} us per run ({:.2} us/sample), nodes sum {:.1} us",
+        model.nodes().len(),
+        total.as_secs_f64() * 1e6,
+        total.as_secs_f64() * 1e6 / batch as f64,
+        sum.as_secs_f64() * 1e6
+    );
     let mut by_op: HashMap<String, (Duration, usize)> = HashMap::new();
     for (id, d) in &rows {
         let e = by_op.entry(model.node(*id).op().name().to_string()).or_default();
@@ -80,8 +89,15 @@ fn main() -> TractResult<()> {
     println!("top nodes (us per run, op, ONNX name, output shape):");
     for (id, d) in rows.iter().take(20) {
         let node = model.node(*id);
-        let shape = model.outlet_fact(OutletId::new(*id, 0)).map(|f| format!("{:?}", f.shape)).unwrap_or_default();
-        println!("  {:>8.1}  {:<28} {:<40} {}", (*d / runs).as_secs_f64() * 1e6, node.op().name(), node.name.chars().take(40).collect::<String>(), shape);
+        let shape =
+            model.outlet_fact(OutletId::new(*id, 0)).map(|f| format!("{:?}", f.shape)).unwrap_or_default();
+        println!(
+            "  {:>8.1}  {:<28} {:<40} {}",
+            (*d / runs).as_secs_f64() * 1e6,
+            node.op().name(),
+            node.name.chars().take(40).collect::<String>(),
+            shape
+        );
     }
     Ok(())
 }

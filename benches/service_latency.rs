@@ -29,10 +29,21 @@ use primm::service::ServiceNames;
 use std::fmt::Write as _;
 use std::time::Duration;
 
-const LEGS: [&str; 5] =
-    ["send -> answer", "send -> tracker receive", "tracker receive -> publish", "tracker publish -> answer", "IPC overhead"];
+const LEGS: [&str; 5] = [
+    "send -> answer",
+    "send -> tracker receive",
+    "tracker receive -> publish",
+    "tracker publish -> answer",
+    "IPC overhead",
+];
 
-fn measure(mode: &str, method: &str, objects: usize, frames: usize, latency_every: &str) -> Vec<Histogram<u64>> {
+fn measure(
+    mode: &str,
+    method: &str,
+    objects: usize,
+    frames: usize,
+    latency_every: &str,
+) -> Vec<Histogram<u64>> {
     let prefix = unique_prefix(&format!("bench-{mode}"));
     let client = TestClient::new(&ServiceNames::new(&prefix));
     let mut extra = vec!["--method", method, "--latency-every", latency_every];
@@ -82,7 +93,9 @@ fn measure(mode: &str, method: &str, objects: usize, frames: usize, latency_ever
     }
     serve.signal(libc::SIGINT);
     let (_, stdout) = serve.wait(Duration::from_secs(10));
-    for line in stdout.lines().filter(|line| line.starts_with("learned predictor") || line.starts_with("frames:")) {
+    for line in
+        stdout.lines().filter(|line| line.starts_with("learned predictor") || line.starts_with("frames:"))
+    {
         eprintln!("{mode}: {line}");
     }
     histograms

@@ -215,7 +215,9 @@ fn plot(rows: &[Row], path: &Path) -> Result<(), Box<dyn std::error::Error>> {
         chart
             .draw_series(LineSeries::new(p99, colour.mix(0.5).stroke_width(1)))?
             .label(format!("{method} p99"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.mix(0.5).stroke_width(1)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.mix(0.5).stroke_width(1))
+            });
     }
     chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
     root.present()?;
@@ -250,7 +252,10 @@ fn main() {
             } else {
                 run(method, NoPredictor, count, frames)
             };
-            eprintln!("{} {:>3} objects: step p50 {:.1} µs, p99 {:.1} µs", row.method, count, row.step_p50_us, row.step_p99_us);
+            eprintln!(
+                "{} {:>3} objects: step p50 {:.1} µs, p99 {:.1} µs",
+                row.method, count, row.step_p50_us, row.step_p99_us
+            );
             rows.push(row);
         }
     }

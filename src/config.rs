@@ -280,24 +280,36 @@ impl Config {
         for (i, row) in imm.transition.iter().enumerate() {
             for (j, &p) in row.iter().enumerate() {
                 if !(0.0..=1.0).contains(&p) {
-                    return Err(invalid(format!("imm.transition[{i}][{j}]"), format!("must be a probability in [0, 1], got {p}")));
+                    return Err(invalid(
+                        format!("imm.transition[{i}][{j}]"),
+                        format!("must be a probability in [0, 1], got {p}"),
+                    ));
                 }
             }
             let sum: f64 = row.iter().sum();
             if (sum - 1.0).abs() > 1e-9 {
-                return Err(invalid(format!("imm.transition[{i}]"), format!("row must sum to 1, sums to {sum}")));
+                return Err(invalid(
+                    format!("imm.transition[{i}]"),
+                    format!("row must sum to 1, sums to {sum}"),
+                ));
             }
         }
         for mode in imm.modes.iter() {
             let i = mode.index();
             let active_sum: f64 = imm.modes.iter().map(|to| imm.transition[i][to.index()]).sum();
             if active_sum <= 0.0 {
-                return Err(invalid(format!("imm.transition[{i}]"), "row has no probability mass on the active modes"));
+                return Err(invalid(
+                    format!("imm.transition[{i}]"),
+                    "row has no probability mass on the active modes",
+                ));
             }
         }
         for (i, &p) in imm.initial_mode_probabilities.iter().enumerate() {
             if !(0.0..=1.0).contains(&p) {
-                return Err(invalid(format!("imm.initial_mode_probabilities[{i}]"), format!("must be a probability in [0, 1], got {p}")));
+                return Err(invalid(
+                    format!("imm.initial_mode_probabilities[{i}]"),
+                    format!("must be a probability in [0, 1], got {p}"),
+                ));
             }
         }
         if imm.modes.iter().map(|m| imm.initial_mode_probabilities[m.index()]).sum::<f64>() <= 0.0 {
@@ -306,7 +318,10 @@ impl Config {
         positive("imm.likelihood_temperature", imm.likelihood_temperature)?;
         let floor = imm.mode_probability_floor;
         if !(floor >= 0.0 && floor < 1.0 / imm.modes.len() as f64) {
-            return Err(invalid("imm.mode_probability_floor", format!("must be in [0, 1/number of active modes), got {floor}")));
+            return Err(invalid(
+                "imm.mode_probability_floor",
+                format!("must be in [0, 1/number of active modes), got {floor}"),
+            ));
         }
         if !(self.association.velocity_weight_s.is_finite() && self.association.velocity_weight_s >= 0.0) {
             return Err(invalid("association.velocity_weight_s", "must be a finite number >= 0"));
@@ -332,14 +347,38 @@ impl Config {
             covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
             positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
             positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
-            positive(&key("constant_velocity.acceleration_psd_m2_per_s3"), section.constant_velocity.acceleration_psd_m2_per_s3)?;
-            positive(&key("constant_acceleration.jerk_psd_m2_per_s5"), section.constant_acceleration.jerk_psd_m2_per_s5)?;
-            positive(&key("constant_acceleration.initial_acceleration_std_mps2"), section.constant_acceleration.initial_acceleration_std_mps2)?;
-            positive(&key("coordinated_turn.acceleration_psd_m2_per_s3"), section.coordinated_turn.acceleration_psd_m2_per_s3)?;
-            positive(&key("coordinated_turn.turn_rate_psd_rad2_per_s3"), section.coordinated_turn.turn_rate_psd_rad2_per_s3)?;
-            positive(&key("coordinated_turn.initial_turn_rate_std_radps"), section.coordinated_turn.initial_turn_rate_std_radps)?;
-            covariance(&key("learned.process_noise_covariance_m2"), &section.learned.process_noise_covariance_m2)?;
-            covariance(&key("learned.measurement_noise_covariance_m2"), &section.learned.measurement_noise_covariance_m2)?;
+            positive(
+                &key("constant_velocity.acceleration_psd_m2_per_s3"),
+                section.constant_velocity.acceleration_psd_m2_per_s3,
+            )?;
+            positive(
+                &key("constant_acceleration.jerk_psd_m2_per_s5"),
+                section.constant_acceleration.jerk_psd_m2_per_s5,
+            )?;
+            positive(
+                &key("constant_acceleration.initial_acceleration_std_mps2"),
+                section.constant_acceleration.initial_acceleration_std_mps2,
+            )?;
+            positive(
+                &key("coordinated_turn.acceleration_psd_m2_per_s3"),
+                section.coordinated_turn.acceleration_psd_m2_per_s3,
+            )?;
+            positive(
+                &key("coordinated_turn.turn_rate_psd_rad2_per_s3"),
+                section.coordinated_turn.turn_rate_psd_rad2_per_s3,
+            )?;
+            positive(
+                &key("coordinated_turn.initial_turn_rate_std_radps"),
+                section.coordinated_turn.initial_turn_rate_std_radps,
+            )?;
+            covariance(
+                &key("learned.process_noise_covariance_m2"),
+                &section.learned.process_noise_covariance_m2,
+            )?;
+            covariance(
+                &key("learned.measurement_noise_covariance_m2"),
+                &section.learned.measurement_noise_covariance_m2,
+            )?;
         }
         Ok(())
     }
@@ -375,7 +414,8 @@ mod tests {
 
     #[test]
     fn a_non_positive_temperature_is_named() {
-        let text = DEFAULT_CONFIG_TOML.replace("likelihood_temperature = 0.1", "likelihood_temperature = 0.0");
+        let text =
+            DEFAULT_CONFIG_TOML.replace("likelihood_temperature = 0.1", "likelihood_temperature = 0.0");
         assert_eq!(invalid_key(&text), "imm.likelihood_temperature");
     }
 
@@ -401,7 +441,8 @@ mod tests {
 
     #[test]
     fn a_floor_too_high_for_the_mode_count_is_named() {
-        let text = DEFAULT_CONFIG_TOML.replace("mode_probability_floor = 0.001", "mode_probability_floor = 0.3");
+        let text =
+            DEFAULT_CONFIG_TOML.replace("mode_probability_floor = 0.001", "mode_probability_floor = 0.3");
         assert_eq!(invalid_key(&text), "imm.mode_probability_floor");
     }
 

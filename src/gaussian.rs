@@ -245,10 +245,8 @@ pub fn kalman_update_into<const N: usize>(
         let (p0, p1) = (p[(row, 0)], p[(row, 1)]);
         let k = [p0 * i00 + p1 * i01, p0 * i01 + p1 * i11];
         gain[row] = k;
-        a_left[row] = [
-            p0 - (k[0] * p[(0, 0)] + k[1] * p[(1, 0)]),
-            p1 - (k[0] * p[(0, 1)] + k[1] * p[(1, 1)]),
-        ];
+        a_left[row] =
+            [p0 - (k[0] * p[(0, 0)] + k[1] * p[(1, 0)]), p1 - (k[0] * p[(0, 1)] + k[1] * p[(1, 1)])];
     }
     // Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ with H = [I₂ 0], element by element in O(N²):
     // A − A[:, 0..2]·Kᵀ + K R Kᵀ, where A = P − K·P[0..2, :]. Upper triangle, mirrored.
@@ -282,9 +280,7 @@ mod tests {
     use nalgebra::{Matrix4, Vector4};
 
     fn spd4() -> Matrix4<f64> {
-        let a = Matrix4::new(
-            1.0, 0.2, 0.1, 0.0, 0.3, 2.0, 0.0, 0.4, 0.0, 0.1, 1.5, 0.2, 0.1, 0.0, 0.3, 0.8,
-        );
+        let a = Matrix4::new(1.0, 0.2, 0.1, 0.0, 0.3, 2.0, 0.0, 0.4, 0.0, 0.1, 1.5, 0.2, 0.1, 0.0, 0.3, 0.8);
         a * a.transpose() + Matrix4::identity() * 0.1
     }
 
@@ -306,7 +302,8 @@ mod tests {
 
     #[test]
     fn closed_form_pseudo_inverse_matches_nalgebra_svd_on_full_rank_rank_one_and_zero_matrices() {
-        let mut cases = vec![Matrix2::zeros(), Matrix2::new(4.0, 0.0, 0.0, 0.0), Matrix2::new(0.0, 0.0, 0.0, 2.5)];
+        let mut cases =
+            vec![Matrix2::zeros(), Matrix2::new(4.0, 0.0, 0.0, 0.0), Matrix2::new(0.0, 0.0, 0.0, 2.5)];
         for i in 0..200 {
             let angle = f64::from(i) * 0.37;
             let v = Vector2::new(angle.cos(), angle.sin());
@@ -347,7 +344,11 @@ mod tests {
 
     /// The textbook update with explicit `H`, `K = P Hᵀ S⁻¹` and the full Joseph product, in
     /// nalgebra's general matrix arithmetic.
-    fn reference_update(prior: &Gaussian<4>, z: DVec2, r: &Matrix2<f64>) -> (Vector4<f64>, Matrix4<f64>, f64) {
+    fn reference_update(
+        prior: &Gaussian<4>,
+        z: DVec2,
+        r: &Matrix2<f64>,
+    ) -> (Vector4<f64>, Matrix4<f64>, f64) {
         let h = nalgebra::Matrix2x4::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0);
         let s = h * prior.covariance * h.transpose() + r;
         let s_inverse = s.try_inverse().unwrap();
@@ -355,8 +356,9 @@ mod tests {
         let nu = Vector2::new(z.x, z.y) - h * prior.mean;
         let i_kh = Matrix4::identity() - k * h;
         let covariance = i_kh * prior.covariance * i_kh.transpose() + k * r * k.transpose();
-        let log_likelihood =
-            -0.5 * (nu.transpose() * s_inverse * nu)[(0, 0)] - (2.0 * std::f64::consts::PI).ln() - 0.5 * s.determinant().ln();
+        let log_likelihood = -0.5 * (nu.transpose() * s_inverse * nu)[(0, 0)]
+            - (2.0 * std::f64::consts::PI).ln()
+            - 0.5 * s.determinant().ln();
         (prior.mean + k * nu, covariance, log_likelihood)
     }
 
@@ -373,7 +375,10 @@ mod tests {
             let ours = kalman_update(&prior, z, &r).unwrap();
             let (mean, covariance, log_likelihood) = reference_update(&prior, z, &r);
             assert!((ours.posterior.mean - mean).abs().max() < 1e-12);
-            assert!((ours.posterior.covariance - covariance).abs().max() < 1e-12 * covariance.abs().max().max(1.0));
+            assert!(
+                (ours.posterior.covariance - covariance).abs().max()
+                    < 1e-12 * covariance.abs().max().max(1.0)
+            );
             assert!((ours.log_likelihood - log_likelihood).abs() < 1e-12);
         }
     }

@@ -62,7 +62,9 @@ impl ImmState {
     pub fn velocity(&self, mode: Mode) -> DVec2 {
         match mode {
             Mode::Learned => self.learned_velocity_mps,
-            Mode::ConstantVelocity => DVec2::new(self.constant_velocity.mean[2], self.constant_velocity.mean[3]),
+            Mode::ConstantVelocity => {
+                DVec2::new(self.constant_velocity.mean[2], self.constant_velocity.mean[3])
+            }
             Mode::ConstantAcceleration => {
                 DVec2::new(self.constant_acceleration.mean[2], self.constant_acceleration.mean[3])
             }
@@ -119,7 +121,11 @@ fn mode_positions(state: &ImmState, modes: ModeSet) -> [PositionEstimate; MODE_C
 
 /// [`mix_positions`] on positions already extracted.
 #[inline]
-fn mix(positions: &[PositionEstimate; MODE_COUNT], modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
+fn mix(
+    positions: &[PositionEstimate; MODE_COUNT],
+    modes: ModeSet,
+    weights: &ModeProbabilities,
+) -> PositionEstimate {
     let mut mean = DVec2::ZERO;
     for mode in modes.iter() {
         mean += weights[mode.index()] * positions[mode.index()].mean;
@@ -190,7 +196,8 @@ impl Imm {
         let mut initial_probabilities = [0.0; MODE_COUNT];
         let initial_sum: f64 = modes.iter().map(|m| config.initial_mode_probabilities[m.index()]).sum();
         for mode in modes.iter() {
-            initial_probabilities[mode.index()] = config.initial_mode_probabilities[mode.index()] / initial_sum;
+            initial_probabilities[mode.index()] =
+                config.initial_mode_probabilities[mode.index()] / initial_sum;
         }
         let mut imm = Self {
             modes,
@@ -231,14 +238,23 @@ impl Imm {
     pub fn prior_probabilities(&self, posterior: &ModeProbabilities) -> ModeProbabilities {
         let mut c = [0.0; MODE_COUNT];
         for to in self.modes.iter() {
-            c[to.index()] = self.modes.iter().map(|from| self.transition[from.index()][to.index()] * posterior[from.index()]).sum();
+            c[to.index()] = self
+                .modes
+                .iter()
+                .map(|from| self.transition[from.index()][to.index()] * posterior[from.index()])
+                .sum();
         }
         c
     }
 
     /// Mixing probabilities `β_ij = π_ij μ_i / c_j` (`eq:mixing_prob`) into mode `to`.
     #[inline]
-    pub fn mixing_probabilities(&self, posterior: &ModeProbabilities, prior: &ModeProbabilities, to: Mode) -> ModeProbabilities {
+    pub fn mixing_probabilities(
+        &self,
+        posterior: &ModeProbabilities,
+        prior: &ModeProbabilities,
+        to: Mode,
+    ) -> ModeProbabilities {
         let mut beta = [0.0; MODE_COUNT];
         let c = prior[to.index()];
         if c > 0.0 {
@@ -274,7 +290,13 @@ impl Imm {
     /// multi-mode state). `prior.available` and `prior.fused` are only meaningful after
     /// [`complete_prior_in_place`](Self::complete_prior_in_place).
     #[inline(always)]
-    pub fn predict_physics_into(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64, prior: &mut ImmPrior) {
+    pub fn predict_physics_into(
+        &self,
+        models: &ModeModels,
+        posterior: &ImmState,
+        dt_s: f64,
+        prior: &mut ImmPrior,
+    ) {
         let c = self.prior_probabilities(&posterior.probabilities);
         let positions = mode_positions(posterior, self.modes);
         let context = PredictContext { dt_s, displacement_m: None };
@@ -291,21 +313,27 @@ impl Imm {
                         replace_position(&mut state.learned, &start);
                     }
                 }
-                Mode::ConstantVelocity => {
-                    mix_and_predict(&models.constant_velocity, &posterior.constant_velocity, &start, &context, &mut state.constant_velocity)
-                }
-                Mode::ConstantAcceleration => {
-                    mix_and_predict(
-                        &models.constant_acceleration,
-                        &posterior.constant_acceleration,
-                        &start,
-                        &context,
-                        &mut state.constant_acceleration,
-                    )
-                }
-                Mode::CoordinatedTurn => {
-                    mix_and_predict(&models.coordinated_turn, &posterior.coordinated_turn, &start, &context, &mut state.coordinated_turn)
-                }
+                Mode::ConstantVelocity => mix_and_predict(
+                    &models.constant_velocity,
+                    &posterior.constant_velocity,
+                    &start,
+                    &context,
+                    &mut state.constant_velocity,
+                ),
+                Mode::ConstantAcceleration => mix_and_predict(
+                    &models.constant_acceleration,
+                    &posterior.constant_acceleration,
+                    &start,
+                    &context,
+                    &mut state.constant_acceleration,
+                ),
+                Mode::CoordinatedTurn => mix_and_predict(
+                    &models.coordinated_turn,
+                    &posterior.coordinated_turn,
+                    &start,
+                    &context,
+                    &mut state.coordinated_turn,
+                ),
             }
         }
         // Inactive modes are carried along unchanged, so that no stale values linger.
@@ -323,7 +351,12 @@ impl Imm {
     /// Second half of the prediction: the PR prior from the learned displacement
     /// (`eq:pr_prior`, `eq:pr_cov`) and the fused prior (`eq:prior_fusion`). Without a
     /// displacement the PR mode sits the step out (see the module documentation).
-    pub fn complete_prior(&self, models: &ModeModels, pending: &PendingPrior, displacement_m: Option<DVec2>) -> ImmPrior {
+    pub fn complete_prior(
+        &self,
+        models: &ModeModels,
+        pending: &PendingPrior,
+        displacement_m: Option<DVec2>,
+    ) -> ImmPrior {
         let mut prior = pending.prior;
         self.complete_prior_in_place(models, &mut prior, pending.dt_s, displacement_m);
         prior
@@ -332,7 +365,13 @@ impl Imm {
     /// [`complete_prior`](Self::complete_prior) on a prior filled by
     /// [`predict_physics_into`](Self::predict_physics_into) for the same `dt_s`.
     #[inline(always)]
-    pub fn complete_prior_in_place(&self, models: &ModeModels, prior: &mut ImmPrior, dt_s: f64, displacement_m: Option<DVec2>) {
+    pub fn complete_prior_in_place(
+        &self,
+        models: &ModeModels,
+        prior: &mut ImmPrior,
+        dt_s: f64,
+        displacement_m: Option<DVec2>,
+    ) {
         let state = &mut prior.state;
         if self.modes.contains(Mode::Learned) {
             let context = PredictContext { dt_s, displacement_m };
@@ -360,7 +399,13 @@ impl Imm {
     /// [`update`](Self::update) written into `posterior` in place. On error `posterior` holds
     /// the prior's state (the track coasts; nothing half-updated is left behind).
     #[inline(always)]
-    pub fn update_into(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2, posterior: &mut ImmState) -> Result<(), UpdateError> {
+    pub fn update_into(
+        &self,
+        models: &ModeModels,
+        prior: &ImmPrior,
+        z: DVec2,
+        posterior: &mut ImmState,
+    ) -> Result<(), UpdateError> {
         match self.update_modes(models, prior, z, posterior) {
             Ok(log_likelihood) => {
                 posterior.probabilities =
@@ -391,7 +436,14 @@ impl Imm {
             let active = self.modes.contains(mode);
             let i = mode.index();
             match mode {
-                Mode::Learned => update_mode(&from.learned, &mut to.learned, &models.learned, z, active, &mut log_likelihood[i])?,
+                Mode::Learned => update_mode(
+                    &from.learned,
+                    &mut to.learned,
+                    &models.learned,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
                 Mode::ConstantVelocity => update_mode(
                     &from.constant_velocity,
                     &mut to.constant_velocity,
@@ -450,7 +502,8 @@ impl Imm {
                 sum += mu[i];
             }
         }
-        let sitting_out: f64 = self.modes.iter().filter(|m| !available.contains(*m)).map(|m| prior[m.index()]).sum();
+        let sitting_out: f64 =
+            self.modes.iter().filter(|m| !available.contains(*m)).map(|m| prior[m.index()]).sum();
         for mode in self.modes.iter() {
             let i = mode.index();
             mu[i] = if available.contains(mode) { mu[i] / sum * (1.0 - sitting_out) } else { prior[i] };

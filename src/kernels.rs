@@ -22,7 +22,13 @@ pub type ClassModels = [ModeModels; ObjectClass::COUNT];
 /// Mixing and the CV, CA and CT predictions of every track into `priors` (same order, at
 /// least as long as `tracks`).
 #[multiversion(targets("x86_64+avx+avx2+fma"))]
-pub fn predict_physics(imm: &Imm, models: &ClassModels, tracks: &[Track], dt_s: f64, priors: &mut [ImmPrior]) {
+pub fn predict_physics(
+    imm: &Imm,
+    models: &ClassModels,
+    tracks: &[Track],
+    dt_s: f64,
+    priors: &mut [ImmPrior],
+) {
     for (track, prior) in tracks.iter().zip(priors.iter_mut()) {
         imm.predict_physics_into(&models[track.class.index()], &track.estimate, dt_s, prior);
     }
@@ -55,9 +61,13 @@ pub fn update(
     measurements: &[Option<Measurement>],
     outcomes: &mut [Result<(), UpdateError>],
 ) {
-    for (((track, prior), measurement), outcome) in tracks.iter_mut().zip(priors).zip(measurements).zip(outcomes.iter_mut()) {
+    for (((track, prior), measurement), outcome) in
+        tracks.iter_mut().zip(priors).zip(measurements).zip(outcomes.iter_mut())
+    {
         *outcome = match measurement {
-            Some(z) => imm.update_into(&models[track.class.index()], prior, z.position(), &mut track.estimate),
+            Some(z) => {
+                imm.update_into(&models[track.class.index()], prior, z.position(), &mut track.estimate)
+            }
             None => Ok(()),
         };
     }

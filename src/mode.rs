@@ -144,11 +144,9 @@ impl Method {
             Method::ConstantAcceleration => ModeSet::of(&[Mode::ConstantAcceleration]),
             Method::CoordinatedTurn => ModeSet::of(&[Mode::CoordinatedTurn]),
             Method::Learned => ModeSet::of(&[Mode::Learned]),
-            Method::Imm => ModeSet::of(&[
-                Mode::ConstantVelocity,
-                Mode::ConstantAcceleration,
-                Mode::CoordinatedTurn,
-            ]),
+            Method::Imm => {
+                ModeSet::of(&[Mode::ConstantVelocity, Mode::ConstantAcceleration, Mode::CoordinatedTurn])
+            }
             Method::PrImm => ModeSet::ALL,
         }
     }
@@ -222,8 +220,7 @@ impl std::fmt::Display for Method {
 impl std::str::FromStr for Method {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::from_id(s).ok_or_else(|| {
-            format!("unknown method '{s}' (expected one of cv, ca, ct, pr, imm, pr-imm)")
-        })
+        Self::from_id(s)
+            .ok_or_else(|| format!("unknown method '{s}' (expected one of cv, ca, ct, pr, imm, pr-imm)"))
     }
 }

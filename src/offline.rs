@@ -107,6 +107,8 @@ pub fn evaluate_sequence<P: DisplacementPredictor>(
     method: Method,
 ) -> Result<Vec<AssociationRecord>, OfflineError> {
     let mut records = Vec::with_capacity(sequence.measurement_count());
-    track_sequence(tracker, sequence, |recorded, outputs| association_records(recorded, outputs, method, &mut records))?;
+    track_sequence(tracker, sequence, |recorded, outputs| {
+        association_records(recorded, outputs, method, &mut records)
+    })?;
     Ok(records)
 }

@@ -13,13 +13,13 @@ use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
 use crate::kernels;
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use crate::mode::{Mode, ModeSet};
 use crate::motion::ModeModels;
 use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
+use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput, TrackStatus};
 use crate::track_table::{TrackTable, MAX_TRACKS};
 use crate::validation::{validate_frame, validate_measurement, FrameError, MeasurementRejection};
-use crate::mode::{Mode, ModeSet};
-use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use arrayvec::ArrayVec;
 use glam::DVec2;
 
@@ -90,7 +90,8 @@ struct RowRecord {
     measurement_index: Option<u16>,
 }
 
-const EMPTY_ROW: RowRecord = RowRecord { prior_position_m: None, available: ModeSet::EMPTY, measurement_index: None };
+const EMPTY_ROW: RowRecord =
+    RowRecord { prior_position_m: None, available: ModeSet::EMPTY, measurement_index: None };
 
 /// The PR-IMM multi-object tracker with a learned-displacement predictor `P`.
 #[derive(Debug)]
@@ -190,7 +191,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// Everything but the report.
-    fn advance<F: FrameView + ?Sized, O: StageObserver>(&mut self, frame: &F, observer: &mut O) -> Result<(), StepError> {
+    fn advance<F: FrameView + ?Sized, O: StageObserver>(
+        &mut self,
+        frame: &F,
+        observer: &mut O,
+    ) -> Result<(), StepError> {
         let dt_s = self.validate(frame)?;
         observer.stage_finished(Stage::Validate);
         let t = frame.timestamp_s();
@@ -213,22 +218,32 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Frame checks, then per-measurement checks; counts every rejection.
     fn validate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<f64, StepError> {
-        let dt_s = validate_frame(frame, self.last_timestamp_s, &self.config.tracker).inspect_err(|error| {
-            let counter = match error {
-                FrameError::NonFiniteTimestamp { .. } => &mut self.stats.frames_rejected_non_finite_timestamp,
-                FrameError::TimestampNotIncreasing { .. } => &mut self.stats.frames_rejected_timestamp_not_increasing,
-                FrameError::IntervalTooLong { .. } => &mut self.stats.frames_rejected_interval_too_long,
-                FrameError::TooManyMeasurements { .. } => &mut self.stats.frames_rejected_too_many_measurements,
-            };
-            *counter += 1;
-        })?;
+        let dt_s =
+            validate_frame(frame, self.last_timestamp_s, &self.config.tracker).inspect_err(|error| {
+                let counter = match error {
+                    FrameError::NonFiniteTimestamp { .. } => {
+                        &mut self.stats.frames_rejected_non_finite_timestamp
+                    }
+                    FrameError::TimestampNotIncreasing { .. } => {
+                        &mut self.stats.frames_rejected_timestamp_not_increasing
+                    }
+                    FrameError::IntervalTooLong { .. } => &mut self.stats.frames_rejected_interval_too_long,
+                    FrameError::TooManyMeasurements { .. } => {
+                        &mut self.stats.frames_rejected_too_many_measurements
+                    }
+                };
+                *counter += 1;
+            })?;
         for index in 0..frame.len() {
             let verdict = validate_measurement(frame, index);
             self.accepted[index] = verdict.is_ok();
-            self.fates[index] = if verdict.is_ok() { MeasurementFate::Unassigned } else { MeasurementFate::Rejected };
+            self.fates[index] =
+                if verdict.is_ok() { MeasurementFate::Unassigned } else { MeasurementFate::Rejected };
             match verdict {
                 Ok(_) => self.stats.measurements_accepted += 1,
-                Err(MeasurementRejection::UnknownClass) => self.stats.measurements_rejected_unknown_class += 1,
+                Err(MeasurementRejection::UnknownClass) => {
+                    self.stats.measurements_rejected_unknown_class += 1
+                }
                 Err(MeasurementRejection::NonFinite) => self.stats.measurements_rejected_non_finite += 1,
                 Err(MeasurementRejection::OutOfRange) => self.stats.measurements_rejected_out_of_range += 1,
             }
@@ -249,7 +264,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             window[..older.len()].copy_from_slice(older);
             window[older.len()..len].copy_from_slice(newer);
             let step_start = self.last_timestamp_s.unwrap_or(t);
-            self.requests.push(PredictionRequest::from_history(&window[..len], t).with_step_start(step_start));
+            self.requests
+                .push(PredictionRequest::from_history(&window[..len], t).with_step_start(step_start));
         }
         self.predictor.submit(&self.requests);
     }
@@ -272,7 +288,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.stats.learned_predictions_missing += missing;
             self.stats.frames_with_learned_predictions_missing += u64::from(missing > 0);
         }
-        kernels::complete_priors(&self.imm, &self.models, self.table.tracks(), self.dt_s, displacements, &mut self.priors[..]);
+        kernels::complete_priors(
+            &self.imm,
+            &self.models,
+            self.table.tracks(),
+            self.dt_s,
+            displacements,
+            &mut self.priors[..],
+        );
     }
 
     /// Per-class gated optimal assignment (`eq:association_cost`).
@@ -310,13 +333,16 @@ impl<P: DisplacementPredictor> Tracker<P> {
         );
         let confirmation_hits = self.config.tracker.confirmation_hits;
         for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
-            let (Some(index), Some(measurement)) = (self.track_to_measurement[i], self.assigned_measurements[i]) else {
+            let (Some(index), Some(measurement)) =
+                (self.track_to_measurement[i], self.assigned_measurements[i])
+            else {
                 continue;
             };
             if self.update_outcomes[i].is_ok() {
                 let was_confirmed = track.status == TrackStatus::Confirmed;
                 track.record_hit(&measurement, t, confirmation_hits);
-                self.stats.tracks_confirmed += u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);
+                self.stats.tracks_confirmed +=
+                    u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);
                 self.fates[usize::from(index)] = MeasurementFate::Assigned;
             } else {
                 // Numerically unusable: the track coasts and the measurement is free to start a

@@ -83,7 +83,10 @@ pub fn validate_frame<F: FrameView + ?Sized>(
 }
 
 /// Decodes and checks measurement `index` of `frame`.
-pub fn validate_measurement<F: FrameView + ?Sized>(frame: &F, index: usize) -> Result<Measurement, MeasurementRejection> {
+pub fn validate_measurement<F: FrameView + ?Sized>(
+    frame: &F,
+    index: usize,
+) -> Result<Measurement, MeasurementRejection> {
     let measurement = frame.measurement(index).map_err(|_| MeasurementRejection::UnknownClass)?;
     let values = [measurement.x_m, measurement.y_m, measurement.radial_velocity_mps, measurement.rcs_dbsm];
     if values.iter().any(|v| !v.is_finite()) {

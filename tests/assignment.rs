@@ -33,16 +33,7 @@ fn exhaustive_optimum(rows: usize, cols: usize, costs: &[f64]) -> (usize, f64) {
             let cost = costs[row * cols + col];
             if !used[col] && cost.is_finite() {
                 used[col] = true;
-                visit(
-                    row + 1,
-                    rows,
-                    cols,
-                    costs,
-                    used,
-                    pairs + 1,
-                    total + cost,
-                    best,
-                );
+                visit(row + 1, rows, cols, costs, used, pairs + 1, total + cost, best);
                 used[col] = false;
             }
         }
@@ -66,25 +57,16 @@ fn assert_valid_assignment(
     let mut total = 0.0;
     for (row, assigned) in row_to_col[..rows].iter().enumerate() {
         if let Some(col) = *assigned {
-            assert!(
-                col < cols,
-                "row {row} assigned to out-of-range column {col}"
-            );
+            assert!(col < cols, "row {row} assigned to out-of-range column {col}");
             assert!(!used[col], "column {col} assigned twice");
             used[col] = true;
             let cost = costs[row * cols + col];
-            assert!(
-                cost.is_finite(),
-                "row {row} assigned to forbidden column {col}"
-            );
+            assert!(cost.is_finite(), "row {row} assigned to forbidden column {col}");
             pairs += 1;
             total += cost;
         }
     }
-    assert_eq!(
-        summary.pairs, pairs,
-        "summary pair count disagrees with the assignment"
-    );
+    assert_eq!(summary.pairs, pairs, "summary pair count disagrees with the assignment");
     assert!(
         (summary.total_cost - total).abs() <= 1e-9 * (1.0 + total.abs()),
         "summary cost {} disagrees with the assignment cost {total}",
@@ -152,9 +134,7 @@ fn solver_matches_exhaustive_search_on_every_small_gated_matrix() {
 
 /// Integer-valued random matrix and the optimum `kuhn_munkres` finds for it.
 fn compare_with_kuhn_munkres(rng: &mut ChaCha8Rng, rows: usize, cols: usize) {
-    let values: Vec<i64> = (0..rows * cols)
-        .map(|_| rng.random_range(0..1000))
-        .collect();
+    let values: Vec<i64> = (0..rows * cols).map(|_| rng.random_range(0..1000)).collect();
     let costs: Vec<f64> = values.iter().map(|&value| value as f64).collect();
 
     // `kuhn_munkres` maximises and needs rows <= columns.
@@ -171,10 +151,7 @@ fn compare_with_kuhn_munkres(rng: &mut ChaCha8Rng, rows: usize, cols: usize) {
     let summary = solver.solve(rows, cols, &costs, &mut row_to_col).unwrap();
     assert_valid_assignment(rows, cols, &costs, &row_to_col, summary);
     assert_eq!(summary.pairs, rows.min(cols));
-    assert_eq!(
-        summary.total_cost, optimum as f64,
-        "{rows}x{cols} differs from kuhn_munkres"
-    );
+    assert_eq!(summary.total_cost, optimum as f64, "{rows}x{cols} differs from kuhn_munkres");
 }
 
 #[test]
@@ -200,13 +177,7 @@ fn empty_problems_assign_nothing() {
     let mut row_to_col = [Some(9); 4];
 
     let summary = solver.solve(0, 0, &[], &mut []).unwrap();
-    assert_eq!(
-        summary,
-        AssignmentSummary {
-            pairs: 0,
-            total_cost: 0.0
-        }
-    );
+    assert_eq!(summary, AssignmentSummary { pairs: 0, total_cost: 0.0 });
 
     let summary = solver.solve(0, 3, &[], &mut []).unwrap();
     assert_eq!(summary.pairs, 0);
@@ -221,13 +192,7 @@ fn fully_forbidden_matrix_assigns_nothing() {
     let mut solver = AssignmentSolver::with_capacity(3, 4);
     let mut row_to_col = [Some(0); 3];
     let summary = solver.solve(3, 4, &[INF; 12], &mut row_to_col).unwrap();
-    assert_eq!(
-        summary,
-        AssignmentSummary {
-            pairs: 0,
-            total_cost: 0.0
-        }
-    );
+    assert_eq!(summary, AssignmentSummary { pairs: 0, total_cost: 0.0 });
     assert_eq!(row_to_col, [None; 3]);
 }
 
@@ -238,13 +203,7 @@ fn single_row_takes_its_cheapest_allowed_column() {
     let costs = [4.0, INF, -2.5, 7.0, INF];
     let summary = solver.solve(1, 5, &costs, &mut row_to_col).unwrap();
     assert_eq!(row_to_col, [Some(2)]);
-    assert_eq!(
-        summary,
-        AssignmentSummary {
-            pairs: 1,
-            total_cost: -2.5
-        }
-    );
+    assert_eq!(summary, AssignmentSummary { pairs: 1, total_cost: -2.5 });
 }
 
 #[test]
@@ -254,13 +213,7 @@ fn single_column_goes_to_the_cheapest_allowed_row() {
     let costs = [3.0, INF, 1.0, 2.0];
     let summary = solver.solve(4, 1, &costs, &mut row_to_col).unwrap();
     assert_eq!(row_to_col, [None, None, Some(0), None]);
-    assert_eq!(
-        summary,
-        AssignmentSummary {
-            pairs: 1,
-            total_cost: 1.0
-        }
-    );
+    assert_eq!(summary, AssignmentSummary { pairs: 1, total_cost: 1.0 });
 }
 
 #[test]
@@ -272,13 +225,7 @@ fn an_extra_pair_outweighs_any_cost_saving() {
     let costs = [0.0, 1e12, -1e3, INF];
     let summary = solver.solve(2, 2, &costs, &mut row_to_col).unwrap();
     assert_eq!(row_to_col, [Some(1), Some(0)]);
-    assert_eq!(
-        summary,
-        AssignmentSummary {
-            pairs: 2,
-            total_cost: 1e12 - 1e3
-        }
-    );
+    assert_eq!(summary, AssignmentSummary { pairs: 2, total_cost: 1e12 - 1e3 });
 }
 
 #[test]
@@ -290,19 +237,13 @@ fn tall_gated_matrix_is_solved_like_its_transpose() {
     for _ in 0..200 {
         let (rows, cols) = (rng.random_range(1..=9), rng.random_range(1..=9));
         let costs = random_gated_matrix(&mut rng, rows, cols);
-        let transposed: Vec<f64> = (0..cols * rows)
-            .map(|index| costs[(index % rows) * cols + index / rows])
-            .collect();
+        let transposed: Vec<f64> =
+            (0..cols * rows).map(|index| costs[(index % rows) * cols + index / rows]).collect();
         let direct = solver.solve(rows, cols, &costs, &mut row_to_col).unwrap();
-        let flipped = solver
-            .solve(cols, rows, &transposed, &mut col_to_row)
-            .unwrap();
+        let flipped = solver.solve(cols, rows, &transposed, &mut col_to_row).unwrap();
         assert_valid_assignment(cols, rows, &transposed, &col_to_row, flipped);
         assert_eq!(direct.pairs, flipped.pairs);
-        assert!(
-            (direct.total_cost - flipped.total_cost).abs()
-                <= 1e-9 * (1.0 + direct.total_cost.abs())
-        );
+        assert!((direct.total_cost - flipped.total_cost).abs() <= 1e-9 * (1.0 + direct.total_cost.abs()));
     }
 }
 
@@ -312,24 +253,9 @@ fn problem_larger_than_capacity_is_rejected() {
     assert_eq!((solver.max_rows(), solver.max_cols()), (3, 5));
     let mut row_to_col = [None; 4];
     let error = solver.solve(4, 2, &[0.0; 8], &mut row_to_col).unwrap_err();
-    assert_eq!(
-        error,
-        AssignmentError::CapacityExceeded {
-            rows: 4,
-            cols: 2,
-            max_rows: 3,
-            max_cols: 5
-        }
-    );
+    assert_eq!(error, AssignmentError::CapacityExceeded { rows: 4, cols: 2, max_rows: 3, max_cols: 5 });
     let error = solver.solve(2, 6, &[0.0; 12], &mut row_to_col).unwrap_err();
-    assert!(matches!(
-        error,
-        AssignmentError::CapacityExceeded {
-            rows: 2,
-            cols: 6,
-            ..
-        }
-    ));
+    assert!(matches!(error, AssignmentError::CapacityExceeded { rows: 2, cols: 6, .. }));
     assert!(error.to_string().contains("2x6"));
 }
 
@@ -338,15 +264,7 @@ fn cost_slice_of_the_wrong_length_is_rejected() {
     let mut solver = AssignmentSolver::with_capacity(3, 3);
     let mut row_to_col = [None; 3];
     let error = solver.solve(2, 3, &[0.0; 5], &mut row_to_col).unwrap_err();
-    assert_eq!(
-        error,
-        AssignmentError::CostLengthMismatch {
-            rows: 2,
-            cols: 3,
-            expected: 6,
-            actual: 5
-        }
-    );
+    assert_eq!(error, AssignmentError::CostLengthMismatch { rows: 2, cols: 3, expected: 6, actual: 5 });
 }
 
 #[test]
@@ -354,10 +272,7 @@ fn output_slice_shorter_than_the_rows_is_rejected() {
     let mut solver = AssignmentSolver::with_capacity(3, 3);
     let mut row_to_col = [None; 2];
     let error = solver.solve(3, 1, &[0.0; 3], &mut row_to_col).unwrap_err();
-    assert_eq!(
-        error,
-        AssignmentError::OutputTooShort { rows: 3, actual: 2 }
-    );
+    assert_eq!(error, AssignmentError::OutputTooShort { rows: 3, actual: 2 });
 }
 
 #[test]
@@ -376,10 +291,7 @@ fn negative_infinite_cost_is_rejected_with_its_position() {
     let mut row_to_col = [None; 3];
     let costs = [1.0, f64::NEG_INFINITY, 3.0, 4.0];
     let error = solver.solve(2, 2, &costs, &mut row_to_col).unwrap_err();
-    assert_eq!(
-        error,
-        AssignmentError::NegativeInfiniteCost { row: 0, col: 1 }
-    );
+    assert_eq!(error, AssignmentError::NegativeInfiniteCost { row: 0, col: 1 });
 }
 
 #[test]
@@ -388,13 +300,7 @@ fn cost_range_too_wide_for_f64_is_rejected() {
     let mut row_to_col = [None; 2];
     let costs = [-1e307, 1e307, 0.0, INF];
     let error = solver.solve(2, 2, &costs, &mut row_to_col).unwrap_err();
-    assert_eq!(
-        error,
-        AssignmentError::CostRangeTooLarge {
-            lowest: -1e307,
-            highest: 1e307
-        }
-    );
+    assert_eq!(error, AssignmentError::CostRangeTooLarge { lowest: -1e307, highest: 1e307 });
 }
 
 #[test]
@@ -403,17 +309,13 @@ fn one_solver_reused_across_shapes_matches_fresh_solvers() {
     let mut reused = AssignmentSolver::with_capacity(12, 12);
     for _ in 0..300 {
         let (rows, cols) = (rng.random_range(0..=12), rng.random_range(0..=12));
-        let costs = if rows == 0 || cols == 0 {
-            Vec::new()
-        } else {
-            random_gated_matrix(&mut rng, rows, cols)
-        };
+        let costs =
+            if rows == 0 || cols == 0 { Vec::new() } else { random_gated_matrix(&mut rng, rows, cols) };
         let mut reused_out = vec![Some(99); rows];
         let mut fresh_out = vec![Some(99); rows];
         let reused_summary = reused.solve(rows, cols, &costs, &mut reused_out).unwrap();
-        let fresh_summary = AssignmentSolver::with_capacity(rows, cols)
-            .solve(rows, cols, &costs, &mut fresh_out)
-            .unwrap();
+        let fresh_summary =
+            AssignmentSolver::with_capacity(rows, cols).solve(rows, cols, &costs, &mut fresh_out).unwrap();
         assert_eq!(reused_out, fresh_out, "{rows}x{cols} differs: {costs:?}");
         assert_eq!(reused_summary, fresh_summary);
     }

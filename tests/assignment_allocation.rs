@@ -51,21 +51,12 @@ fn solving_performs_no_heap_allocation() {
     let mut pairs = 0;
     let count = allocations_during(|| {
         for (rows, cols, costs) in &problems {
-            pairs += solver
-                .solve(*rows, *cols, costs, &mut row_to_col)
-                .unwrap()
-                .pairs;
+            pairs += solver.solve(*rows, *cols, costs, &mut row_to_col).unwrap().pairs;
         }
         let error = solver.solve(1, 2, &nan_problem, &mut row_to_col);
-        assert!(matches!(
-            error,
-            Err(AssignmentError::NanCost { row: 0, col: 1 })
-        ));
+        assert!(matches!(error, Err(AssignmentError::NanCost { row: 0, col: 1 })));
         let error = solver.solve(MAX + 1, 1, &[], &mut row_to_col);
-        assert!(matches!(
-            error,
-            Err(AssignmentError::CapacityExceeded { .. })
-        ));
+        assert!(matches!(error, Err(AssignmentError::CapacityExceeded { .. })));
     });
     assert_eq!(count, 0, "solve allocated {count} times");
     // The full-size dense problem alone yields MAX pairs, so real work was done.

@@ -64,7 +64,12 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
 }
 
 /// Number of pairs and total cost of an assignment.
-fn score(scene: &Scene, config: &Config, track_to_measurement: &[Option<u16>], class: ObjectClass) -> (usize, f64) {
+fn score(
+    scene: &Scene,
+    config: &Config,
+    track_to_measurement: &[Option<u16>],
+    class: ObjectClass,
+) -> (usize, f64) {
     let mut pairs = 0;
     let mut total = 0.0;
     for (i, assigned) in track_to_measurement.iter().enumerate() {
@@ -76,7 +81,12 @@ fn score(scene: &Scene, config: &Config, track_to_measurement: &[Option<u16>], c
         let measurement = scene.frame.measurements[usize::from(*j)];
         assert_eq!(measurement.class, track.class, "a track got a measurement of another class");
         assert!(scene.accepted[usize::from(*j)], "a rejected measurement was assigned");
-        let cost = association_cost(scene.priors[i].fused.mean, track.last_radial_velocity_mps, &measurement, &config.association);
+        let cost = association_cost(
+            scene.priors[i].fused.mean,
+            track.last_radial_velocity_mps,
+            &measurement,
+            &config.association,
+        );
         assert!(cost <= config.classes.get(class).gate_m, "an assigned pair lies outside the gate");
         pairs += 1;
         total += cost;
@@ -87,8 +97,9 @@ fn score(scene: &Scene, config: &Config, track_to_measurement: &[Option<u16>], c
 /// The reference: one dense gated matrix per class, solved at once.
 fn dense_optimum(scene: &Scene, config: &Config, class: ObjectClass) -> (usize, f64) {
     let rows: Vec<usize> = (0..scene.tracks.len()).filter(|&i| scene.tracks[i].class == class).collect();
-    let columns: Vec<usize> =
-        (0..scene.frame.measurements.len()).filter(|&j| scene.accepted[j] && scene.frame.measurements[j].class == class).collect();
+    let columns: Vec<usize> = (0..scene.frame.measurements.len())
+        .filter(|&j| scene.accepted[j] && scene.frame.measurements[j].class == class)
+        .collect();
     if rows.is_empty() || columns.is_empty() {
         return (0, 0.0);
     }
@@ -123,7 +134,14 @@ fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
         let scene = scene(&mut rng, &config);
         let mut track_to_measurement = vec![Some(u16::MAX); scene.tracks.len()];
         associator
-            .associate(&scene.tracks, &scene.priors, &scene.frame, &scene.accepted, &config, &mut track_to_measurement)
+            .associate(
+                &scene.tracks,
+                &scene.priors,
+                &scene.frame,
+                &scene.accepted,
+                &config,
+                &mut track_to_measurement,
+            )
             .unwrap();
         let mut used = vec![false; scene.frame.measurements.len()];
         for j in track_to_measurement.iter().flatten() {
@@ -162,7 +180,10 @@ fn tracks_far_apart_are_paired_without_the_solver() {
         prior.fused.mean = position;
         tracks.push(Track::new(i, &first, 0.0, state));
         priors.push(prior);
-        frame.measurements.push(Measurement { radial_velocity_mps: 1.0, ..measurement(&mut rng, position, 0.5, ObjectClass::Car) });
+        frame.measurements.push(Measurement {
+            radial_velocity_mps: 1.0,
+            ..measurement(&mut rng, position, 0.5, ObjectClass::Car)
+        });
     }
     // Reverse the measurement order so that index order does not line up with track order.
     frame.measurements.reverse();

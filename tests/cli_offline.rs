@@ -5,16 +5,22 @@ use std::process::Command;
 
 fn primm(args: &[&str]) -> std::process::Output {
     let output = Command::new(env!("CARGO_BIN_EXE_primm")).args(args).output().expect("primm runs");
-    assert!(
-        output.status.success(),
-        "primm {args:?} failed:\n{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    assert!(output.status.success(), "primm {args:?} failed:\n{}", String::from_utf8_lossy(&output.stderr));
     output
 }
 
 fn generate(dir: &Path) {
-    primm(&["generate", "--output", dir.to_str().unwrap(), "--split", "evaluation", "--sequences", "2", "--duration-s", "3"]);
+    primm(&[
+        "generate",
+        "--output",
+        dir.to_str().unwrap(),
+        "--split",
+        "evaluation",
+        "--sequences",
+        "2",
+        "--duration-s",
+        "3",
+    ]);
 }
 
 #[test]
@@ -23,7 +29,15 @@ fn track_writes_one_row_per_measurement_with_consistent_columns() {
     generate(&dir);
     let input = dir.join("evaluation/evaluation_0000.csv");
     let output = dir.join("tracks.csv");
-    primm(&["track", "--input", input.to_str().unwrap(), "--output", output.to_str().unwrap(), "--method", "imm"]);
+    primm(&[
+        "track",
+        "--input",
+        input.to_str().unwrap(),
+        "--output",
+        output.to_str().unwrap(),
+        "--method",
+        "imm",
+    ]);
     let sequence = primm::io::read_sequence_file(&input).unwrap();
     let text = std::fs::read_to_string(&output).unwrap();
     let mut lines = text.lines();
@@ -105,14 +119,24 @@ fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
     let lines = std::fs::read_to_string(dir.join("steps.txt")).unwrap();
     assert_eq!(lines.lines().count(), timed_frames, "one step time per frame, appended over the files");
     assert!(lines.lines().all(|line| line.parse::<u64>().is_ok()));
-    let score = primm(&["score", "--data", data.to_str().unwrap(), "--associations", associations.to_str().unwrap(), "--name", "imm"]);
+    let score = primm(&[
+        "score",
+        "--data",
+        data.to_str().unwrap(),
+        "--associations",
+        associations.to_str().unwrap(),
+        "--name",
+        "imm",
+    ]);
     let score: serde_json::Value = serde_json::from_slice(&score.stdout).unwrap();
     let json = dir.join("eval.json");
     primm(&["eval", "--data", data.to_str().unwrap(), "--methods", "imm", "--json", json.to_str().unwrap()]);
     let eval: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let eval = &eval["methods"]["imm"];
     assert_eq!(score["idsw"], eval["idsw"]);
-    for (scored, evaluated) in [("rmse_xy_m", "rmse_xy"), ("rmse_x_m", "rmse_x"), ("rmse_y_m", "rmse_y"), ("idf1", "idf1")] {
+    for (scored, evaluated) in
+        [("rmse_xy_m", "rmse_xy"), ("rmse_x_m", "rmse_x"), ("rmse_y_m", "rmse_y"), ("idf1", "idf1")]
+    {
         let (a, b) = (score[scored].as_f64().unwrap(), eval[evaluated].as_f64().unwrap());
         assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "{scored}: score {a} vs eval {b}");
     }

@@ -55,8 +55,7 @@ fn load_sequences() -> BTreeMap<String, Vec<AssociationRecord>> {
 }
 
 fn load_motmetrics() -> Value {
-    let text = std::fs::read_to_string(fixture("identity_fixture_motmetrics.json"))
-        .expect("motmetrics JSON");
+    let text = std::fs::read_to_string(fixture("identity_fixture_motmetrics.json")).expect("motmetrics JSON");
     serde_json::from_str(&text).expect("valid JSON")
 }
 
@@ -70,17 +69,9 @@ fn assert_counts_match(name: &str, ours: &IdentityCounts, theirs: &Value) {
     assert_eq!(ours.idfn, as_u64(theirs, "idfn"), "{name}: IDFN");
     assert_eq!(ours.idsw, as_u64(theirs, "num_switches"), "{name}: IDSW");
     assert_eq!(ours.gt_object_frames, as_u64(theirs, "num_objects"), "{name}: GT frames");
-    assert_eq!(
-        ours.estimated_object_frames,
-        as_u64(theirs, "num_predictions"),
-        "{name}: estimated frames"
-    );
+    assert_eq!(ours.estimated_object_frames, as_u64(theirs, "num_predictions"), "{name}: estimated frames");
     let idf1 = theirs["idf1"].as_f64().expect("idf1");
-    assert!(
-        (ours.idf1().unwrap() - idf1).abs() < 1e-12,
-        "{name}: IDF1 {:?} vs {idf1}",
-        ours.idf1()
-    );
+    assert!((ours.idf1().unwrap() - idf1).abs() < 1e-12, "{name}: IDF1 {:?} vs {idf1}", ours.idf1());
 }
 
 #[test]

@@ -72,8 +72,7 @@ fn count(haystack: &str, needle: &str) -> usize {
 
 #[test]
 fn trajectory_figure_has_one_panel_per_method_with_all_trajectories() {
-    let methods =
-        [(Method::Imm, 1.2, Some(35)), (Method::Learned, 0.6, None), (Method::PrImm, 0.3, None)];
+    let methods = [(Method::Imm, 1.2, Some(35)), (Method::Learned, 0.6, None), (Method::PrImm, 0.3, None)];
     let mut ground_truth = Vec::new();
     let mut panels = Vec::new();
     for (index, (method, noise, switch)) in methods.into_iter().enumerate() {
@@ -92,14 +91,9 @@ fn trajectory_figure_has_one_panel_per_method_with_all_trajectories() {
     };
     let svg = trajectory_svg(&ground_truth, &panels, &options).unwrap();
     assert!(svg.starts_with("<svg"));
-    for text in [
-        "IMM",
-        "PR-IMM",
-        "Synthetic crossing scene",
-        "ground truth",
-        "estimated track",
-        "track start",
-    ] {
+    for text in
+        ["IMM", "PR-IMM", "Synthetic crossing scene", "ground truth", "estimated track", "track start"]
+    {
         assert!(svg.contains(text), "missing text {text}");
     }
     assert_eq!(count(&svg, "x, longitudinal [m]"), 3);
@@ -113,8 +107,7 @@ fn trajectory_figure_has_one_panel_per_method_with_all_trajectories() {
     assert_eq!(thin, 2 * (3 + 2 + 2) + 2);
     assert_eq!(count(&svg, "<circle"), 3 + 2 + 2 + 1);
     assert!(ground_truth_lines >= 3 * 2 + 3 + 2 + 2);
-    write_trajectory_svg(output_dir().join("trajectories.svg"), &ground_truth, &panels, &options)
-        .unwrap();
+    write_trajectory_svg(output_dir().join("trajectories.svg"), &ground_truth, &panels, &options).unwrap();
 }
 
 #[test]
@@ -130,8 +123,7 @@ fn single_point_tracks_are_drawn_as_dots() {
     };
     let svg = trajectory_svg(&ground_truth, &[panel], &TrajectoryPlotOptions::default()).unwrap();
     // One filled dot for the track; the legend's start marker is the only hollow circle.
-    let circles: Vec<&str> =
-        svg.split("<circle").skip(1).filter_map(|rest| rest.split('>').next()).collect();
+    let circles: Vec<&str> = svg.split("<circle").skip(1).filter_map(|rest| rest.split('>').next()).collect();
     assert_eq!(circles.len(), 2);
     assert_eq!(circles.iter().filter(|c| c.contains("fill=\"none\"")).count(), 1);
 }

@@ -33,7 +33,11 @@ fn sampled(step: usize) -> bool {
 /// Mean NEES of `samples` independent samples and the two-sided 95 % χ² interval of that mean.
 fn nees_interval(mean: f64, samples: usize, dimension: usize) -> (f64, f64, f64) {
     let dof = (samples * dimension) as f64;
-    (mean, chi_squared_quantile(dof, -1.959_964) / samples as f64, chi_squared_quantile(dof, 1.959_964) / samples as f64)
+    (
+        mean,
+        chi_squared_quantile(dof, -1.959_964) / samples as f64,
+        chi_squared_quantile(dof, 1.959_964) / samples as f64,
+    )
 }
 
 #[test]
@@ -53,7 +57,8 @@ fn constant_velocity_filter_is_consistent_on_motion_drawn_from_its_own_model() {
         let mut truth: Vector4<f64> = estimate.mean + common::sample(&mut rng, &estimate.covariance);
         for step in 0..steps {
             let dt = irregular_dt(step);
-            truth = ConstantVelocity::transition(dt) * truth + common::sample(&mut rng, &model.process_noise(dt));
+            truth =
+                ConstantVelocity::transition(dt) * truth + common::sample(&mut rng, &model.process_noise(dt));
             let noise = common::sample(&mut rng, &r);
             let z = DVec2::new(truth[0] + noise[0], truth[1] + noise[1]);
             let prior = model.predict(&estimate, &PredictContext { dt_s: dt, displacement_m: None });
@@ -85,7 +90,8 @@ fn coordinated_turn_filter_is_consistent_on_motion_drawn_from_its_own_model() {
         let mut truth: Vector5 = estimate.mean + common::sample(&mut rng, &estimate.covariance);
         for step in 0..steps {
             let dt = irregular_dt(step);
-            truth = CoordinatedTurn::transition(&truth, dt) + common::sample(&mut rng, &model.process_noise(dt));
+            truth =
+                CoordinatedTurn::transition(&truth, dt) + common::sample(&mut rng, &model.process_noise(dt));
             let noise = common::sample(&mut rng, &r);
             let z = DVec2::new(truth[0] + noise[0], truth[1] + noise[1]);
             let prior = model.predict(&estimate, &PredictContext { dt_s: dt, displacement_m: None });
@@ -104,7 +110,9 @@ fn coordinated_turn_filter_is_consistent_on_motion_drawn_from_its_own_model() {
 
 #[test]
 fn a_single_mode_imm_is_exactly_that_modes_kalman_filter() {
-    for method in [Method::ConstantVelocity, Method::ConstantAcceleration, Method::CoordinatedTurn, Method::Learned] {
+    for method in
+        [Method::ConstantVelocity, Method::ConstantAcceleration, Method::CoordinatedTurn, Method::Learned]
+    {
         let config = Config::default().with_modes(method.modes());
         let models = ModeModels::from_config(&config.classes.car);
         let imm = Imm::new(&config.imm);
@@ -117,30 +125,38 @@ fn a_single_mode_imm_is_exactly_that_modes_kalman_filter() {
         for step in 0..300 {
             let dt = irregular_dt(step);
             position += DVec2::new(6.0, 1.0 + (step as f64 * 0.05).sin()) * dt;
-            let z = position + DVec2::new(common::standard_normal(&mut rng), common::standard_normal(&mut rng)) * 0.5;
+            let z = position
+                + DVec2::new(common::standard_normal(&mut rng), common::standard_normal(&mut rng)) * 0.5;
             let context = PredictContext { dt_s: dt, displacement_m: Some(DVec2::new(6.0, 1.0) * dt) };
             let prior = imm.predict(&models, &state, &context);
             state = imm.update(&models, &prior, z).unwrap();
             match mode {
                 Mode::Learned => {
                     let p = models.learned.predict(&plain.learned, &context);
-                    plain.learned = kalman_update(&p, z, &models.learned.measurement_noise()).unwrap().posterior;
+                    plain.learned =
+                        kalman_update(&p, z, &models.learned.measurement_noise()).unwrap().posterior;
                     assert_eq!(state.learned, plain.learned);
                 }
                 Mode::ConstantVelocity => {
                     let p = models.constant_velocity.predict(&plain.constant_velocity, &context);
-                    plain.constant_velocity = kalman_update(&p, z, &models.constant_velocity.measurement_noise()).unwrap().posterior;
+                    plain.constant_velocity =
+                        kalman_update(&p, z, &models.constant_velocity.measurement_noise())
+                            .unwrap()
+                            .posterior;
                     assert_eq!(state.constant_velocity, plain.constant_velocity);
                 }
                 Mode::ConstantAcceleration => {
                     let p = models.constant_acceleration.predict(&plain.constant_acceleration, &context);
                     plain.constant_acceleration =
-                        kalman_update(&p, z, &models.constant_acceleration.measurement_noise()).unwrap().posterior;
+                        kalman_update(&p, z, &models.constant_acceleration.measurement_noise())
+                            .unwrap()
+                            .posterior;
                     assert_eq!(state.constant_acceleration, plain.constant_acceleration);
                 }
                 Mode::CoordinatedTurn => {
                     let p = models.coordinated_turn.predict(&plain.coordinated_turn, &context);
-                    plain.coordinated_turn = kalman_update(&p, z, &models.coordinated_turn.measurement_noise()).unwrap().posterior;
+                    plain.coordinated_turn =
+                        kalman_update(&p, z, &models.coordinated_turn.measurement_noise()).unwrap().posterior;
                     assert_eq!(state.coordinated_turn, plain.coordinated_turn);
                 }
             }
@@ -168,7 +184,9 @@ fn run_on_turn_with(config: Config, oracle: bool, speed: f64, turn_rate: f64, no
     // ~24 s: straight until 8 s, a 0.35 rad/s turn until 14 s, straight again.
     let truth = common::straight_turn_straight(&dts, speed, 8.0, 14.0, turn_rate);
     let mut rng = common::rng(11);
-    let noise = |rng: &mut rand_chacha::ChaCha8Rng| DVec2::new(common::standard_normal(rng), common::standard_normal(rng)) * noise_std;
+    let noise = |rng: &mut rand_chacha::ChaCha8Rng| {
+        DVec2::new(common::standard_normal(rng), common::standard_normal(rng)) * noise_std
+    };
     let (_, p0, v0, _) = truth[0];
     let z0 = DVec2::from(p0) + noise(&mut rng);
     let mut state = imm.initiate(&models, &common::measurement(z0.x, z0.y, common::radial_velocity(p0, v0)));
@@ -190,8 +208,12 @@ fn run_on_turn_with(config: Config, oracle: bool, speed: f64, turn_rate: f64, no
 }
 
 fn mean_probability(run: &Run, mode: Mode, from: f64, to: f64) -> f64 {
-    let selected: Vec<f64> =
-        run.probabilities.iter().filter(|(t, _)| *t >= from && *t < to).map(|(_, p)| p[mode.index()]).collect();
+    let selected: Vec<f64> = run
+        .probabilities
+        .iter()
+        .filter(|(t, _)| *t >= from && *t < to)
+        .map(|(_, p)| p[mode.index()])
+        .collect();
     selected.iter().sum::<f64>() / selected.len() as f64
 }
 
@@ -228,15 +250,20 @@ fn the_fused_prior_weights_mode_priors_by_the_prior_probabilities() {
     let imm = Imm::new(&config.imm);
     let mut state = imm.initiate(&models, &common::measurement(10.0, 0.0, 3.0));
     state.probabilities = [0.1, 0.2, 0.3, 0.4];
-    let prior = imm.predict(&models, &state, &PredictContext { dt_s: 0.1, displacement_m: Some(DVec2::new(1.0, 2.0)) });
-    let expected: DVec2 = Mode::ALL.iter().map(|m| prior.state.probabilities[m.index()] * prior.state.position(*m).mean).sum();
+    let prior = imm.predict(
+        &models,
+        &state,
+        &PredictContext { dt_s: 0.1, displacement_m: Some(DVec2::new(1.0, 2.0)) },
+    );
+    let expected: DVec2 =
+        Mode::ALL.iter().map(|m| prior.state.probabilities[m.index()] * prior.state.position(*m).mean).sum();
     assert!((prior.fused.mean - expected).length() < 1e-12);
     // Without a displacement the PR mode drops out of the fusion.
     let prior = imm.predict(&models, &state, &PredictContext { dt_s: 0.1, displacement_m: None });
     assert!(!prior.available.contains(Mode::Learned));
     let c = prior.state.probabilities;
     let others = c[1] + c[2] + c[3];
-    let expected: DVec2 = Mode::ALL[1..].iter().map(|m| c[m.index()] / others * prior.state.position(*m).mean).sum();
+    let expected: DVec2 =
+        Mode::ALL[1..].iter().map(|m| c[m.index()] / others * prior.state.position(*m).mean).sum();
     assert!((prior.fused.mean - expected).length() < 1e-12);
 }
-

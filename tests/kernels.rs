@@ -56,8 +56,9 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
         assert_eq!(bits(&dispatched), bits(&plain), "{method}: predict_physics");
 
         // Every third track without a learned displacement.
-        let displacements: Vec<Option<DVec2>> =
-            (0..tracks.len()).map(|i| (i % 3 != 0).then(|| DVec2::new(0.4 + 0.01 * i as f64, -0.05))).collect();
+        let displacements: Vec<Option<DVec2>> = (0..tracks.len())
+            .map(|i| (i % 3 != 0).then(|| DVec2::new(0.4 + 0.01 * i as f64, -0.05)))
+            .collect();
         kernels::complete_priors(&imm, &models, &tracks, dt_s, &displacements, &mut dispatched);
         for ((track, prior), displacement) in tracks.iter().zip(plain.iter_mut()).zip(&displacements) {
             imm.complete_prior_in_place(&models[track.class.index()], prior, dt_s, *displacement);
@@ -68,7 +69,9 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
         let measurements: Vec<Option<Measurement>> = plain
             .iter()
             .enumerate()
-            .map(|(i, prior)| (i % 4 != 0).then(|| measurement(prior.fused.mean.x + 0.3, prior.fused.mean.y - 0.2, 1.0)))
+            .map(|(i, prior)| {
+                (i % 4 != 0).then(|| measurement(prior.fused.mean.x + 0.3, prior.fused.mean.y - 0.2, 1.0))
+            })
             .collect();
         let mut dispatched_tracks = tracks.clone();
         let mut outcomes = vec![Err(UpdateError); tracks.len()];
@@ -76,7 +79,12 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
         let mut plain_tracks = tracks.clone();
         for (i, track) in plain_tracks.iter_mut().enumerate() {
             let expected = match measurements[i] {
-                Some(z) => imm.update_into(&models[track.class.index()], &plain[i], z.position(), &mut track.estimate),
+                Some(z) => imm.update_into(
+                    &models[track.class.index()],
+                    &plain[i],
+                    z.position(),
+                    &mut track.estimate,
+                ),
                 None => Ok(()),
             };
             assert_eq!(outcomes[i], expected, "{method}: outcome of track {i}");

@@ -23,7 +23,12 @@ fn coordinated_turn_without_turning_is_constant_velocity() {
             let ct = CoordinatedTurn::transition(&state, dt);
             let cv = cv_prediction(&state, dt);
             for i in 0..4 {
-                assert!((ct[i] - cv[i]).abs() < 1e-9, "omega {omega} dt {dt} index {i}: {} vs {}", ct[i], cv[i]);
+                assert!(
+                    (ct[i] - cv[i]).abs() < 1e-9,
+                    "omega {omega} dt {dt} index {i}: {} vs {}",
+                    ct[i],
+                    cv[i]
+                );
             }
             let jacobian = CoordinatedTurn::jacobian(&state, dt);
             let f = ConstantVelocity::transition(dt);
@@ -108,7 +113,8 @@ fn coordinated_turn_jacobian_matches_central_finite_differences() {
             let mut minus = state;
             plus[c] += h;
             minus[c] -= h;
-            let numeric = (CoordinatedTurn::transition(&plus, dt) - CoordinatedTurn::transition(&minus, dt)) / (2.0 * h);
+            let numeric = (CoordinatedTurn::transition(&plus, dt) - CoordinatedTurn::transition(&minus, dt))
+                / (2.0 * h);
             for r in 0..5 {
                 let tolerance = 1e-6 * (1.0 + analytic[(r, c)].abs());
                 assert!(
@@ -129,7 +135,8 @@ fn constant_velocity_converges_to_the_true_state_on_noise_free_straight_motion()
     let (velocity_x, velocity_y) = (11.0, -2.5);
     let start = [20.0, 5.0];
     let mut t = 0.0;
-    let first = common::measurement(start[0], start[1], common::radial_velocity(start, [velocity_x, velocity_y]));
+    let first =
+        common::measurement(start[0], start[1], common::radial_velocity(start, [velocity_x, velocity_y]));
     let mut estimate = model.initiate(&first);
     for k in 0..400 {
         let dt = 0.03 + 0.04 * ((k * 7) % 5) as f64 / 4.0;
@@ -187,8 +194,18 @@ fn initial_velocity_lies_along_the_line_of_sight_with_the_measured_radial_speed(
     let across = nalgebra::Vector2::new(-0.8, 0.6);
     let velocity_covariance = g.covariance.fixed_view::<2, 2>(2, 2).into_owned();
     let config = common::config();
-    assert!(((along.transpose() * velocity_covariance * along)[(0, 0)] - config.classes.car.radial_velocity_std_mps.powi(2)).abs() < 1e-12);
-    assert!(((across.transpose() * velocity_covariance * across)[(0, 0)] - config.classes.car.initial_tangential_speed_std_mps.powi(2)).abs() < 1e-9);
+    assert!(
+        ((along.transpose() * velocity_covariance * along)[(0, 0)]
+            - config.classes.car.radial_velocity_std_mps.powi(2))
+        .abs()
+            < 1e-12
+    );
+    assert!(
+        ((across.transpose() * velocity_covariance * across)[(0, 0)]
+            - config.classes.car.initial_tangential_speed_std_mps.powi(2))
+        .abs()
+            < 1e-9
+    );
 }
 
 /// A random symmetric positive definite matrix.

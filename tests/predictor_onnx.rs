@@ -27,7 +27,10 @@ fn parity() -> Parity {
     serde_json::from_str(&text).expect("parity fixture parses")
 }
 
-fn flatten(features: &[[[f32; FEATURES]; MAX_HISTORY]], valid: &[[f32; MAX_HISTORY]]) -> (Vec<f32>, Vec<f32>) {
+fn flatten(
+    features: &[[[f32; FEATURES]; MAX_HISTORY]],
+    valid: &[[f32; MAX_HISTORY]],
+) -> (Vec<f32>, Vec<f32>) {
     (features.iter().flatten().flatten().copied().collect(), valid.iter().flatten().copied().collect())
 }
 
@@ -102,7 +105,13 @@ fn the_valid_rows_matter() {
 fn history(points: &[(f64, f64, f64)]) -> Vec<HistoryEntry> {
     points
         .iter()
-        .map(|&(t, x, y)| HistoryEntry { x_m: x, y_m: y, radial_velocity_mps: -3.0, rcs_dbsm: 5.0, timestamp_s: t })
+        .map(|&(t, x, y)| HistoryEntry {
+            x_m: x,
+            y_m: y,
+            radial_velocity_mps: -3.0,
+            rcs_dbsm: 5.0,
+            timestamp_s: t,
+        })
         .collect()
 }
 

@@ -38,7 +38,8 @@ fn the_step_start_is_kept_between_the_latest_measurement_and_the_prediction_time
 
 #[test]
 fn re_timing_shifts_only_the_time_feature_of_the_valid_rows() {
-    let request = PredictionRequest::from_history(&entries(&[0.0, 0.03, 0.06, 0.09]), 0.12).with_step_start(0.105);
+    let request =
+        PredictionRequest::from_history(&entries(&[0.0, 0.03, 0.06, 0.09]), 0.12).with_step_start(0.105);
     let earlier = request.at_time(0.105);
     assert_eq!(earlier.prediction_time_s, 0.105);
     assert_eq!(earlier.len, request.len);

@@ -202,7 +202,8 @@ fn dropping_the_predictor_stops_its_thread() {
     }
     let dropped = Arc::new(AtomicU64::new(0));
     let predictor =
-        ThreadedPredictor::new(Holder(Echo::new(), Counted(dropped.clone())), Duration::from_secs(1)).unwrap();
+        ThreadedPredictor::new(Holder(Echo::new(), Counted(dropped.clone())), Duration::from_secs(1))
+            .unwrap();
     drop(predictor);
     // The inference thread was joined, so the predictor it owned is gone.
     assert_eq!(dropped.load(Ordering::SeqCst), 1);
@@ -212,7 +213,8 @@ fn dropping_the_predictor_stops_its_thread() {
 fn the_threaded_onnx_predictor_gives_the_synchronous_results() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr.onnx");
     let mut synchronous = OnnxPredictor::load(&path).unwrap();
-    let mut threaded = ThreadedPredictor::new(OnnxPredictor::load(&path).unwrap(), Duration::from_secs(5)).unwrap();
+    let mut threaded =
+        ThreadedPredictor::new(OnnxPredictor::load(&path).unwrap(), Duration::from_secs(5)).unwrap();
     for frame in 0..20 {
         let t = frame as f64 * 0.015;
         let batch: Vec<PredictionRequest> = (0..(5 + frame % 11))

@@ -16,7 +16,8 @@ fn objects(sequence: &Sequence) -> BTreeMap<u64, Vec<(HistoryEntry, DVec2, Objec
     let mut objects: BTreeMap<u64, Vec<_>> = BTreeMap::new();
     for frame in &sequence.frames {
         for recorded in &frame.measurements {
-            let (Some(id), Some(truth)) = (recorded.measurement.ground_truth_id, recorded.true_position) else {
+            let (Some(id), Some(truth)) = (recorded.measurement.ground_truth_id, recorded.true_position)
+            else {
                 continue;
             };
             let m = &recorded.measurement;
@@ -68,7 +69,8 @@ fn the_model_predicts_the_next_displacement_far_better_than_constant_velocity_fr
             // two-measurement extrapolation exists for every case compared).
             for j in 1..track.len() - 1 {
                 let start = (j + 1).saturating_sub(MAX_HISTORY);
-                let history: Vec<HistoryEntry> = track[start..=j].iter().map(|(entry, _, _)| *entry).collect();
+                let history: Vec<HistoryEntry> =
+                    track[start..=j].iter().map(|(entry, _, _)| *entry).collect();
                 let next_time = track[j + 1].0.timestamp_s;
                 if next_time - track[j].0.timestamp_s > 0.2 {
                     continue;

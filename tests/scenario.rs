@@ -8,17 +8,15 @@ use glam::DVec2;
 use primm::io::{read_sequence, write_sequence, RecordedFrame, Sequence};
 use primm::measurement::ObjectClass;
 use primm::scenario::{
-    count_events, GeneratedSequence, ObjectState, Preset, RadarMount, ScenarioConfig,
-    ScenarioGenerator, Split, SplitSummary, TruthFrame, SPLIT_SEED_STRIDE,
+    count_events, GeneratedSequence, ObjectState, Preset, RadarMount, ScenarioConfig, ScenarioGenerator,
+    Split, SplitSummary, TruthFrame, SPLIT_SEED_STRIDE,
 };
 
 /// The default evaluation split, generated once and shared by the tests that inspect it.
 fn evaluation_split() -> &'static [GeneratedSequence] {
     static SPLIT: OnceLock<Vec<GeneratedSequence>> = OnceLock::new();
     SPLIT.get_or_init(|| {
-        ScenarioGenerator::from_preset(Preset::Default)
-            .split_sequences(Split::Evaluation)
-            .collect()
+        ScenarioGenerator::from_preset(Preset::Default).split_sequences(Split::Evaluation).collect()
     })
 }
 
@@ -29,12 +27,7 @@ fn short_generator(preset: Preset, duration_s: f64) -> ScenarioGenerator {
 }
 
 fn mount_of(config: &ScenarioConfig, sensor_id: u16) -> &RadarMount {
-    config
-        .radar
-        .sensors
-        .iter()
-        .find(|s| s.id == sensor_id)
-        .expect("known sensor")
+    config.radar.sensors.iter().find(|s| s.id == sensor_id).expect("known sensor")
 }
 
 /// Mean and standard deviation.
@@ -66,13 +59,8 @@ fn different_seeds_give_different_sequences() {
     assert_ne!(a.sequence.frames, b.sequence.frames);
     let pose = |g: &GeneratedSequence| g.sequence.frames[0].ego_pose.expect("ego pose");
     assert_ne!(pose(&a), pose(&b));
-    let timestamps = |g: &GeneratedSequence| {
-        g.sequence
-            .frames
-            .iter()
-            .map(|f| f.timestamp_s)
-            .collect::<Vec<_>>()
-    };
+    let timestamps =
+        |g: &GeneratedSequence| g.sequence.frames.iter().map(|f| f.timestamp_s).collect::<Vec<_>>();
     assert_ne!(timestamps(&a), timestamps(&b));
 }
 
@@ -103,10 +91,7 @@ fn tracks(truth: &[TruthFrame]) -> HashMap<u64, Vec<(f64, ObjectState)>> {
     let mut tracks: HashMap<u64, Vec<(f64, ObjectState)>> = HashMap::new();
     for frame in truth {
         for object in &frame.objects {
-            tracks
-                .entry(object.id)
-                .or_default()
-                .push((frame.timestamp_s, *object));
+            tracks.entry(object.id).or_default().push((frame.timestamp_s, *object));
         }
     }
     tracks
@@ -151,11 +136,7 @@ fn check_kinematics(preset: Preset, sequences: u32) -> [f64; 2] {
                     "{ctx}: deceleration {}",
                     o.acceleration_mps2
                 );
-                assert!(
-                    o.yaw_rate_radps.abs() <= max_yaw + 1e-9,
-                    "{ctx}: yaw rate {}",
-                    o.yaw_rate_radps
-                );
+                assert!(o.yaw_rate_radps.abs() <= max_yaw + 1e-9, "{ctx}: yaw rate {}", o.yaw_rate_radps);
                 if o.class == ObjectClass::Car {
                     let lateral = o.speed_mps * o.yaw_rate_radps.abs();
                     assert!(
@@ -191,10 +172,7 @@ fn check_kinematics(preset: Preset, sequences: u32) -> [f64; 2] {
                 let cruising = a.speed_mps > 0.0 && b.speed_mps > 0.0 && b.speed_mps < limit_speed;
                 if cruising {
                     let jerk = (b.acceleration_mps2 - a.acceleration_mps2).abs() / dt;
-                    assert!(
-                        jerk <= max_jerk + 1e-6,
-                        "{preset} object {id}: jerk {jerk} at t = {t1}"
-                    );
+                    assert!(jerk <= max_jerk + 1e-6, "{preset} object {id}: jerk {jerk} at t = {t1}");
                 }
             }
         }
@@ -208,16 +186,8 @@ fn kinematic_limits_hold_over_many_sequences() {
     let default = check_kinematics(Preset::Default, 10);
     let cfg = ScenarioConfig::default();
     // Objects really move: cars reach urban speeds, pedestrians walk.
-    assert!(
-        default[0] > 0.6 * cfg.car.desired_speed_mps[1],
-        "fastest car {}",
-        default[0]
-    );
-    assert!(
-        default[1] > cfg.pedestrian.desired_speed_mps[0],
-        "fastest pedestrian {}",
-        default[1]
-    );
+    assert!(default[0] > 0.6 * cfg.car.desired_speed_mps[1], "fastest car {}", default[0]);
+    assert!(default[1] > cfg.pedestrian.desired_speed_mps[0], "fastest pedestrian {}", default[1]);
     let robust = check_kinematics(Preset::Robustness, 6);
     assert!(
         robust[0] > default[0],
@@ -232,34 +202,22 @@ fn frames_are_irregular_positive_steps_from_interleaved_sensors() {
     let generated = &evaluation_split()[0];
     let cfg = ScenarioConfig::default();
     let frames = &generated.sequence.frames;
-    let dts: Vec<f64> = frames
-        .windows(2)
-        .map(|p| p[1].timestamp_s - p[0].timestamp_s)
-        .collect();
+    let dts: Vec<f64> = frames.windows(2).map(|p| p[1].timestamp_s - p[0].timestamp_s).collect();
     assert!(dts.iter().all(|&dt| dt > 0.0), "non-positive time step");
     let (mean, std) = mean_std(&dts);
     let slot = cfg.radar.scan_period_s / cfg.radar.sensors.len() as f64;
     assert!((mean - slot).abs() < 0.001, "mean frame interval {mean} s");
     assert!(std > 0.001, "frame intervals too regular: std {std} s");
     for pair in frames.windows(2) {
-        assert_ne!(
-            pair[0].sensor_id, pair[1].sensor_id,
-            "consecutive frames from one sensor"
-        );
+        assert_ne!(pair[0].sensor_id, pair[1].sensor_id, "consecutive frames from one sensor");
     }
     let sensors: HashSet<u16> = frames.iter().filter_map(|f| f.sensor_id).collect();
     assert_eq!(sensors.len(), cfg.radar.sensors.len());
     for &sensor in &sensors {
-        let times: Vec<f64> = frames
-            .iter()
-            .filter(|f| f.sensor_id == Some(sensor))
-            .map(|f| f.timestamp_s)
-            .collect();
+        let times: Vec<f64> =
+            frames.iter().filter(|f| f.sensor_id == Some(sensor)).map(|f| f.timestamp_s).collect();
         let (period, _) = mean_std(&times.windows(2).map(|p| p[1] - p[0]).collect::<Vec<_>>());
-        assert!(
-            (period - cfg.radar.scan_period_s).abs() < 0.002,
-            "sensor {sensor} period {period}"
-        );
+        assert!((period - cfg.radar.scan_period_s).abs() < 0.002, "sensor {sensor} period {period}");
     }
     // Frame indices are 0-based and consecutive; truth is aligned.
     for (i, (frame, truth)) in frames.iter().zip(&generated.truth).enumerate() {
@@ -270,10 +228,7 @@ fn frames_are_irregular_positive_steps_from_interleaved_sensors() {
 
 /// Measurement position error in the sensor's polar frame: (along line of sight, across,
 /// range of the true position).
-fn polar_errors(
-    cfg: &ScenarioConfig,
-    frame: &RecordedFrame,
-) -> Vec<(ObjectClass, u16, f64, f64, f64)> {
+fn polar_errors(cfg: &ScenarioConfig, frame: &RecordedFrame) -> Vec<(ObjectClass, u16, f64, f64, f64)> {
     let sensor_id = frame.sensor_id.expect("sensor id");
     let mount = mount_of(cfg, sensor_id);
     let origin = DVec2::new(mount.x_m, mount.y_m);
@@ -284,13 +239,7 @@ fn polar_errors(
             let truth = m.true_position.expect("true position");
             let los = (truth - origin).normalize();
             let error = m.measurement.position() - truth;
-            (
-                m.measurement.class,
-                sensor_id,
-                error.dot(los),
-                los.perp_dot(error),
-                (truth - origin).length(),
-            )
+            (m.measurement.class, sensor_id, error.dot(los), los.perp_dot(error), (truth - origin).length())
         })
         .collect()
 }
@@ -309,10 +258,7 @@ fn measurement_errors_depend_on_size_aspect_and_sensor() {
                 entry.0.push(along);
                 entry.1.push(across);
                 if class == ObjectClass::Pedestrian {
-                    ped_angle_by_sensor
-                        .entry(sensor)
-                        .or_default()
-                        .push((across / range).atan().to_degrees());
+                    ped_angle_by_sensor.entry(sensor).or_default().push((across / range).atan().to_degrees());
                     if range < 20.0 {
                         ped_cross_near.push(across);
                     } else if range > 40.0 {
@@ -328,19 +274,13 @@ fn measurement_errors_depend_on_size_aspect_and_sensor() {
     let car_rms = rms(car_along).hypot(rms(car_across));
     let ped_rms = rms(ped_along).hypot(rms(ped_across));
     assert!(ped_rms > 0.1, "pedestrian errors vanish: {ped_rms}");
-    assert!(
-        car_rms > 1.5 * ped_rms,
-        "car error {car_rms} not larger than pedestrian error {ped_rms}"
-    );
+    assert!(car_rms > 1.5 * ped_rms, "car error {car_rms} not larger than pedestrian error {ped_rms}");
     // Reflections come from the faces turned to the sensor: the centroid is pulled towards it,
     // more so for long objects. The error is therefore not zero-mean along the line of sight.
     let (car_bias, _) = mean_std(car_along);
     let (ped_bias, _) = mean_std(ped_along);
     assert!(car_bias < -0.3, "car line-of-sight bias {car_bias}");
-    assert!(
-        car_bias < ped_bias,
-        "car bias {car_bias} should exceed pedestrian bias {ped_bias}"
-    );
+    assert!(car_bias < ped_bias, "car bias {car_bias} should exceed pedestrian bias {ped_bias}");
     // Across the line of sight the error is roughly centred, but it widens with range
     // (azimuth noise).
     let (car_cross_mean, car_cross_std) = mean_std(car_across);
@@ -350,21 +290,12 @@ fn measurement_errors_depend_on_size_aspect_and_sensor() {
     );
     let (_, near) = mean_std(&ped_cross_near);
     let (_, far) = mean_std(&ped_cross_far);
-    assert!(
-        far > 1.3 * near,
-        "cross-range spread near {near} vs far {far}"
-    );
+    assert!(far > 1.3 * near, "cross-range spread near {near} vs far {far}");
     // Sensors differ (mounting misalignment): their mean angular errors are not all equal.
-    let means: Vec<f64> = ped_angle_by_sensor
-        .values()
-        .map(|v| mean_std(v).0)
-        .collect();
-    let spread = means.iter().cloned().fold(f64::MIN, f64::max)
-        - means.iter().cloned().fold(f64::MAX, f64::min);
-    assert!(
-        spread > 0.2,
-        "per-sensor mean azimuth errors too similar: {means:?}"
-    );
+    let means: Vec<f64> = ped_angle_by_sensor.values().map(|v| mean_std(v).0).collect();
+    let spread =
+        means.iter().cloned().fold(f64::MIN, f64::max) - means.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(spread > 0.2, "per-sensor mean azimuth errors too similar: {means:?}");
 }
 
 #[test]
@@ -400,15 +331,9 @@ fn radial_velocity_is_the_projected_true_velocity() {
     assert!(mean.abs() < 0.1, "radial velocity bias {mean}");
     assert!(std < 0.5, "radial velocity residual std {std}");
     assert!(std > 0.01, "radial velocity has no noise");
-    assert!(
-        spread > 3.0 * std,
-        "radial velocities barely vary ({spread})"
-    );
+    assert!(spread > 3.0 * std, "radial velocities barely vary ({spread})");
     assert!(moving_away.0 > 100);
-    assert!(
-        moving_away.1 as f64 > 0.97 * moving_away.0 as f64,
-        "sign convention: {moving_away:?}"
-    );
+    assert!(moving_away.1 as f64 > 0.97 * moving_away.0 as f64, "sign convention: {moving_away:?}");
 }
 
 #[test]
@@ -416,17 +341,10 @@ fn every_class_appears_in_every_split_kind() {
     let mut summary = SplitSummary::new(Split::Evaluation);
     for generated in evaluation_split() {
         summary.add_generated(generated);
-        assert!(
-            generated.sequence.measurement_count() > 0,
-            "{} has no measurement",
-            generated.sequence.name
-        );
+        assert!(generated.sequence.measurement_count() > 0, "{} has no measurement", generated.sequence.name);
         for frame in &generated.sequence.frames {
             for m in &frame.measurements {
-                assert!(matches!(
-                    m.measurement.class,
-                    ObjectClass::Car | ObjectClass::Pedestrian
-                ));
+                assert!(matches!(m.measurement.class, ObjectClass::Car | ObjectClass::Pedestrian));
                 assert_eq!(m.measurement.sensor_id, frame.sensor_id);
             }
         }
@@ -435,14 +353,8 @@ fn every_class_appears_in_every_split_kind() {
     assert!(summary.car_object_frames > 1000, "{summary:?}");
     assert!(summary.pedestrian_object_frames > 1000, "{summary:?}");
     let total = summary.object_frames();
-    assert!(
-        (15_000..=25_000).contains(&total),
-        "evaluation split has {total} object measurements"
-    );
-    let frames: usize = evaluation_split()
-        .iter()
-        .map(|g| g.sequence.frames.len())
-        .sum();
+    assert!((15_000..=25_000).contains(&total), "evaluation split has {total} object measurements");
+    let frames: usize = evaluation_split().iter().map(|g| g.sequence.frames.len()).sum();
     assert_eq!(summary.frames, frames);
     // The robustness preset also produces both classes.
     let robust = short_generator(Preset::Robustness, 3.0).generate(Split::Evaluation, 0);
@@ -461,18 +373,9 @@ fn close_proximity_and_crossing_occur_in_the_evaluation_split() {
         crossing_sequences += usize::from(events.crossing_frames > 0);
         total += events;
     }
-    assert!(
-        close_sequences >= 11,
-        "close proximity in only {close_sequences} of 22 sequences"
-    );
-    assert!(
-        crossing_sequences >= 3,
-        "crossing in only {crossing_sequences} of 22 sequences"
-    );
-    assert!(
-        total.close_proximity_frames > 500 && total.crossing_frames > 50,
-        "{total:?}"
-    );
+    assert!(close_sequences >= 11, "close proximity in only {close_sequences} of 22 sequences");
+    assert!(crossing_sequences >= 3, "crossing in only {crossing_sequences} of 22 sequences");
+    assert!(total.close_proximity_frames > 500 && total.crossing_frames > 50, "{total:?}");
 }
 
 #[test]
@@ -491,24 +394,14 @@ fn objects_enter_and_leave_the_field_of_view() {
         }
         for (id, (first, final_seen)) in seen {
             // Existing before its first detection / after its last one, but not detected then.
-            let existed_before = generated.truth[..first]
-                .iter()
-                .any(|t| t.object(id).is_some());
-            let exists_after = generated.truth[final_seen + 1..]
-                .iter()
-                .any(|t| t.object(id).is_some());
+            let existed_before = generated.truth[..first].iter().any(|t| t.object(id).is_some());
+            let exists_after = generated.truth[final_seen + 1..].iter().any(|t| t.object(id).is_some());
             entering += usize::from(first > 50 && existed_before);
             leaving += usize::from(final_seen + 50 < last && exists_after);
         }
     }
-    assert!(
-        entering >= 20,
-        "only {entering} objects entered the field of view"
-    );
-    assert!(
-        leaving >= 20,
-        "only {leaving} objects left the field of view"
-    );
+    assert!(entering >= 20, "only {entering} objects entered the field of view");
+    assert!(leaving >= 20, "only {leaving} objects left the field of view");
 }
 
 /// Whether the segment from `a` to `b` crosses the box of `o`.
@@ -525,19 +418,15 @@ fn blocks(a: DVec2, b: DVec2, o: &ObjectState) -> bool {
 #[test]
 fn hidden_objects_are_missed_more_often_than_visible_ones() {
     let cfg = ScenarioConfig::default();
-    let (mut visible, mut visible_hit, mut hidden, mut hidden_hit) =
-        (0usize, 0usize, 0usize, 0usize);
+    let (mut visible, mut visible_hit, mut hidden, mut hidden_hit) = (0usize, 0usize, 0usize, 0usize);
     for generated in evaluation_split().iter().take(8) {
         for (frame, truth) in generated.sequence.frames.iter().zip(&generated.truth) {
             let pose = frame.ego_pose.expect("pose");
             let mount = mount_of(&cfg, frame.sensor_id.expect("sensor"));
             let origin = pose.car_to_world(DVec2::new(mount.x_m, mount.y_m));
             let boresight = pose.yaw_rad + mount.yaw_deg.to_radians();
-            let measured: HashSet<u64> = frame
-                .measurements
-                .iter()
-                .filter_map(|m| m.measurement.ground_truth_id)
-                .collect();
+            let measured: HashSet<u64> =
+                frame.measurements.iter().filter_map(|m| m.measurement.ground_truth_id).collect();
             for object in &truth.objects {
                 let rel = object.position - origin;
                 let azimuth = (rel.to_angle() - boresight + std::f64::consts::PI)
@@ -565,14 +454,8 @@ fn hidden_objects_are_missed_more_often_than_visible_ones() {
     let visible_rate = visible_hit as f64 / visible as f64;
     let hidden_rate = hidden_hit as f64 / hidden.max(1) as f64;
     assert!(hidden > 50, "too few occlusions ({hidden})");
-    assert!(
-        visible_rate > 0.9 && visible_rate < 1.0,
-        "visible detection rate {visible_rate}"
-    );
-    assert!(
-        hidden_rate < visible_rate - 0.2,
-        "hidden {hidden_rate} vs visible {visible_rate}"
-    );
+    assert!(visible_rate > 0.9 && visible_rate < 1.0, "visible detection rate {visible_rate}");
+    assert!(hidden_rate < visible_rate - 0.2, "hidden {hidden_rate} vs visible {visible_rate}");
 }
 
 #[test]
@@ -615,8 +498,7 @@ fn configuration_is_validated_and_serialisable() {
     cfg.validate().expect("default is valid");
     let text = toml::to_string(&cfg).expect("serialise");
     assert_eq!(ScenarioConfig::from_toml_str(&text).expect("parse"), cfg);
-    let partial =
-        ScenarioConfig::from_toml_str("[sequence]\nduration_s = 3.5\n").expect("partial config");
+    let partial = ScenarioConfig::from_toml_str("[sequence]\nduration_s = 3.5\n").expect("partial config");
     assert_eq!(partial.sequence.duration_s, 3.5);
     assert_eq!(partial.car, cfg.car);
 
@@ -631,10 +513,7 @@ fn configuration_is_validated_and_serialisable() {
     assert_eq!(bad.validate().unwrap_err().field, "radar.sensors[1].id");
     let mut bad = cfg.clone();
     bad.pedestrian.stop_probability = 1.5;
-    assert_eq!(
-        bad.validate().unwrap_err().field,
-        "pedestrian.stop_probability"
-    );
+    assert_eq!(bad.validate().unwrap_err().field, "pedestrian.stop_probability");
     let mut bad = cfg;
     bad.road.block_length_m = 40.0;
     assert_eq!(bad.validate().unwrap_err().field, "road.block_length_m");
@@ -657,11 +536,7 @@ fn csv_round_trip_of_a_generated_sequence_is_exact() {
     // Conversion to library frames keeps ground-truth ids and classes.
     for (recorded, frame) in back.frames.iter().zip(back.to_frames().expect("frames")) {
         assert_eq!(frame.timestamp_s, recorded.timestamp_s);
-        let ids: Vec<_> = frame
-            .measurements
-            .iter()
-            .map(|m| (m.ground_truth_id, m.class))
-            .collect();
+        let ids: Vec<_> = frame.measurements.iter().map(|m| (m.ground_truth_id, m.class)).collect();
         let expected: Vec<_> = recorded
             .measurements
             .iter()
@@ -679,33 +554,18 @@ fn split_summary_counts_match_the_sequences() {
     for generated in generator.split_sequences(Split::Validation) {
         frames += generated.sequence.frames.len();
         for frame in &generated.sequence.frames {
-            cars += frame
-                .measurements
-                .iter()
-                .filter(|m| m.measurement.class == ObjectClass::Car)
-                .count();
-            peds += frame
-                .measurements
-                .iter()
-                .filter(|m| m.measurement.class == ObjectClass::Pedestrian)
-                .count();
+            cars += frame.measurements.iter().filter(|m| m.measurement.class == ObjectClass::Car).count();
+            peds +=
+                frame.measurements.iter().filter(|m| m.measurement.class == ObjectClass::Pedestrian).count();
         }
         summary.add_generated(&generated);
     }
     assert_eq!(summary.sequences, 6);
     assert_eq!(
-        (
-            summary.frames,
-            summary.car_object_frames,
-            summary.pedestrian_object_frames
-        ),
+        (summary.frames, summary.car_object_frames, summary.pedestrian_object_frames),
         (frames, cars, peds)
     );
     let table = primm::scenario::format_table(&[summary]);
     assert!(table.contains("Validation"));
-    assert!(table
-        .lines()
-        .next()
-        .unwrap()
-        .contains("Pedestrian object frames"));
+    assert!(table.lines().next().unwrap().contains("Pedestrian object frames"));
 }

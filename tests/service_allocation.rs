@@ -47,7 +47,8 @@ fn run(wait: WaitMode, method: Method) {
         } else {
             Box::new(NoPredictor)
         };
-        let tracker = Tracker::with_predictor(Config::default().with_modes(method.modes()), predictor).unwrap();
+        let tracker =
+            Tracker::with_predictor(Config::default().with_modes(method.modes()), predictor).unwrap();
         let options = TrackingOptions {
             names: tracker_names,
             wait,
@@ -81,7 +82,10 @@ fn run(wait: WaitMode, method: Method) {
         client.send(&frame, k, 0);
         let (sequence, updated) = client
             .next_answer(Duration::from_secs(10), |answer| {
-                (answer.input_sequence, answer.valid_tracks().iter().filter(|t| t.measurement_index().is_some()).count())
+                (
+                    answer.input_sequence,
+                    answer.valid_tracks().iter().filter(|t| t.measurement_index().is_some()).count(),
+                )
             })
             .expect("the tracker answers every frame");
         assert_eq!(sequence, k);

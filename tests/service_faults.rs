@@ -123,7 +123,16 @@ fn a_publisher_killed_mid_stream_and_restarted_resumes_tracking() {
     let spawn_publisher = || {
         ChildGuard(
             Command::new(env!("CARGO_BIN_EXE_primm"))
-                .args(["publish", "--scenario", "--duration-s", "30", "--speed", "2", "--service-prefix", &prefix])
+                .args([
+                    "publish",
+                    "--scenario",
+                    "--duration-s",
+                    "30",
+                    "--speed",
+                    "2",
+                    "--service-prefix",
+                    &prefix,
+                ])
                 .env("RUST_LOG", "warn")
                 .spawn()
                 .unwrap(),

@@ -26,7 +26,15 @@ fn the_python_subscriber_reads_the_tracks_the_tracker_publishes() {
     let mut python = ChildGuard(
         Command::new("python3")
             .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/python/subscriber.py"))
-            .args(["--service-prefix", &prefix, "--frames", &FRAMES.to_string(), "--json", "--timeout-s", "30"])
+            .args([
+                "--service-prefix",
+                &prefix,
+                "--frames",
+                &FRAMES.to_string(),
+                "--json",
+                "--timeout-s",
+                "30",
+            ])
             .stdout(Stdio::piped())
             .spawn()
             .expect("the Python subscriber starts"),
@@ -63,13 +71,21 @@ fn the_python_subscriber_reads_the_tracks_the_tracker_publishes() {
             })
             .expect("the tracker answers");
         expected.push(answer);
-        let line = line_rx.recv_timeout(Duration::from_secs(20)).expect("the Python subscriber prints the frame");
+        let line =
+            line_rx.recv_timeout(Duration::from_secs(20)).expect("the Python subscriber prints the frame");
         let record: serde_json::Value = serde_json::from_str(&line).expect("one JSON object per line");
         let tracks: Vec<(u64, f64, f64, bool)> = record["tracks"]
             .as_array()
             .unwrap()
             .iter()
-            .map(|t| (t["id"].as_u64().unwrap(), t["x_m"].as_f64().unwrap(), t["y_m"].as_f64().unwrap(), t["confirmed"].as_bool().unwrap()))
+            .map(|t| {
+                (
+                    t["id"].as_u64().unwrap(),
+                    t["x_m"].as_f64().unwrap(),
+                    t["y_m"].as_f64().unwrap(),
+                    t["confirmed"].as_bool().unwrap(),
+                )
+            })
             .collect();
         assert_eq!(record["status"], "tracked");
         seen.push((record["input_sequence"].as_u64().unwrap(), tracks));
@@ -83,7 +99,10 @@ fn the_python_subscriber_reads_the_tracks_the_tracker_publishes() {
         assert_eq!(seq_seen, seq_expected);
         assert_eq!(seen_tracks.len(), expected_tracks.len(), "frame {seq_seen}");
         for (s, e) in seen_tracks.iter().zip(expected_tracks) {
-            assert!(s.0 == e.0 && s.3 == e.3 && close(s.1, e.1) && close(s.2, e.2), "frame {seq_seen}: {s:?} != {e:?}");
+            assert!(
+                s.0 == e.0 && s.3 == e.3 && close(s.1, e.1) && close(s.2, e.2),
+                "frame {seq_seen}: {s:?} != {e:?}"
+            );
         }
     }
     assert_eq!(seen.last().unwrap().1.iter().filter(|t| t.3).count(), 4, "four confirmed tracks at the end");

@@ -56,7 +56,16 @@ fn every_frame_comes_back_in_order_with_the_offline_tracks() {
     let (status, stdout) = serve.wait(Duration::from_secs(10));
     assert!(status.success(), "{status}: {stdout}");
     assert!(stdout.contains("frames: 200 received, 200 tracked, 0 rejected, 0 lost"), "{stdout}");
-    for stage in ["validate", "predict", "associate", "update", "report", "publish", "receive_to_publish", "end_to_end"] {
+    for stage in [
+        "validate",
+        "predict",
+        "associate",
+        "update",
+        "report",
+        "publish",
+        "receive_to_publish",
+        "end_to_end",
+    ] {
         assert!(stdout.contains(stage), "the final latency table lacks {stage}: {stdout}");
     }
 }
@@ -82,7 +91,8 @@ fn with_the_learned_predictor_every_frame_comes_back_with_the_tracks_of_a_synchr
 
     let frames = common::scene_frames(&common::lanes(8), 60, 0.05, 0.2, 6);
     let predictor = OnnxPredictor::load("models/pr.onnx").unwrap();
-    let mut offline = Tracker::with_predictor(Config::default().with_modes(Method::PrImm.modes()), predictor).unwrap();
+    let mut offline =
+        Tracker::with_predictor(Config::default().with_modes(Method::PrImm.modes()), predictor).unwrap();
     // The offline run has a displacement for every frame: equal tracks mean the served tracker
     // got every one of them from its inference thread.
     assert_eq!(replay_against_offline(&client, &frames, &mut offline), 8, "every lane object is confirmed");

@@ -4,7 +4,9 @@ use crate::common;
 
 use common::{lanes, scene_frames, SceneObject};
 use primm::config::Config;
-use primm::measurement::{Frame, FrameView, Measurement, ObjectClass, UnknownClass, MAX_MEASUREMENTS_PER_FRAME};
+use primm::measurement::{
+    Frame, FrameView, Measurement, ObjectClass, UnknownClass, MAX_MEASUREMENTS_PER_FRAME,
+};
 use primm::mode::Method;
 use primm::track::{TrackOutput, TrackStatus};
 use primm::tracker::{StepError, Tracker};
@@ -45,8 +47,20 @@ fn distinct(ids: &[u64]) -> usize {
 fn two_crossing_objects_with_different_radial_velocities_keep_their_ids() {
     // Two cars cross at right angles at (30, 0) at t = 2 s.
     let objects = [
-        SceneObject { id: 1, class: ObjectClass::Car, start: [10.0, 0.0], velocity: [10.0, 0.0], visible: (0.0, 9.0) },
-        SceneObject { id: 2, class: ObjectClass::Car, start: [30.0, -16.0], velocity: [0.0, 8.0], visible: (0.0, 9.0) },
+        SceneObject {
+            id: 1,
+            class: ObjectClass::Car,
+            start: [10.0, 0.0],
+            velocity: [10.0, 0.0],
+            visible: (0.0, 9.0),
+        },
+        SceneObject {
+            id: 2,
+            class: ObjectClass::Car,
+            start: [30.0, -16.0],
+            velocity: [0.0, 8.0],
+            visible: (0.0, 9.0),
+        },
     ];
     let frames = scene_frames(&objects, 80, 0.05, 0.15, 1);
     for method in [Method::Imm, Method::ConstantVelocity] {
@@ -60,7 +74,13 @@ fn two_crossing_objects_with_different_radial_velocities_keep_their_ids() {
 #[test]
 fn an_object_that_disappears_briefly_keeps_its_id() {
     // Hidden between 1.0 s and 1.4 s (8 frames), inside the 1 s coast time.
-    let hidden = |id, start: [f64; 2], from, to| SceneObject { id, class: ObjectClass::Car, start, velocity: [6.0, 1.0], visible: (from, to) };
+    let hidden = |id, start: [f64; 2], from, to| SceneObject {
+        id,
+        class: ObjectClass::Car,
+        start,
+        velocity: [6.0, 1.0],
+        visible: (from, to),
+    };
     let frames_a = scene_frames(&[hidden(1, [20.0, 5.0], 0.0, 1.0)], 60, 0.05, 0.1, 2);
     let frames_b = scene_frames(&[hidden(1, [20.0, 5.0], 1.4, 9.0)], 60, 0.05, 0.1, 3);
     let frames: Vec<Frame> = frames_a
@@ -82,9 +102,27 @@ fn an_object_that_disappears_briefly_keeps_its_id() {
 #[test]
 fn a_new_object_gets_a_new_id_and_ids_are_never_reused() {
     let objects = [
-        SceneObject { id: 1, class: ObjectClass::Car, start: [10.0, 0.0], velocity: [5.0, 0.0], visible: (0.0, 1.0) },
-        SceneObject { id: 2, class: ObjectClass::Car, start: [10.0, 0.0], velocity: [5.0, 0.0], visible: (3.0, 5.0) },
-        SceneObject { id: 3, class: ObjectClass::Pedestrian, start: [15.0, 8.0], velocity: [0.0, -1.0], visible: (2.0, 5.0) },
+        SceneObject {
+            id: 1,
+            class: ObjectClass::Car,
+            start: [10.0, 0.0],
+            velocity: [5.0, 0.0],
+            visible: (0.0, 1.0),
+        },
+        SceneObject {
+            id: 2,
+            class: ObjectClass::Car,
+            start: [10.0, 0.0],
+            velocity: [5.0, 0.0],
+            visible: (3.0, 5.0),
+        },
+        SceneObject {
+            id: 3,
+            class: ObjectClass::Pedestrian,
+            start: [15.0, 8.0],
+            velocity: [0.0, -1.0],
+            visible: (2.0, 5.0),
+        },
     ];
     let frames = scene_frames(&objects, 100, 0.05, 0.1, 4);
     let ids = track_ids_by_object(&run(imm_config(), &frames));
@@ -98,14 +136,27 @@ fn a_new_object_gets_a_new_id_and_ids_are_never_reused() {
 fn a_pedestrian_measurement_never_updates_a_car_track() {
     // A car and a pedestrian at nearly the same place.
     let objects = [
-        SceneObject { id: 1, class: ObjectClass::Car, start: [20.0, 0.0], velocity: [2.0, 0.0], visible: (0.0, 3.0) },
-        SceneObject { id: 2, class: ObjectClass::Pedestrian, start: [20.3, 0.2], velocity: [2.0, 0.1], visible: (0.0, 3.0) },
+        SceneObject {
+            id: 1,
+            class: ObjectClass::Car,
+            start: [20.0, 0.0],
+            velocity: [2.0, 0.0],
+            visible: (0.0, 3.0),
+        },
+        SceneObject {
+            id: 2,
+            class: ObjectClass::Pedestrian,
+            start: [20.3, 0.2],
+            velocity: [2.0, 0.1],
+            visible: (0.0, 3.0),
+        },
     ];
     let frames = scene_frames(&objects, 60, 0.05, 0.3, 5);
     let outputs = run(imm_config(), &frames);
     for frame in &outputs {
         for output in frame.iter().filter(|o| o.measurement_index.is_some()) {
-            let expected = if output.ground_truth_id == Some(1) { ObjectClass::Car } else { ObjectClass::Pedestrian };
+            let expected =
+                if output.ground_truth_id == Some(1) { ObjectClass::Car } else { ObjectClass::Pedestrian };
             assert_eq!(output.class, expected);
         }
     }
@@ -120,11 +171,26 @@ fn tracks_are_confirmed_after_the_configured_hits_and_deleted_after_misses() {
     config.tracker.confirmation_hits = 4;
     config.tracker.confirmed_max_misses = 5;
     config.tracker.max_coast_s = 10.0;
-    let objects = [SceneObject { id: 1, class: ObjectClass::Car, start: [20.0, 0.0], velocity: [3.0, 0.0], visible: (0.0, 1.0) }];
+    let objects = [SceneObject {
+        id: 1,
+        class: ObjectClass::Car,
+        start: [20.0, 0.0],
+        velocity: [3.0, 0.0],
+        visible: (0.0, 1.0),
+    }];
     let frames = scene_frames(&objects, 40, 0.05, 0.1, 6);
     let outputs = run(config, &frames);
     let status: Vec<TrackStatus> = outputs.iter().take(5).map(|f| f[0].status).collect();
-    assert_eq!(status, [TrackStatus::Tentative, TrackStatus::Tentative, TrackStatus::Tentative, TrackStatus::Confirmed, TrackStatus::Confirmed]);
+    assert_eq!(
+        status,
+        [
+            TrackStatus::Tentative,
+            TrackStatus::Tentative,
+            TrackStatus::Tentative,
+            TrackStatus::Confirmed,
+            TrackStatus::Confirmed
+        ]
+    );
     // Visible for 20 frames, then 5 misses are tolerated and the 6th deletes it.
     assert_eq!(outputs[24].len(), 1);
     assert_eq!(outputs[24][0].misses, 5);
@@ -159,7 +225,10 @@ fn a_frame_with_a_non_finite_timestamp_is_rejected_and_changes_nothing() {
     let before = snapshot(&tracker);
     let mut bad = frames[20].clone();
     bad.timestamp_s = f64::NAN;
-    assert!(matches!(tracker.step(&bad), Err(StepError::InvalidFrame(FrameError::NonFiniteTimestamp { .. }))));
+    assert!(matches!(
+        tracker.step(&bad),
+        Err(StepError::InvalidFrame(FrameError::NonFiniteTimestamp { .. }))
+    ));
     assert_eq!(snapshot(&tracker), before);
     assert_eq!(tracker.stats().frames_rejected_non_finite_timestamp, 1);
     tracker.step(&frames[20]).unwrap();
@@ -172,7 +241,10 @@ fn a_frame_going_back_in_time_or_repeating_is_rejected() {
     for bad_time in [frames[19].timestamp_s, frames[10].timestamp_s] {
         let mut bad = frames[20].clone();
         bad.timestamp_s = bad_time;
-        assert!(matches!(tracker.step(&bad), Err(StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. }))));
+        assert!(matches!(
+            tracker.step(&bad),
+            Err(StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. }))
+        ));
     }
     assert_eq!(snapshot(&tracker), before);
     assert_eq!(tracker.stats().frames_rejected_timestamp_not_increasing, 2);
@@ -189,7 +261,9 @@ fn a_frame_after_too_long_a_gap_is_rejected_until_reset() {
     assert_eq!(snapshot(&tracker), before);
     tracker.reset();
     let outputs = tracker.step(&late).unwrap();
-    assert!(outputs.iter().all(|o| o.status == TrackStatus::Tentative && o.id > before.iter().map(|b| b.0).max().unwrap()));
+    assert!(outputs
+        .iter()
+        .all(|o| o.status == TrackStatus::Tentative && o.id > before.iter().map(|b| b.0).max().unwrap()));
 }
 
 /// A frame view whose claimed length and class codes are under the test's control, as a
@@ -209,7 +283,9 @@ impl FrameView for RawFrame {
     }
     fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
         let (measurement, code) = self.measurements[index];
-        ObjectClass::from_code(code).map(|class| Measurement { class, ..measurement }).ok_or(UnknownClass { code })
+        ObjectClass::from_code(code)
+            .map(|class| Measurement { class, ..measurement })
+            .ok_or(UnknownClass { code })
     }
 }
 
@@ -217,8 +293,15 @@ impl FrameView for RawFrame {
 fn a_frame_claiming_too_many_measurements_is_rejected() {
     let (mut tracker, frames) = warmed_up_tracker();
     let before = snapshot(&tracker);
-    let raw = RawFrame { timestamp_s: frames[20].timestamp_s, claimed_len: MAX_MEASUREMENTS_PER_FRAME + 1, measurements: vec![] };
-    assert!(matches!(tracker.step(&raw), Err(StepError::InvalidFrame(FrameError::TooManyMeasurements { .. }))));
+    let raw = RawFrame {
+        timestamp_s: frames[20].timestamp_s,
+        claimed_len: MAX_MEASUREMENTS_PER_FRAME + 1,
+        measurements: vec![],
+    };
+    assert!(matches!(
+        tracker.step(&raw),
+        Err(StepError::InvalidFrame(FrameError::TooManyMeasurements { .. }))
+    ));
     assert_eq!(snapshot(&tracker), before);
     assert_eq!(tracker.stats().frames_rejected_too_many_measurements, 1);
 }
@@ -227,7 +310,8 @@ fn a_frame_claiming_too_many_measurements_is_rejected() {
 fn a_bad_measurement_is_rejected_alone_and_the_rest_of_the_frame_is_tracked() {
     let (mut tracker, frames) = warmed_up_tracker();
     let frame = &frames[20];
-    let mut measurements: Vec<(Measurement, u8)> = frame.measurements.iter().map(|m| (*m, m.class.code())).collect();
+    let mut measurements: Vec<(Measurement, u8)> =
+        frame.measurements.iter().map(|m| (*m, m.class.code())).collect();
     let good = measurements.len();
     let template = measurements[0].0;
     measurements.push((Measurement { x_m: f64::NAN, ..template }, 0));
@@ -254,7 +338,11 @@ fn a_full_table_refuses_new_tracks_and_keeps_the_old_ones() {
     let frame_at = |k: usize| {
         let mut frame = Frame::new(k as f64 * 0.05);
         for j in 0..MAX_MEASUREMENTS_PER_FRAME {
-            frame.measurements.push(common::measurement(1000.0 * k as f64 + 20.0 * (j % 16) as f64, 20.0 * (j / 16) as f64, 0.0));
+            frame.measurements.push(common::measurement(
+                1000.0 * k as f64 + 20.0 * (j % 16) as f64,
+                20.0 * (j / 16) as f64,
+                0.0,
+            ));
         }
         frame
     };

@@ -35,26 +35,104 @@ macro_rules! layout {
 
 fn rust_layouts() -> Vec<TypeLayout> {
     vec![
-        layout!(WireMeasurement, "primm_wire_measurement", [
-            x_m, y_m, vr_mps, rcs_dbsm, true_x_m, true_y_m, gt_id, sensor_id, class_code, truth_valid, _pad0
-        ]),
-        layout!(MeasurementFrame, "primm_measurement_frame", [
-            sequence, source_frame, sensor_timestamp_s, publish_time_ns, ego_x_m, ego_y_m, ego_yaw_rad, count, flags,
-            measurements
-        ]),
-        layout!(WireTrack, "primm_wire_track", [
-            id, x_m, y_m, covariance_m2, vx_mps, vy_mps, prior_x_m, prior_y_m, mode_probabilities, gt_id, age_frames,
-            hits, misses, measurement_index, class_code, status, prior_valid, _pad0
-        ]),
-        layout!(TrackFrame, "primm_track_frame", [
-            input_sequence, source_frame, sensor_timestamp_s, input_publish_time_ns, receive_time_ns, publish_time_ns,
-            count, status, flags, measurements_accepted, measurements_rejected, _pad0, tracks
-        ]),
-        layout!(StageLatency, "primm_stage_latency", [name, count, p50_ns, p90_ns, p99_ns, p999_ns, max_ns, mean_ns]),
-        layout!(LatencyReport, "primm_latency_report", [
-            sequence, publish_time_ns, frames_received, frames_tracked, frames_rejected, frames_lost,
-            measurements_rejected, resets, stage_count, _pad0, stages
-        ]),
+        layout!(
+            WireMeasurement,
+            "primm_wire_measurement",
+            [
+                x_m,
+                y_m,
+                vr_mps,
+                rcs_dbsm,
+                true_x_m,
+                true_y_m,
+                gt_id,
+                sensor_id,
+                class_code,
+                truth_valid,
+                _pad0
+            ]
+        ),
+        layout!(
+            MeasurementFrame,
+            "primm_measurement_frame",
+            [
+                sequence,
+                source_frame,
+                sensor_timestamp_s,
+                publish_time_ns,
+                ego_x_m,
+                ego_y_m,
+                ego_yaw_rad,
+                count,
+                flags,
+                measurements
+            ]
+        ),
+        layout!(
+            WireTrack,
+            "primm_wire_track",
+            [
+                id,
+                x_m,
+                y_m,
+                covariance_m2,
+                vx_mps,
+                vy_mps,
+                prior_x_m,
+                prior_y_m,
+                mode_probabilities,
+                gt_id,
+                age_frames,
+                hits,
+                misses,
+                measurement_index,
+                class_code,
+                status,
+                prior_valid,
+                _pad0
+            ]
+        ),
+        layout!(
+            TrackFrame,
+            "primm_track_frame",
+            [
+                input_sequence,
+                source_frame,
+                sensor_timestamp_s,
+                input_publish_time_ns,
+                receive_time_ns,
+                publish_time_ns,
+                count,
+                status,
+                flags,
+                measurements_accepted,
+                measurements_rejected,
+                _pad0,
+                tracks
+            ]
+        ),
+        layout!(
+            StageLatency,
+            "primm_stage_latency",
+            [name, count, p50_ns, p90_ns, p99_ns, p999_ns, max_ns, mean_ns]
+        ),
+        layout!(
+            LatencyReport,
+            "primm_latency_report",
+            [
+                sequence,
+                publish_time_ns,
+                frames_received,
+                frames_tracked,
+                frames_rejected,
+                frames_lost,
+                measurements_rejected,
+                resets,
+                stage_count,
+                _pad0,
+                stages
+            ]
+        ),
     ]
 }
 
@@ -94,7 +172,9 @@ fn the_c_header_matches_the_rust_layout() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = std::env::temp_dir().join(format!("primm-wire-layout-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut source = String::from("#include <stdio.h>\n#include <stddef.h>\n#include \"primm_wire.h\"\nint main(void) {\n");
+    let mut source = String::from(
+        "#include <stdio.h>\n#include <stddef.h>\n#include \"primm_wire.h\"\nint main(void) {\n",
+    );
     for layout in rust_layouts() {
         source += &format!(
             "    printf(\"{} size %zu align %zu\\n\", sizeof({c}), _Alignof({c}));\n",
@@ -102,7 +182,10 @@ fn the_c_header_matches_the_rust_layout() {
             c = layout.c_name
         );
         for (field, _) in &layout.fields {
-            source += &format!("    printf(\"{}.{} %zu\\n\", offsetof({}, {}));\n", layout.name, field, layout.c_name, field);
+            source += &format!(
+                "    printf(\"{}.{} %zu\\n\", offsetof({}, {}));\n",
+                layout.name, field, layout.c_name, field
+            );
         }
     }
     source += "    return 0;\n}\n";

@@ -201,9 +201,7 @@ impl AssignmentSolver {
     ///
     /// Panics if `max_rows * max_cols` overflows `usize` or the buffers cannot be allocated.
     pub fn with_capacity(max_rows: usize, max_cols: usize) -> Self {
-        let cells = max_rows
-            .checked_mul(max_cols)
-            .expect("assignment solver capacity overflows usize");
+        let cells = max_rows.checked_mul(max_cols).expect("assignment solver capacity overflows usize");
         let short = max_rows.min(max_cols);
         let long = max_rows.max(max_cols);
         Self {
@@ -262,18 +260,10 @@ impl AssignmentSolver {
         // Cannot overflow: bounded by the capacity product checked in `with_capacity`.
         let expected = rows * cols;
         if costs.len() != expected {
-            return Err(AssignmentError::CostLengthMismatch {
-                rows,
-                cols,
-                expected,
-                actual: costs.len(),
-            });
+            return Err(AssignmentError::CostLengthMismatch { rows, cols, expected, actual: costs.len() });
         }
         if row_to_col.len() < rows {
-            return Err(AssignmentError::OutputTooShort {
-                rows,
-                actual: row_to_col.len(),
-            });
+            return Err(AssignmentError::OutputTooShort { rows, actual: row_to_col.len() });
         }
 
         // Validate every entry, find live rows/columns and the range of allowed costs.
@@ -313,11 +303,8 @@ impl AssignmentSolver {
 
         // Orientation and the substitute for forbidden entries (see the module documentation).
         let transposed = live_row_count > live_col_count;
-        let (short, long) = if transposed {
-            (live_col_count, live_row_count)
-        } else {
-            (live_row_count, live_col_count)
-        };
+        let (short, long) =
+            if transposed { (live_col_count, live_row_count) } else { (live_row_count, live_col_count) };
         let mut forbidden_cost = 0.0;
         if short > 0 {
             let span = highest - lowest;
@@ -334,10 +321,7 @@ impl AssignmentSolver {
         let row_to_col = &mut row_to_col[..rows];
         row_to_col.fill(None);
         if short == 0 {
-            return Ok(AssignmentSummary {
-                pairs: 0,
-                total_cost: 0.0,
-            });
+            return Ok(AssignmentSummary { pairs: 0, total_cost: 0.0 });
         }
 
         let live_rows = &self.live_rows[..live_row_count];
@@ -468,8 +452,7 @@ impl AugmentingPathWorkspace {
                     }
                     let candidate = distance[col];
                     // Prefer free columns on ties: the search can stop there at once.
-                    if candidate < lowest || (candidate == lowest && row_for_col[col] == UNASSIGNED)
-                    {
+                    if candidate < lowest || (candidate == lowest && row_for_col[col] == UNASSIGNED) {
                         lowest = candidate;
                         best = position;
                     }

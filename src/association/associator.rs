@@ -161,7 +161,14 @@ impl Associator {
     }
 
     /// Fills `pairs` with every allowed pair of the current class, row by row.
-    fn gate<F: FrameView + ?Sized>(&mut self, tracks: &[Track], priors: &[ImmPrior], frame: &F, config: &Config, class: ObjectClass) {
+    fn gate<F: FrameView + ?Sized>(
+        &mut self,
+        tracks: &[Track],
+        priors: &[ImmPrior],
+        frame: &F,
+        config: &Config,
+        class: ObjectClass,
+    ) {
         let gate = config.classes.get(class).gate_m;
         let mut count = 0usize;
         for (r, &track_index) in self.rows.iter().enumerate() {
@@ -173,8 +180,16 @@ impl Associator {
                 if x > prior.x + gate {
                     break;
                 }
-                let Ok(measurement) = frame.measurement(usize::from(self.columns[usize::from(column)])) else { continue };
-                let cost = association_cost(prior, track.last_radial_velocity_mps, &measurement, &config.association);
+                let Ok(measurement) = frame.measurement(usize::from(self.columns[usize::from(column)]))
+                else {
+                    continue;
+                };
+                let cost = association_cost(
+                    prior,
+                    track.last_radial_velocity_mps,
+                    &measurement,
+                    &config.association,
+                );
                 if cost <= gate {
                     self.pairs[count] = Pair { row: r as u16, column, cost };
                     count += 1;
@@ -223,7 +238,8 @@ impl Associator {
         let (rows, columns) = (self.rows.len(), self.columns.len());
         let nodes = rows + columns;
         for root in 0..nodes {
-            let members = &self.members[self.member_start[root] as usize..self.member_start[root + 1] as usize];
+            let members =
+                &self.members[self.member_start[root] as usize..self.member_start[root + 1] as usize];
             // Rows come first in each cluster because nodes were placed in index order.
             let row_count = members.partition_point(|&node| usize::from(node) < rows);
             let (cluster_rows, cluster_columns) = members.split_at(row_count);
@@ -248,7 +264,8 @@ impl Associator {
             for (local_row, &r) in cluster_rows.iter().enumerate() {
                 let r = usize::from(r);
                 for pair in &self.pairs[self.row_start[r] as usize..self.row_start[r + 1] as usize] {
-                    costs[local_row * width + usize::from(self.local_column[usize::from(pair.column)])] = pair.cost;
+                    costs[local_row * width + usize::from(self.local_column[usize::from(pair.column)])] =
+                        pair.cost;
                 }
             }
             self.solver.solve(height, width, costs, &mut self.row_to_column[..height])?;

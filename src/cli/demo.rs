@@ -98,7 +98,9 @@ impl Managed {
     fn wait(mut self, timeout: Duration) -> Result<(ExitStatus, String), DemoError> {
         let deadline = Instant::now() + timeout;
         loop {
-            if let Some(status) = self.child.try_wait().map_err(|source| DemoError::Spawn { what: self.what, source })? {
+            if let Some(status) =
+                self.child.try_wait().map_err(|source| DemoError::Spawn { what: self.what, source })?
+            {
                 let mut output = String::new();
                 if let Some(mut stdout) = self.child.stdout.take() {
                     use std::io::Read;
@@ -107,7 +109,11 @@ impl Managed {
                 return Ok((status, output));
             }
             if Instant::now() >= deadline {
-                return Err(DemoError::Timeout { what: self.what, event: "finish", seconds: timeout.as_secs() });
+                return Err(DemoError::Timeout {
+                    what: self.what,
+                    event: "finish",
+                    seconds: timeout.as_secs(),
+                });
             }
             std::thread::sleep(Duration::from_millis(20));
         }
@@ -211,12 +217,20 @@ pub fn run(args: Args) -> Result<(), DemoError> {
     }
     let (status, subscriber_output) = subscriber.wait(Duration::from_secs(60))?;
     if !status.success() {
-        return Err(DemoError::Failed { what: "the subscriber", status, output: format!(":\n{subscriber_output}") });
+        return Err(DemoError::Failed {
+            what: "the subscriber",
+            status,
+            output: format!(":\n{subscriber_output}"),
+        });
     }
     tracker.interrupt();
     let (status, tracker_output) = tracker.wait(Duration::from_secs(10))?;
     if !status.success() {
-        return Err(DemoError::Failed { what: "the tracker", status, output: format!(":\n{tracker_output}") });
+        return Err(DemoError::Failed {
+            what: "the tracker",
+            status,
+            output: format!(":\n{tracker_output}"),
+        });
     }
 
     println!("\n== subscriber (primm-subscriber) ==\n{subscriber_output}");

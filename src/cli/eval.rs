@@ -4,8 +4,8 @@ use crate::cli::predictor::predictor_for;
 use crate::config::Config;
 use crate::eval::dropout::{sequence_seed, DropoutMask};
 use crate::eval::plots::{
-    ground_truth_points, majority_ground_truth, write_mode_probability_svg, write_trajectory_svg, TrajectoryPanel,
-    TrajectoryPlotOptions, TrajectoryPoint,
+    ground_truth_points, majority_ground_truth, write_mode_probability_svg, write_trajectory_svg,
+    TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint,
 };
 use crate::eval::record::AssociationRecord;
 use crate::eval::report::{EvaluationReport, MethodEvaluator, DEFAULT_MISS_PERCENTS};
@@ -22,7 +22,9 @@ pub const DEFAULT_MISS_SEED: u64 = 2024;
 
 /// Arguments of `primm eval`.
 #[derive(Debug, Clone, ClapArgs)]
-#[command(about = "Evaluate methods on a data set (a directory of measurement CSV files) and print the paper's tables")]
+#[command(
+    about = "Evaluate methods on a data set (a directory of measurement CSV files) and print the paper's tables"
+)]
 pub struct Args {
     /// Directory of measurement CSV files (one sequence per file).
     #[arg(long, value_name = "DIR")]
@@ -63,7 +65,9 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let measurements: usize = sequences.iter().map(Sequence::measurement_count).sum();
     eprintln!("{} sequences, {} measurements from {}", sequences.len(), measurements, args.data.display());
     let plot_sequence = match &args.plot_sequence {
-        Some(name) => sequences.iter().position(|s| &s.name == name).ok_or(format!("no sequence named {name}"))?,
+        Some(name) => {
+            sequences.iter().position(|s| &s.name == name).ok_or(format!("no sequence named {name}"))?
+        }
         None => 0,
     };
 
@@ -88,10 +92,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             track_sequence(&mut tracker, sequence, |recorded, outputs| {
                 association_records(recorded, outputs, method, &mut records);
                 if index == plot_sequence {
-                    points.extend(outputs.iter().filter(|o| o.measurement_index.is_some()).map(|o| TrajectoryPoint {
-                        id: o.id,
-                        frame: recorded.index,
-                        position: o.position_m,
+                    points.extend(outputs.iter().filter(|o| o.measurement_index.is_some()).map(|o| {
+                        TrajectoryPoint { id: o.id, frame: recorded.index, position: o.position_m }
                     }));
                 }
             })?;
@@ -105,7 +107,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
                 });
             }
             for percent in DEFAULT_MISS_PERCENTS {
-                let records = missed_detection_records(&mut tracker, sequence, method, percent, args.miss_seed)?;
+                let records =
+                    missed_detection_records(&mut tracker, sequence, method, percent, args.miss_seed)?;
                 evaluator.add_missed_detection_sequence(percent, &records);
             }
         }
@@ -134,7 +137,11 @@ fn missed_detection_records<P: DisplacementPredictor>(
     percent: u32,
     seed: u64,
 ) -> Result<Vec<AssociationRecord>, Box<dyn std::error::Error>> {
-    let mask = DropoutMask::new(sequence.measurement_count(), f64::from(percent) / 100.0, sequence_seed(seed, &sequence.name))?;
+    let mask = DropoutMask::new(
+        sequence.measurement_count(),
+        f64::from(percent) / 100.0,
+        sequence_seed(seed, &sequence.name),
+    )?;
     let mut reduced = sequence.clone();
     let mut flat = 0;
     for frame in &mut reduced.frames {
@@ -145,7 +152,9 @@ fn missed_detection_records<P: DisplacementPredictor>(
         });
     }
     let mut kept_records = Vec::with_capacity(sequence.measurement_count());
-    track_sequence(tracker, &reduced, |recorded, outputs| association_records(recorded, outputs, method, &mut kept_records))?;
+    track_sequence(tracker, &reduced, |recorded, outputs| {
+        association_records(recorded, outputs, method, &mut kept_records)
+    })?;
     let mut kept = kept_records.into_iter();
     let mut records = Vec::with_capacity(sequence.measurement_count());
     let mut flat = 0;

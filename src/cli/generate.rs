@@ -97,8 +97,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut summaries = Vec::new();
     for split in splits {
         let dir = args.output.join(split.name());
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         let mut summary = SplitSummary::new(split);
         for generated in generator.split_sequences(split) {
             let path = dir.join(format!("{}.csv", generated.sequence.name));

@@ -12,7 +12,10 @@ pub const DEFAULT_MODEL_PATH: &str = "models/pr.onnx";
 /// The predictor a method needs: none for the physics-only methods, the PR model (`model`, or
 /// [`DEFAULT_MODEL_PATH`]) run synchronously otherwise, so offline results do not depend on
 /// timing. A missing, unreadable or incompatible model is an error naming the file.
-pub fn predictor_for(method: Method, model: Option<&Path>) -> Result<Box<dyn DisplacementPredictor + Send>, String> {
+pub fn predictor_for(
+    method: Method,
+    model: Option<&Path>,
+) -> Result<Box<dyn DisplacementPredictor + Send>, String> {
     if !method.needs_predictor() {
         return Ok(Box::new(NoPredictor));
     }

@@ -113,11 +113,18 @@ pub fn run(args: Args) -> Result<(), PublishError> {
             if shutdown.is_requested() {
                 return Ok(());
             }
-            return Err(PublishError::NoTracker { service: names.tracks(), waited_s: args.wait_for_tracker_s });
+            return Err(PublishError::NoTracker {
+                service: names.tracks(),
+                waited_s: args.wait_for_tracker_s,
+            });
         }
     }
     let options = ReplayOptions {
-        pacing: if args.as_fast_as_possible { Pacing::AsFastAsPossible } else { Pacing::Recorded { speed: args.speed } },
+        pacing: if args.as_fast_as_possible {
+            Pacing::AsFastAsPossible
+        } else {
+            Pacing::Recorded { speed: args.speed }
+        },
         repeat: args.repeat,
         frame_limit: args.frames,
         max_in_flight: args.max_in_flight,

@@ -61,9 +61,12 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         let sequence = read_sequence_file(file)?;
         let name = file.file_name().ok_or("a data file without a name")?;
         let path = args.associations.join(name);
-        let reader = std::fs::File::open(&path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
-        let rows = read_association_rows(std::io::BufReader::new(reader)).map_err(|e| format!("{}: {e}", path.display()))?;
-        let records = association_records_from_rows(&sequence, &rows).map_err(|e| format!("{}: {e}", path.display()))?;
+        let reader =
+            std::fs::File::open(&path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+        let rows = read_association_rows(std::io::BufReader::new(reader))
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let records = association_records_from_rows(&sequence, &rows)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         evaluator.add_sequence(&records);
     }
     println!("{}", summary_json(&args.name, evaluator.result()));

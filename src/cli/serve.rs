@@ -7,14 +7,18 @@ use crate::predictor::onnx::{ModelError, OnnxPredictor};
 use crate::predictor::threaded::ThreadedPredictor;
 use crate::predictor::{DisplacementPredictor, NoPredictor};
 use crate::service::catalog::SERVICE_PREFIX_ENV;
-use crate::service::{ConnectError, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService, WaitMode};
+use crate::service::{
+    ConnectError, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService, WaitMode,
+};
 use crate::tracker::Tracker;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// Arguments of `primm serve`.
 #[derive(Debug, Clone, clap::Args)]
-#[command(about = "Track frames from primm/measurements and publish primm/tracks and primm/latency over shared memory")]
+#[command(
+    about = "Track frames from primm/measurements and publish primm/tracks and primm/latency over shared memory"
+)]
 pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults when absent.
     #[arg(long, value_name = "FILE")]

@@ -13,7 +13,8 @@ use crate::service::latency::{format_table, summarise, MAX_TRACKABLE_NS};
 use crate::service::track_csv::TrackCsvWriter;
 use crate::service::{ConnectError, ServiceNames, ShutdownFlag};
 use crate::wire::{
-    FrameStatus, LatencyReport, StageLatency, TrackFrame, WireTrack, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
+    FrameStatus, LatencyReport, StageLatency, TrackFrame, WireTrack, TRACK_FLAG_STREAM_END,
+    TRACK_FLAG_TRACKER_RESET,
 };
 use hdrhistogram::Histogram;
 use iceoryx2::port::ReceiveError;
@@ -186,7 +187,10 @@ impl SubscriberSummary {
             );
         }
         let mut rows: Vec<StageLatency> = Vec::new();
-        for (row, name) in [(&self.end_to_end_latency, "publisher_to_subscriber"), (&self.delivery_latency, "tracker_to_subscriber")] {
+        for (row, name) in [
+            (&self.end_to_end_latency, "publisher_to_subscriber"),
+            (&self.delivery_latency, "tracker_to_subscriber"),
+        ] {
             if let Some(row) = row {
                 let mut stage = StageLatency::named(name);
                 stage.count = row.count;
@@ -258,11 +262,14 @@ impl Viewer {
             summary.stream_end_seen = true;
         }
         match self.last_sequence {
-            Some(last) if frame.input_sequence > last + 1 => summary.input_sequence_gaps += frame.input_sequence - last - 1,
+            Some(last) if frame.input_sequence > last + 1 => {
+                summary.input_sequence_gaps += frame.input_sequence - last - 1
+            }
             _ => {}
         }
         self.last_sequence = Some(frame.input_sequence);
-        summary.confirmed_tracks_last_frame = frame.valid_tracks().iter().filter(|t| t.status == 1).count() as u64;
+        summary.confirmed_tracks_last_frame =
+            frame.valid_tracks().iter().filter(|t| t.status == 1).count() as u64;
         if frame.publish_time_ns != 0 && now_ns >= frame.publish_time_ns {
             self.delivery.saturating_record(now_ns - frame.publish_time_ns);
         }
@@ -273,7 +280,8 @@ impl Viewer {
             accuracy.add_tracks(frame);
         }
         if let Some((path, csv)) = &mut self.csv {
-            csv.write_frame(frame).map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+            csv.write_frame(frame)
+                .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
             self.summary.csv_rows = csv.rows();
         }
         if self.live && self.last_draw.elapsed() >= Duration::from_millis(200) {
@@ -325,7 +333,10 @@ impl Viewer {
             screen += &format!("... {} more confirmed tracks\n", tracks.len() - 25);
         }
         if let Some(report) = &self.last_report {
-            screen += &format!("\ntracker latency (report {}, {} frames):\n", report.sequence, report.frames_received);
+            screen += &format!(
+                "\ntracker latency (report {}, {} frames):\n",
+                report.sequence, report.frames_received
+            );
             screen += &format_table(report.valid_stages());
         }
         let mut stdout = std::io::stdout().lock();
@@ -335,14 +346,15 @@ impl Viewer {
 
     fn finish(mut self) -> Result<SubscriberSummary, SubscribeError> {
         if let Some((path, csv)) = &mut self.csv {
-            csv.flush().map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+            csv.flush()
+                .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
         }
         let mut summary = self.summary;
         summary.accuracy = self.accuracy.as_mut().map(AccuracyMonitor::summary);
-        summary.delivery_latency =
-            (!self.delivery.is_empty()).then(|| LatencyRow::from(&summarise("tracker_to_subscriber", &self.delivery)));
-        summary.end_to_end_latency =
-            (!self.end_to_end.is_empty()).then(|| LatencyRow::from(&summarise("publisher_to_subscriber", &self.end_to_end)));
+        summary.delivery_latency = (!self.delivery.is_empty())
+            .then(|| LatencyRow::from(&summarise("tracker_to_subscriber", &self.delivery)));
+        summary.end_to_end_latency = (!self.end_to_end.is_empty())
+            .then(|| LatencyRow::from(&summarise("publisher_to_subscriber", &self.end_to_end)));
         if let Some(report) = &self.last_report {
             summary.tracker_latency = report.valid_stages().iter().map(LatencyRow::from).collect();
             summary.tracker_frames_received = report.frames_received;
@@ -363,7 +375,8 @@ pub fn run(args: Args) -> Result<(), SubscribeError> {
     print!("{}", summary.text());
     if let Some(path) = &args.json {
         let json = serde_json::to_string_pretty(&summary).expect("the summary serialises");
-        std::fs::write(path, json).map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+        std::fs::write(path, json)
+            .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
     }
     Ok(())
 }
@@ -419,7 +432,8 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
         if let Some((_, listener)) = &truth {
             guards.push(waitset.attach_notification(listener).map_err(SubscribeError::WaitSetAttach)?);
         }
-        tick = Some(waitset.attach_interval(Duration::from_millis(200)).map_err(SubscribeError::WaitSetAttach)?);
+        tick =
+            Some(waitset.attach_interval(Duration::from_millis(200)).map_err(SubscribeError::WaitSetAttach)?);
     }
     let idle_timeout = args.idle_timeout_s.map(Duration::from_secs_f64);
     loop {
@@ -427,7 +441,10 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
             std::hint::spin_loop();
         } else {
             waitset
-                .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, Duration::from_millis(200))
+                .wait_and_process_once_with_timeout(
+                    |_| CallbackProgression::Continue,
+                    Duration::from_millis(200),
+                )
                 .map_err(SubscribeError::WaitSetRun)?;
             // Consume the notifications; the data is read below.
             let _ = track_listener.try_wait(|_| {});
@@ -455,14 +472,23 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
         while let Some(sample) = latency_subscriber.receive().map_err(SubscribeError::Receive)? {
             viewer.last_report = Some(*sample);
         }
-        if !viewer.live && !args.quiet && viewer.summary.track_frames > 0 && viewer.last_draw.elapsed() >= Duration::from_secs(1) {
+        if !viewer.live
+            && !args.quiet
+            && viewer.summary.track_frames > 0
+            && viewer.last_draw.elapsed() >= Duration::from_secs(1)
+        {
             eprintln!(
                 "track frames {} (rejected {}), confirmed tracks {}",
-                viewer.summary.track_frames, viewer.summary.frames_rejected, viewer.summary.confirmed_tracks_last_frame
+                viewer.summary.track_frames,
+                viewer.summary.frames_rejected,
+                viewer.summary.confirmed_tracks_last_frame
             );
             viewer.last_draw = Instant::now();
         }
-        if done || shutdown.is_requested() || idle_timeout.is_some_and(|timeout| viewer.last_frame_at.elapsed() >= timeout) {
+        if done
+            || shutdown.is_requested()
+            || idle_timeout.is_some_and(|timeout| viewer.last_frame_at.elapsed() >= timeout)
+        {
             break;
         }
     }

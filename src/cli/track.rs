@@ -2,8 +2,8 @@
 
 use crate::cli::predictor::predictor_for;
 use crate::config::Config;
-use crate::io::read_sequence_file;
 use crate::io::association_csv::AssociationCsvWriter;
+use crate::io::read_sequence_file;
 use crate::io::track_csv::TrackCsvWriter;
 use crate::mode::Method;
 use crate::tracker::Tracker;
@@ -55,7 +55,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut writer = TrackCsvWriter::new(std::io::BufWriter::new(file))?;
     let mut associations = match &args.associations {
         Some(path) => {
-            let file = std::fs::File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+            let file =
+                std::fs::File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
             Some(AssociationCsvWriter::new(std::io::BufWriter::new(file))?)
         }
         None => None,

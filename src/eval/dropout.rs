@@ -72,10 +72,7 @@ impl DropoutMask {
     /// Splits `items` into (kept, dropped), both in their original order.
     pub fn partition<T>(&self, items: Vec<T>) -> Result<(Vec<T>, Vec<T>), EvalError> {
         if items.len() != self.dropped.len() {
-            return Err(EvalError::LengthMismatch {
-                expected: self.dropped.len(),
-                actual: items.len(),
-            });
+            return Err(EvalError::LengthMismatch { expected: self.dropped.len(), actual: items.len() });
         }
         let mut kept = Vec::with_capacity(items.len() - self.dropped_count);
         let mut dropped = Vec::with_capacity(self.dropped_count);
@@ -177,10 +174,7 @@ mod tests {
         for k in dropped_numbers {
             assert!(mask.is_dropped(k as usize));
         }
-        assert!(matches!(
-            mask.kept(&[1, 2, 3]),
-            Err(EvalError::LengthMismatch { expected: 10, actual: 3 })
-        ));
+        assert!(matches!(mask.kept(&[1, 2, 3]), Err(EvalError::LengthMismatch { expected: 10, actual: 3 })));
     }
 
     #[test]

@@ -118,8 +118,7 @@ pub fn identity_counts_subset(records: &[AssociationRecord], in_subset: &[bool])
     counts.idtp = max_total_overlap(&overlap);
     counts.idfp = counts.estimated_object_frames - counts.idtp;
     counts.idfn = counts.gt_object_frames - counts.idtp;
-    counts.idsw =
-        id_switch_rows(records).into_iter().filter(|&index| in_subset[index]).count() as u64;
+    counts.idsw = id_switch_rows(records).into_iter().filter(|&index| in_subset[index]).count() as u64;
     counts
 }
 
@@ -182,13 +181,11 @@ fn component_optimum(entries: &[(u64, u64, u64)]) -> u64 {
         tracks.entry(track).or_insert(next);
     }
     let transpose = gts.len() > tracks.len();
-    let (rows, columns) =
-        if transpose { (tracks.len(), gts.len()) } else { (gts.len(), tracks.len()) };
+    let (rows, columns) = if transpose { (tracks.len(), gts.len()) } else { (gts.len(), tracks.len()) };
     let mut weights = Matrix::new(rows, columns, 0i64);
     for &(gt, track, count) in entries {
         let weight = i64::try_from(count).expect("overlap count fits in i64");
-        let (row, column) =
-            if transpose { (tracks[&track], gts[&gt]) } else { (gts[&gt], tracks[&track]) };
+        let (row, column) = if transpose { (tracks[&track], gts[&gt]) } else { (gts[&gt], tracks[&track]) };
         weights[(row, column)] = weight;
     }
     let (total, _) = kuhn_munkres(&weights);
@@ -230,8 +227,7 @@ mod tests {
     #[test]
     fn idsw_follows_frames_not_input_order() {
         // Same object, frames given out of order: f0→7, f1→8, f2→7. Two switches.
-        let records =
-            vec![row(2, Some(1), Some(7)), row(0, Some(1), Some(7)), row(1, Some(1), Some(8))];
+        let records = vec![row(2, Some(1), Some(7)), row(0, Some(1), Some(7)), row(1, Some(1), Some(8))];
         assert_eq!(id_switches(&records), 2);
         // Index 2 (frame 1) and index 0 (frame 2), in time order.
         assert_eq!(id_switch_rows(&records), vec![2, 0]);

@@ -77,9 +77,7 @@ impl InteractionRules {
             }
         }
         if self.crossing_min_heading_diff_deg > self.crossing_max_heading_diff_deg {
-            return Err(EvalError::InvalidRules(
-                "crossing heading range is empty (min > max)".into(),
-            ));
+            return Err(EvalError::InvalidRules("crossing heading range is empty (min > max)".into()));
         }
         Ok(())
     }
@@ -96,10 +94,7 @@ pub struct InteractionFlags {
 
 /// Subset flags of every row of one sequence (input order). Rows without a ground-truth id are
 /// in neither subset.
-pub fn interaction_flags(
-    records: &[AssociationRecord],
-    rules: &InteractionRules,
-) -> Vec<InteractionFlags> {
+pub fn interaction_flags(records: &[AssociationRecord], rules: &InteractionRules) -> Vec<InteractionFlags> {
     let headings = row_headings(records, rules);
     let mut by_frame: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
     for (index, record) in records.iter().enumerate() {
@@ -128,8 +123,7 @@ pub fn interaction_flags(
                     }
                 }
             }
-            flags[a] =
-                InteractionFlags { close_proximity: nearest <= rules.close_proximity_m, crossing };
+            flags[a] = InteractionFlags { close_proximity: nearest <= rules.close_proximity_m, crossing };
         }
     }
     flags

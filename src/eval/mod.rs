@@ -30,8 +30,7 @@ pub mod scenario;
 
 pub use dropout::{sequence_seed, DropoutMask};
 pub use identity::{
-    id_switch_rows, id_switches, identity_counts, identity_counts_subset, max_total_overlap,
-    IdentityCounts,
+    id_switch_rows, id_switches, identity_counts, identity_counts_subset, max_total_overlap, IdentityCounts,
 };
 pub use interaction::{interaction_flags, InteractionFlags, InteractionRules};
 pub use modes::{ModeProbabilityAccumulator, MODE_NAMES};
@@ -39,6 +38,4 @@ pub use plots::{TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint};
 pub use record::{AssociationRecord, EvalError, Method};
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;
-pub use scenario::{
-    classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules,
-};
+pub use scenario::{classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules};

@@ -141,9 +141,7 @@ pub fn trajectory_svg(
         return Err(EvalError::Plot("at least one panel is required".into()));
     }
     if options.columns == 0 || options.panel_width_px < 200 || options.panel_height_px < 200 {
-        return Err(EvalError::Plot(
-            "columns must be positive and panels at least 200 x 200 pixels".into(),
-        ));
+        return Err(EvalError::Plot("columns must be positive and panels at least 200 x 200 pixels".into()));
     }
     let columns = options.columns.min(panels.len());
     let rows = panels.len().div_ceil(columns);
@@ -179,14 +177,8 @@ pub fn trajectory_svg(
         for (panel, cell) in panels.iter().zip(&cells) {
             let (caption, chart_area) = cell.split_vertically(CAPTION_PX);
             draw_centred_text(&caption, &panel.title, 20)?;
-            let (view, (plot_w, plot_h)) = draw_trajectory_panel(
-                &chart_area,
-                &bounds,
-                &gt_lines,
-                &colour_index,
-                panel,
-                options,
-            )?;
+            let (view, (plot_w, plot_h)) =
+                draw_trajectory_panel(&chart_area, &bounds, &gt_lines, &colour_index, panel, options)?;
             debug_assert!(
                 ((view.max.x - view.min.x) / f64::from(plot_w)
                     - (view.max.y - view.min.y) / f64::from(plot_h))
@@ -302,8 +294,7 @@ fn draw_centred_text(
             plotters::style::text_anchor::VPos::Center,
         ),
     );
-    area.draw(&Text::new(text.to_string(), (width as i32 / 2, height as i32 / 2), style))
-        .map_err(plot_error)
+    area.draw(&Text::new(text.to_string(), (width as i32 / 2, height as i32 / 2), style)).map_err(plot_error)
 }
 
 /// Label-area sizes and margin of a trajectory chart, pixels.
@@ -321,8 +312,7 @@ fn draw_trajectory_panel(
 ) -> Result<(Bounds, (u32, u32)), EvalError> {
     // Measure the plotting area first, then choose ranges with equal metres per pixel.
     let (plot_w, plot_h) = {
-        let probe =
-            chart_builder(area).build_cartesian_2d(0.0..1.0, 0.0..1.0).map_err(plot_error)?;
+        let probe = chart_builder(area).build_cartesian_2d(0.0..1.0, 0.0..1.0).map_err(plot_error)?;
         probe.plotting_area().dim_in_pixel()
     };
     let view = bounds.with_equal_aspect(plot_w, plot_h);
@@ -397,10 +387,7 @@ fn draw_polyline(
             .draw_series(std::iter::once(Circle::new(*point, dot_radius, style.filled())))
             .map(|_| ())
             .map_err(plot_error),
-        _ => chart
-            .draw_series(LineSeries::new(line.iter().copied(), style))
-            .map(|_| ())
-            .map_err(plot_error),
+        _ => chart.draw_series(LineSeries::new(line.iter().copied(), style)).map(|_| ()).map_err(plot_error),
     }
 }
 
@@ -424,8 +411,7 @@ fn draw_trajectory_legend(area: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(
             ShapeStyle::from(&colour).stroke_width(stroke),
         ))
         .map_err(plot_error)?;
-        area.draw(&Text::new(label.to_string(), (x + 60, y), text_style.clone()))
-            .map_err(plot_error)?;
+        area.draw(&Text::new(label.to_string(), (x + 60, y), text_style.clone())).map_err(plot_error)?;
     }
     let x = left + 480;
     area.draw(&Circle::new(
@@ -434,8 +420,7 @@ fn draw_trajectory_legend(area: &DrawingArea<SVGBackend<'_>, Shift>) -> Result<(
         ShapeStyle::from(&dark(0)).stroke_width(ESTIMATE_WIDTH),
     ))
     .map_err(plot_error)?;
-    area.draw(&Text::new("track start".to_string(), (x + 40, y), text_style))
-        .map_err(plot_error)?;
+    area.draw(&Text::new("track start".to_string(), (x + 40, y), text_style)).map_err(plot_error)?;
     Ok(())
 }
 
@@ -453,19 +438,15 @@ pub fn write_mode_probability_svg(
 /// The mode-probability bar chart as SVG text.
 pub fn mode_probability_svg(means: [f64; 4], samples: u64) -> Result<String, EvalError> {
     if means.iter().any(|p| !p.is_finite() || *p < 0.0 || *p > 1.0 + 1e-9) {
-        return Err(EvalError::Plot(format!(
-            "mode probabilities must lie in [0, 1], got {means:?}"
-        )));
+        return Err(EvalError::Plot(format!("mode probabilities must lie in [0, 1], got {means:?}")));
     }
     let top = (means.iter().copied().fold(0.0, f64::max) * 1.25).clamp(0.1, 1.0);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (640, 440)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
-        let title = format!(
-            "Mean mode probability of PR-IMM ({} updates)",
-            super::report::group_thousands(samples)
-        );
+        let title =
+            format!("Mean mode probability of PR-IMM ({} updates)", super::report::group_thousands(samples));
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
             .margin(16)

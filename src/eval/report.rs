@@ -160,16 +160,8 @@ impl MethodEvaluator {
 
     /// Adds the rows of one sequence re-run with `drop_percent` % of its measurements removed
     /// (see [`super::dropout`]); dropped measurements must be present as rows without a track.
-    pub fn add_missed_detection_sequence(
-        &mut self,
-        drop_percent: u32,
-        records: &[AssociationRecord],
-    ) {
-        self.result
-            .missed_detection
-            .entry(drop_percent)
-            .or_default()
-            .merge(&identity_counts(records));
+    pub fn add_missed_detection_sequence(&mut self, drop_percent: u32, records: &[AssociationRecord]) {
+        self.result.missed_detection.entry(drop_percent).or_default().merge(&identity_counts(records));
     }
 
     /// The result so far.
@@ -249,10 +241,8 @@ impl EvaluationReport {
         let columns: Vec<Vec<Cell>> = metrics
             .iter()
             .map(|(_, metric)| {
-                let values: Vec<Option<f64>> = Method::ALL
-                    .iter()
-                    .map(|m| self.result(*m).and_then(|r| metric(&r.rmse)))
-                    .collect();
+                let values: Vec<Option<f64>> =
+                    Method::ALL.iter().map(|m| self.result(*m).and_then(|r| metric(&r.rmse))).collect();
                 mark_best(&values, Better::Lower, 3)
             })
             .collect();
@@ -291,8 +281,7 @@ impl EvaluationReport {
                 line
             })
             .collect::<Vec<_>>();
-        let mut text =
-            render_table("Table III. Scenario-wise prior prediction RMSE_xy [m]", &header, &rows);
+        let mut text = render_table("Table III. Scenario-wise prior prediction RMSE_xy [m]", &header, &rows);
         self.append_notes(&mut text, "* lowest value in its row");
         text
     }
@@ -305,32 +294,26 @@ impl EvaluationReport {
             Method::ALL.iter().map(|m| self.result(*m).and_then(|r| r.identity.idf1())).collect();
         let idsw = mark_best(&idsw, Better::Lower, 0);
         let idf1 = mark_best(&idf1, Better::Higher, 4);
-        let header: Vec<String> = ["Model", "IDSW", "IDF1", "IDTP", "IDFP", "IDFN"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let header: Vec<String> =
+            ["Model", "IDSW", "IDF1", "IDTP", "IDFP", "IDFN"].iter().map(|s| s.to_string()).collect();
         let rows = Method::ALL
             .iter()
             .enumerate()
             .map(|(row, method)| {
-                let mut line = vec![
-                    method.row_label().to_string(),
-                    idsw[row].to_string(),
-                    idf1[row].to_string(),
-                ];
+                let mut line =
+                    vec![method.row_label().to_string(), idsw[row].to_string(), idf1[row].to_string()];
                 match self.result(*method) {
-                    Some(r) => line.extend(
-                        [r.identity.idtp, r.identity.idfp, r.identity.idfn].map(group_thousands),
-                    ),
+                    Some(r) => {
+                        line.extend([r.identity.idtp, r.identity.idfp, r.identity.idfn].map(group_thousands))
+                    }
                     None => line.extend(std::iter::repeat_n("n/a".to_string(), 3)),
                 }
                 line
             })
             .collect::<Vec<_>>();
         let count = self.common_count(|r| r.identity.gt_object_frames);
-        let title = format!(
-            "Table IV. Overall multiple-object-tracking performance (GT object frames = {count})"
-        );
+        let title =
+            format!("Table IV. Overall multiple-object-tracking performance (GT object frames = {count})");
         let mut text = render_table(&title, &header, &rows);
         self.append_notes(&mut text, "* lowest IDSW / highest IDF1 in its column");
         text
@@ -345,8 +328,7 @@ impl EvaluationReport {
             let counts: Vec<Option<IdentityCounts>> =
                 Method::ALL.iter().map(|m| self.result(*m).and_then(&select)).collect();
             let frames = {
-                let present: Vec<u64> =
-                    counts.iter().flatten().map(|c| c.gt_object_frames).collect();
+                let present: Vec<u64> = counts.iter().flatten().map(|c| c.gt_object_frames).collect();
                 count_text(&present)
             };
             let idsw: Vec<Option<f64>> = counts.iter().map(|c| c.map(|c| c.idsw as f64)).collect();
@@ -373,8 +355,7 @@ impl EvaluationReport {
         let modes = self.result(Method::PrImm).map(|r| r.modes);
         let mean = modes.and_then(|m| m.mean());
         let samples = modes.map(|m| group_thousands(m.count())).unwrap_or_else(|| "n/a".into());
-        let header: Vec<String> =
-            ["Mode", "Mean probability", ""].iter().map(|s| s.to_string()).collect();
+        let header: Vec<String> = ["Mode", "Mean probability", ""].iter().map(|s| s.to_string()).collect();
         let rows = MODE_NAMES
             .iter()
             .enumerate()
@@ -631,12 +612,7 @@ fn render_table(title: &str, header: &[String], rows: &[Vec<String>]) -> String 
 }
 
 /// Renders a table whose first `left_columns` columns are left-aligned and the rest right-aligned.
-fn render_table_aligned(
-    title: &str,
-    header: &[String],
-    rows: &[Vec<String>],
-    left_columns: usize,
-) -> String {
+fn render_table_aligned(title: &str, header: &[String], rows: &[Vec<String>], left_columns: usize) -> String {
     let columns = header.len();
     let mut widths: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
     for row in rows {
@@ -871,25 +847,13 @@ mod tests {
         assert!(table.contains("GT object frames = 24"));
         assert_eq!(row(&table, "IMM (CV+CA+CT)"), vec!["1*", "0.7500*", "18", "6", "6"]);
         let table = report.table_scenario_rmse();
-        assert_eq!(
-            row(&table, "Straight (6)"),
-            vec!["2.000", "n/a", "n/a", "n/a", "1.000", "0.500*"]
-        );
+        assert_eq!(row(&table, "Straight (6)"), vec!["2.000", "n/a", "n/a", "n/a", "1.000", "0.500*"]);
         assert_eq!(row(&table, "Left/Right Turn (0)"), vec!["n/a"; 6]);
         let table = report.table_scenario_mot();
-        assert_eq!(
-            row(&table, "Close Proximity (24)"),
-            vec!["IDSW", "1*", "n/a", "n/a", "n/a", "1*", "1*"]
-        );
+        assert_eq!(row(&table, "Close Proximity (24)"), vec!["IDSW", "1*", "n/a", "n/a", "n/a", "1*", "1*"]);
         // Only PR-IMM has a 10 % run: a single value is not marked.
-        assert_eq!(
-            row(&table, "10% Miss (24)"),
-            vec!["IDSW", "n/a", "n/a", "n/a", "n/a", "n/a", "1"]
-        );
-        assert_eq!(
-            row(&table, "20% Miss (n/a)"),
-            vec!["IDSW", "n/a", "n/a", "n/a", "n/a", "n/a", "n/a"]
-        );
+        assert_eq!(row(&table, "10% Miss (24)"), vec!["IDSW", "n/a", "n/a", "n/a", "n/a", "n/a", "1"]);
+        assert_eq!(row(&table, "20% Miss (n/a)"), vec!["IDSW", "n/a", "n/a", "n/a", "n/a", "n/a", "n/a"]);
         let table = report.mode_probability_table();
         assert!(table.contains("updates = 24"));
         assert_eq!(row(&table, "PR "), vec!["0.250", "##########"]);

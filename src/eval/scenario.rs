@@ -226,27 +226,22 @@ impl ScenarioRules {
             }
             let displacement = positions[i] - positions[i - 1];
             let speed = displacement.length() / dt;
-            if !speed.is_finite() || speed < self.min_step_speed_mps || displacement.length() == 0.0
-            {
+            if !speed.is_finite() || speed < self.min_step_speed_mps || displacement.length() == 0.0 {
                 return None;
             }
             speeds.push(speed);
             mid_times.push(0.5 * (times[i] + times[i - 1]));
             headings.push(displacement.y.atan2(displacement.x));
         }
-        let turns: Vec<f64> =
-            headings.windows(2).map(|pair| wrap_angle(pair[1] - pair[0])).collect();
+        let turns: Vec<f64> = headings.windows(2).map(|pair| wrap_angle(pair[1] - pair[0])).collect();
         let net_turn: f64 = turns.iter().sum();
         let total_turn: f64 = turns.iter().map(|turn| turn.abs()).sum();
         let turn_consistency = if total_turn > 0.0 { net_turn.abs() / total_turn } else { 1.0 };
         let speed_changes: Vec<f64> = speeds.windows(2).map(|pair| pair[1] - pair[0]).collect();
         let net_speed_change: f64 = speed_changes.iter().sum();
         let total_speed_change: f64 = speed_changes.iter().map(|change| change.abs()).sum();
-        let speed_consistency = if total_speed_change > 0.0 {
-            net_speed_change.abs() / total_speed_change
-        } else {
-            1.0
-        };
+        let speed_consistency =
+            if total_speed_change > 0.0 { net_speed_change.abs() / total_speed_change } else { 1.0 };
         Some(MotionFeatures {
             net_turn_deg: net_turn.to_degrees(),
             total_turn_deg: total_turn.to_degrees(),
@@ -272,9 +267,7 @@ impl ScenarioRules {
                 MotionScenario::Nonlinear
             });
         }
-        if net >= self.turn_min_net_turn_deg
-            && features.turn_consistency >= self.turn_min_consistency
-        {
+        if net >= self.turn_min_net_turn_deg && features.turn_consistency >= self.turn_min_consistency {
             return Some(if accel >= self.turn_max_accel_mps2 {
                 MotionScenario::Nonlinear
             } else if features.net_turn_deg > 0.0 {
@@ -316,8 +309,7 @@ pub fn classify_sequence(
         }
         let window = &rows[rows.len() - rules.window_len..];
         let times: Vec<f64> = window.iter().map(|&row| records[row].timestamp_s).collect();
-        let positions: Vec<DVec2> =
-            window.iter().map(|&row| records[row].reference_position()).collect();
+        let positions: Vec<DVec2> = window.iter().map(|&row| records[row].reference_position()).collect();
         labels[index] = rules.classify_window(&times, &positions);
     }
     labels
@@ -393,8 +385,7 @@ mod tests {
         // x(t) = 10 t − t² (a = −2 m/s²) along a diagonal heading. The mean speed over a step
         // equals the speed at its mid-time, so the fitted slope is exactly −2 m/s².
         let direction = DVec2::new(1.0, 1.0).normalize();
-        let positions: Vec<DVec2> =
-            times(10).iter().map(|&t| direction * (10.0 * t - t * t)).collect();
+        let positions: Vec<DVec2> = times(10).iter().map(|&t| direction * (10.0 * t - t * t)).collect();
         let rules = ScenarioRules::default();
         let features = rules.features(&times(10), &positions).unwrap();
         assert!((features.acceleration_mps2 + 2.0).abs() < 1e-9);

@@ -103,7 +103,12 @@ impl<W: Write> AssociationCsvWriter<W> {
 
     /// One row per measurement of a frame of `measurement_count` measurements, from the
     /// tracker's outputs for that frame.
-    pub fn write_frame(&mut self, frame: u64, measurement_count: usize, outputs: &[TrackOutput]) -> std::io::Result<()> {
+    pub fn write_frame(
+        &mut self,
+        frame: u64,
+        measurement_count: usize,
+        outputs: &[TrackOutput],
+    ) -> std::io::Result<()> {
         let mut taken: Vec<Option<&TrackOutput>> = vec![None; measurement_count];
         for output in outputs {
             if let Some(slot) = output.measurement_index.and_then(|index| taken.get_mut(usize::from(index))) {
@@ -125,7 +130,9 @@ impl<W: Write> AssociationCsvWriter<W> {
     pub fn write_row(&mut self, row: &AssociationRow) -> std::io::Result<()> {
         let track = row.track_id.map(|id| id.to_string()).unwrap_or_default();
         match row.prior_m {
-            Some(prior) => writeln!(self.out, "{},{},{track},{},{}", row.frame, row.measurement, prior.x, prior.y),
+            Some(prior) => {
+                writeln!(self.out, "{},{},{track},{},{}", row.frame, row.measurement, prior.x, prior.y)
+            }
             None => writeln!(self.out, "{},{},{track},,", row.frame, row.measurement),
         }
     }
@@ -149,13 +156,22 @@ pub fn read_association_rows<R: Read>(reader: R) -> Result<Vec<AssociationRow>, 
         let record = record?;
         let line = i as u64 + 2;
         let field = |column: usize, name: &'static str| -> Result<Option<&str>, AssociationCsvError> {
-            let value = record.get(column).ok_or(AssociationCsvError::Field { line, column: name, value: String::new() })?;
+            let value = record.get(column).ok_or(AssociationCsvError::Field {
+                line,
+                column: name,
+                value: String::new(),
+            })?;
             Ok(if value.is_empty() { None } else { Some(value) })
         };
-        let bad = |name: &'static str, value: &str| AssociationCsvError::Field { line, column: name, value: value.to_string() };
+        let bad = |name: &'static str, value: &str| AssociationCsvError::Field {
+            line,
+            column: name,
+            value: value.to_string(),
+        };
         let frame = field(0, "frame")?.ok_or_else(|| bad("frame", ""))?;
         let measurement = field(1, "measurement")?.ok_or_else(|| bad("measurement", ""))?;
-        let track_id = field(2, "track_id")?.map(|v| v.parse::<u64>().map_err(|_| bad("track_id", v))).transpose()?;
+        let track_id =
+            field(2, "track_id")?.map(|v| v.parse::<u64>().map_err(|_| bad("track_id", v))).transpose()?;
         let number = |column: usize, name: &'static str| -> Result<Option<f64>, AssociationCsvError> {
             match field(column, name)? {
                 None => Ok(None),
@@ -265,7 +281,10 @@ mod tests {
 
     #[test]
     fn a_wrong_header_a_bad_number_or_half_a_prior_is_an_error() {
-        assert!(matches!(read_association_rows("frame,track\n".as_bytes()), Err(AssociationCsvError::Header(_))));
+        assert!(matches!(
+            read_association_rows("frame,track\n".as_bytes()),
+            Err(AssociationCsvError::Header(_))
+        ));
         assert!(matches!(rows("0,0,x,,"), Err(AssociationCsvError::Field { column: "track_id", .. })));
         assert!(matches!(rows("0,0,1,nan,1"), Err(AssociationCsvError::Field { column: "prior_x", .. })));
         assert!(matches!(rows("0,0,1,1.0,"), Err(AssociationCsvError::Field { .. })));
@@ -274,7 +293,10 @@ mod tests {
     #[test]
     fn a_measurement_listed_twice_or_a_track_taking_two_measurements_of_a_frame_is_refused() {
         let twice = rows("0,0,1,,\n0,0,2,,\n").unwrap();
-        assert!(matches!(association_records_from_rows(&sequence(), &twice), Err(AssociationCsvError::Duplicate { .. })));
+        assert!(matches!(
+            association_records_from_rows(&sequence(), &twice),
+            Err(AssociationCsvError::Duplicate { .. })
+        ));
         let greedy = rows("0,0,1,,\n0,1,1,,\n").unwrap();
         assert!(matches!(
             association_records_from_rows(&sequence(), &greedy),

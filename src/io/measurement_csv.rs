@@ -41,16 +41,14 @@ use super::recording::{EgoPose, RecordedFrame, RecordedMeasurement, Sequence};
 use crate::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 
 /// Columns every file must have.
-pub const REQUIRED_COLUMNS: [&str; 10] = [
-    "frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y",
-];
+pub const REQUIRED_COLUMNS: [&str; 10] =
+    ["frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y"];
 
 /// Optional frame-level columns understood by the reader.
 pub const OPTIONAL_COLUMNS: [&str; 4] = ["sensor_id", "ego_x", "ego_y", "ego_yaw"];
 
 /// Columns holding measurement values; all empty on an empty-frame row.
-const MEASUREMENT_COLUMNS: [&str; 8] =
-    ["gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y"];
+const MEASUREMENT_COLUMNS: [&str; 8] = ["gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y"];
 
 /// What went wrong while reading or writing a measurement file.
 #[derive(Debug, thiserror::Error)]
@@ -98,7 +96,9 @@ pub enum CsvErrorKind {
         found: f64,
     },
     /// A frame starts earlier than the previous frame.
-    #[error("timestamp {found} of frame {frame} is earlier than {previous}, the timestamp of the previous frame")]
+    #[error(
+        "timestamp {found} of frame {frame} is earlier than {previous}, the timestamp of the previous frame"
+    )]
     TimeDecreasing {
         /// The frame.
         frame: u64,
@@ -160,21 +160,11 @@ pub struct CsvError {
 
 impl CsvError {
     fn new(kind: CsvErrorKind) -> Self {
-        Self {
-            path: None,
-            line: None,
-            column: None,
-            kind,
-        }
+        Self { path: None, line: None, column: None, kind }
     }
 
     fn at(line: u64, column: Option<&str>, kind: CsvErrorKind) -> Self {
-        Self {
-            path: None,
-            line: Some(line),
-            column: column.map(str::to_owned),
-            kind,
-        }
+        Self { path: None, line: Some(line), column: column.map(str::to_owned), kind }
     }
 
     fn with_path(mut self, path: &Path) -> Self {
@@ -184,12 +174,7 @@ impl CsvError {
 
     fn from_csv(err: csv::Error) -> Self {
         let line = err.position().map(|p| p.line());
-        Self {
-            path: None,
-            line,
-            column: None,
-            kind: CsvErrorKind::Csv(err),
-        }
+        Self { path: None, line, column: None, kind: CsvErrorKind::Csv(err) }
     }
 }
 
@@ -249,14 +234,8 @@ fn fmt_opt_f64(value: Option<f64>) -> Result<String, CsvErrorKind> {
 /// Writes `sequence` as CSV (header plus one row per measurement, one empty-frame row per frame
 /// without measurements).
 pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), CsvError> {
-    let mut out = csv::WriterBuilder::new()
-        .has_headers(false)
-        .from_writer(writer);
-    let header: Vec<&str> = REQUIRED_COLUMNS
-        .iter()
-        .chain(OPTIONAL_COLUMNS.iter())
-        .copied()
-        .collect();
+    let mut out = csv::WriterBuilder::new().has_headers(false).from_writer(writer);
+    let header: Vec<&str> = REQUIRED_COLUMNS.iter().chain(OPTIONAL_COLUMNS.iter()).copied().collect();
     out.write_record(&header).map_err(CsvError::from_csv)?;
     let mut line = 1u64;
     let mut previous: Option<u64> = None;
@@ -266,19 +245,14 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
                 return Err(CsvError::at(
                     line + 1,
                     Some("frame"),
-                    CsvErrorKind::FrameOrder {
-                        previous,
-                        found: frame.index,
-                    },
+                    CsvErrorKind::FrameOrder { previous, found: frame.index },
                 ));
             }
         }
         previous = Some(frame.index);
         let fail = |line: u64, kind| CsvError::at(line, None, kind);
-        let frame_fields = [
-            frame.index.to_string(),
-            fmt_f64(frame.timestamp_s).map_err(|k| fail(line + 1, k))?,
-        ];
+        let frame_fields =
+            [frame.index.to_string(), fmt_f64(frame.timestamp_s).map_err(|k| fail(line + 1, k))?];
         let sensor = frame.sensor_id.map(|s| s.to_string()).unwrap_or_default();
         let ego = match frame.ego_pose {
             Some(pose) => [
@@ -291,10 +265,7 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
         if frame.measurements.is_empty() {
             line += 1;
             let mut row: Vec<String> = frame_fields.to_vec();
-            row.extend(std::iter::repeat_n(
-                String::new(),
-                MEASUREMENT_COLUMNS.len(),
-            ));
+            row.extend(std::iter::repeat_n(String::new(), MEASUREMENT_COLUMNS.len()));
             row.push(sensor.clone());
             row.extend(ego.iter().cloned());
             out.write_record(&row).map_err(CsvError::from_csv)?;
@@ -326,15 +297,13 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
             out.write_record(&row).map_err(CsvError::from_csv)?;
         }
     }
-    out.flush()
-        .map_err(|e| CsvError::new(CsvErrorKind::Io(e)))?;
+    out.flush().map_err(|e| CsvError::new(CsvErrorKind::Io(e)))?;
     Ok(())
 }
 
 /// Writes `sequence` to the file `path` (created or truncated).
 pub fn write_sequence_file(path: &Path, sequence: &Sequence) -> Result<(), CsvError> {
-    let file =
-        File::create(path).map_err(|e| CsvError::new(CsvErrorKind::Io(e)).with_path(path))?;
+    let file = File::create(path).map_err(|e| CsvError::new(CsvErrorKind::Io(e)).with_path(path))?;
     write_sequence(BufWriter::new(file), sequence).map_err(|e| e.with_path(path))
 }
 
@@ -368,8 +337,8 @@ impl Columns {
         };
         let mut required = [0usize; 10];
         for (slot, name) in required.iter_mut().zip(REQUIRED_COLUMNS) {
-            *slot = find(name)?
-                .ok_or_else(|| CsvError::at(1, Some(name), CsvErrorKind::MissingColumn(name)))?;
+            *slot =
+                find(name)?.ok_or_else(|| CsvError::at(1, Some(name), CsvErrorKind::MissingColumn(name)))?;
         }
         Ok(Self {
             required,
@@ -414,8 +383,7 @@ impl RowParser<'_> {
     }
 
     fn req_f64(&self, index: usize, column: &str) -> Result<f64, CsvError> {
-        self.opt_f64(index, column)?
-            .ok_or_else(|| self.error(column, CsvErrorKind::MissingValue))
+        self.opt_f64(index, column)?.ok_or_else(|| self.error(column, CsvErrorKind::MissingValue))
     }
 
     fn parse(&self, columns: &Columns) -> Result<Row, CsvError> {
@@ -431,25 +399,17 @@ impl RowParser<'_> {
         let sensor_id = match columns.sensor_id {
             Some(index) if !self.field(index).is_empty() => {
                 let text = self.field(index);
-                Some(text.parse::<u16>().map_err(|_| {
-                    self.error("sensor_id", CsvErrorKind::BadInteger(text.to_owned()))
-                })?)
+                Some(
+                    text.parse::<u16>()
+                        .map_err(|_| self.error("sensor_id", CsvErrorKind::BadInteger(text.to_owned())))?,
+                )
             }
             _ => None,
         };
         let ego_values = [
-            columns.ego[0]
-                .map(|i| self.opt_f64(i, "ego_x"))
-                .transpose()?
-                .flatten(),
-            columns.ego[1]
-                .map(|i| self.opt_f64(i, "ego_y"))
-                .transpose()?
-                .flatten(),
-            columns.ego[2]
-                .map(|i| self.opt_f64(i, "ego_yaw"))
-                .transpose()?
-                .flatten(),
+            columns.ego[0].map(|i| self.opt_f64(i, "ego_x")).transpose()?.flatten(),
+            columns.ego[1].map(|i| self.opt_f64(i, "ego_y")).transpose()?.flatten(),
+            columns.ego[2].map(|i| self.opt_f64(i, "ego_yaw")).transpose()?.flatten(),
         ];
         let ego = match ego_values {
             [Some(x_m), Some(y_m), Some(yaw_rad)] => Some(EgoPose { x_m, y_m, yaw_rad }),
@@ -462,10 +422,7 @@ impl RowParser<'_> {
                 } else {
                     "ego_yaw"
                 };
-                return Err(self.error(
-                    column,
-                    CsvErrorKind::IncompleteGroup("ego_x, ego_y, ego_yaw"),
-                ));
+                return Err(self.error(column, CsvErrorKind::IncompleteGroup("ego_x, ego_y, ego_yaw")));
             }
         };
 
@@ -476,26 +433,20 @@ impl RowParser<'_> {
             if indices.iter().any(|&index| !self.field(index).is_empty()) {
                 return Err(self.error("class", CsvErrorKind::MissingValue));
             }
-            return Ok(Row {
-                frame,
-                t,
-                sensor_id,
-                ego,
-                measurement: None,
-            });
+            return Ok(Row { frame, t, sensor_id, ego, measurement: None });
         }
-        let class = ObjectClass::from_name(class_text).ok_or_else(|| {
-            self.error("class", CsvErrorKind::UnknownClass(class_text.to_owned()))
-        })?;
+        let class = ObjectClass::from_name(class_text)
+            .ok_or_else(|| self.error("class", CsvErrorKind::UnknownClass(class_text.to_owned())))?;
         let gt_text = self.field(c_gt);
-        let ground_truth_id =
-            if gt_text.is_empty() || gt_text == "-1" {
-                None
-            } else {
-                Some(gt_text.parse::<u64>().map_err(|_| {
-                    self.error("gt_id", CsvErrorKind::BadInteger(gt_text.to_owned()))
-                })?)
-            };
+        let ground_truth_id = if gt_text.is_empty() || gt_text == "-1" {
+            None
+        } else {
+            Some(
+                gt_text
+                    .parse::<u64>()
+                    .map_err(|_| self.error("gt_id", CsvErrorKind::BadInteger(gt_text.to_owned())))?,
+            )
+        };
         let x_m = self.req_f64(c_x, "x")?;
         let y_m = self.req_f64(c_y, "y")?;
         let radial_velocity_mps = self.req_f64(c_vr, "vr")?;
@@ -510,24 +461,14 @@ impl RowParser<'_> {
                 return Err(self.error("true_y", CsvErrorKind::IncompleteGroup("true_x, true_y")))
             }
         };
-        let measurement = Measurement {
-            x_m,
-            y_m,
-            radial_velocity_mps,
-            rcs_dbsm,
-            class,
-            sensor_id,
-            ground_truth_id,
-        };
+        let measurement =
+            Measurement { x_m, y_m, radial_velocity_mps, rcs_dbsm, class, sensor_id, ground_truth_id };
         Ok(Row {
             frame,
             t,
             sensor_id,
             ego,
-            measurement: Some(RecordedMeasurement {
-                measurement,
-                true_position,
-            }),
+            measurement: Some(RecordedMeasurement { measurement, true_position }),
         })
     }
 }
@@ -563,10 +504,7 @@ pub fn read_sequence<R: Read>(reader: R, name: &str) -> Result<Sequence, CsvErro
             break;
         }
         let line = record.position().map_or(0, |p| p.line());
-        let parser = RowParser {
-            record: &record,
-            line,
-        };
+        let parser = RowParser { record: &record, line };
         let row = parser.parse(&columns)?;
         match &mut open {
             Some(current) if current.frame.index == row.frame => {
@@ -603,19 +541,16 @@ pub fn read_sequence<R: Read>(reader: R, name: &str) -> Result<Sequence, CsvErro
                 }
                 match row.measurement {
                     None => {
-                        return Err(parser
-                            .error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame }))
+                        return Err(parser.error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame }))
                     }
                     Some(_) if current.placeholder => {
-                        return Err(parser
-                            .error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame }))
+                        return Err(parser.error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame }))
                     }
                     Some(m) => {
                         if frame.measurements.len() >= MAX_MEASUREMENTS_PER_FRAME {
-                            return Err(parser.error(
-                                "frame",
-                                CsvErrorKind::TooManyMeasurements { frame: row.frame },
-                            ));
+                            return Err(
+                                parser.error("frame", CsvErrorKind::TooManyMeasurements { frame: row.frame })
+                            );
                         }
                         frame.measurements.push(m);
                     }
@@ -662,10 +597,7 @@ pub fn read_sequence<R: Read>(reader: R, name: &str) -> Result<Sequence, CsvErro
 /// Reads the sequence stored in `path`; its name is the file stem.
 pub fn read_sequence_file(path: &Path) -> Result<Sequence, CsvError> {
     let file = File::open(path).map_err(|e| CsvError::new(CsvErrorKind::Io(e)).with_path(path))?;
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     read_sequence(BufReader::new(file), &name).map_err(|e| e.with_path(path))
 }
 
@@ -675,9 +607,7 @@ pub fn dataset_files(dir: &Path) -> Result<Vec<PathBuf>, CsvError> {
     let mut files = Vec::new();
     for entry in std::fs::read_dir(dir).map_err(io_error)? {
         let path = entry.map_err(io_error)?.path();
-        let is_csv = path
-            .extension()
-            .is_some_and(|ext| ext.eq_ignore_ascii_case("csv"));
+        let is_csv = path.extension().is_some_and(|ext| ext.eq_ignore_ascii_case("csv"));
         if is_csv && path.is_file() {
             files.push(path);
         }
@@ -688,18 +618,14 @@ pub fn dataset_files(dir: &Path) -> Result<Vec<PathBuf>, CsvError> {
 
 /// Reads a data set: every `.csv` file directly inside `dir`, in sorted file-name order.
 pub fn read_dataset_dir(dir: &Path) -> Result<Vec<Sequence>, CsvError> {
-    dataset_files(dir)?
-        .iter()
-        .map(|path| read_sequence_file(path))
-        .collect()
+    dataset_files(dir)?.iter().map(|path| read_sequence_file(path)).collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const HEADER: &str =
-        "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw\n";
+    const HEADER: &str = "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw\n";
 
     fn measurement(class: ObjectClass, id: Option<u64>, x: f64) -> RecordedMeasurement {
         RecordedMeasurement {
@@ -718,11 +644,7 @@ mod tests {
 
     fn sample() -> Sequence {
         let mut sequence = Sequence::new("sample");
-        let pose = EgoPose {
-            x_m: 1e-3,
-            y_m: -12.5,
-            yaw_rad: std::f64::consts::PI / 7.0,
-        };
+        let pose = EgoPose { x_m: 1e-3, y_m: -12.5, yaw_rad: std::f64::consts::PI / 7.0 };
         let mut f0 = RecordedFrame::new(0, 0.0071);
         f0.sensor_id = Some(3);
         f0.ego_pose = Some(pose);
@@ -758,18 +680,12 @@ mod tests {
         let text = to_text(&sequence);
         assert!(text.starts_with(HEADER));
         // The empty frame is one row with empty measurement fields.
-        assert!(
-            text.lines().any(|l| l.starts_with("1,0.0213,,,,,,,,,1,")),
-            "{text}"
-        );
+        assert!(text.lines().any(|l| l.starts_with("1,0.0213,,,,,,,,,1,")), "{text}");
         let back = read_sequence(text.as_bytes(), "sample").unwrap();
         assert_eq!(back, sequence);
         assert!(back.frames[1].measurements.is_empty());
         assert_eq!(back.frames[2].index, 3);
-        assert_eq!(
-            back.frames[0].measurements[1].measurement.ground_truth_id,
-            None
-        );
+        assert_eq!(back.frames[0].measurements[1].measurement.ground_truth_id, None);
         let frame = back.frames[0].to_frame().unwrap();
         assert_eq!(frame.measurements[0].ground_truth_id, Some(4));
     }
@@ -786,14 +702,8 @@ mod tests {
         assert_eq!(frame.ego_pose, None);
         assert_eq!(frame.measurements[0].measurement.ground_truth_id, Some(7));
         assert_eq!(frame.measurements[0].true_position, None);
-        assert_eq!(
-            frame.measurements[1].measurement.class,
-            ObjectClass::Pedestrian
-        );
-        assert_eq!(
-            frame.measurements[1].true_position,
-            Some(DVec2::new(3.1, 4.2))
-        );
+        assert_eq!(frame.measurements[1].measurement.class, ObjectClass::Pedestrian);
+        assert_eq!(frame.measurements[1].true_position, Some(DVec2::new(3.1, 4.2)));
     }
 
     #[test]
@@ -809,10 +719,7 @@ mod tests {
         let err = read_err("frame,t,gt_id,class,x,y,vr,true_x,true_y\n0,0,1,car,1,2,3,,\n");
         assert!(matches!(err.kind, CsvErrorKind::MissingColumn("rcs")));
         assert_eq!(err.line, Some(1));
-        assert!(
-            err.to_string().contains("missing header column `rcs`"),
-            "{err}"
-        );
+        assert!(err.to_string().contains("missing header column `rcs`"), "{err}");
     }
 
     #[test]
@@ -823,9 +730,7 @@ mod tests {
 
     #[test]
     fn bad_number_names_line_and_column() {
-        let err = read_err(&format!(
-            "{HEADER}0,0,1,car,1,2,3,4,,,,,,\n0,0,2,car,1,abc,3,4,,,,,,\n"
-        ));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,,,,\n0,0,2,car,1,abc,3,4,,,,,,\n"));
         assert!(matches!(err.kind, CsvErrorKind::BadNumber(ref v) if v == "abc"));
         assert_eq!(err.line, Some(3));
         assert_eq!(err.column.as_deref(), Some("y"));
@@ -867,53 +772,32 @@ mod tests {
 
     #[test]
     fn decreasing_frame_index_is_reported() {
-        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,,,,\n2,0.1,1,car,1,2,3,4,,,,,,\n1,0.2,1,car,1,2,3,4,,,,,,\n"));
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::FrameDecreasing {
-                previous: 2,
-                found: 1
-            }
+        let err = read_err(&format!(
+            "{HEADER}0,0,1,car,1,2,3,4,,,,,,\n2,0.1,1,car,1,2,3,4,,,,,,\n1,0.2,1,car,1,2,3,4,,,,,,\n"
         ));
+        assert!(matches!(err.kind, CsvErrorKind::FrameDecreasing { previous: 2, found: 1 }));
         assert_eq!(err.line, Some(4));
     }
 
     #[test]
     fn timestamp_mismatch_within_a_frame_is_reported() {
-        let err = read_err(&format!(
-            "{HEADER}0,0.1,1,car,1,2,3,4,,,,,,\n0,0.2,2,car,1,2,3,4,,,,,,\n"
-        ));
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::TimeMismatch { frame: 0, .. }
-        ));
+        let err = read_err(&format!("{HEADER}0,0.1,1,car,1,2,3,4,,,,,,\n0,0.2,2,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::TimeMismatch { frame: 0, .. }));
         assert_eq!((err.line, err.column.as_deref()), (Some(3), Some("t")));
     }
 
     #[test]
     fn decreasing_time_between_frames_is_reported() {
-        let err = read_err(&format!(
-            "{HEADER}0,0.2,1,car,1,2,3,4,,,,,,\n1,0.1,2,car,1,2,3,4,,,,,,\n"
-        ));
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::TimeDecreasing { frame: 1, .. }
-        ));
+        let err = read_err(&format!("{HEADER}0,0.2,1,car,1,2,3,4,,,,,,\n1,0.1,2,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::TimeDecreasing { frame: 1, .. }));
     }
 
     #[test]
     fn frame_level_field_mismatch_is_reported() {
-        let err = read_err(&format!(
-            "{HEADER}0,0,1,car,1,2,3,4,,,1,,,\n0,0,2,car,1,2,3,4,,,2,,,\n"
-        ));
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::FrameFieldMismatch { frame: 0, .. }
-        ));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,1,,,\n0,0,2,car,1,2,3,4,,,2,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::FrameFieldMismatch { frame: 0, .. }));
         assert_eq!(err.column.as_deref(), Some("sensor_id"));
-        let err = read_err(&format!(
-            "{HEADER}0,0,1,car,1,2,3,4,,,1,0,0,0\n0,0,2,car,1,2,3,4,,,1,0,0,0.5\n"
-        ));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,1,0,0,0\n0,0,2,car,1,2,3,4,,,1,0,0,0.5\n"));
         assert!(matches!(err.kind, CsvErrorKind::FrameFieldMismatch { .. }));
     }
 
@@ -928,20 +812,10 @@ mod tests {
 
     #[test]
     fn empty_frame_row_must_be_alone() {
-        let err = read_err(&format!(
-            "{HEADER}0,0,,,,,,,,,,,,\n0,0,1,car,1,2,3,4,,,,,,\n"
-        ));
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::PlaceholderMixed { frame: 0 }
-        ));
-        let err = read_err(&format!(
-            "{HEADER}0,0,1,car,1,2,3,4,,,,,,\n0,0,,,,,,,,,,,,\n"
-        ));
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::PlaceholderMixed { frame: 0 }
-        ));
+        let err = read_err(&format!("{HEADER}0,0,,,,,,,,,,,,\n0,0,1,car,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::PlaceholderMixed { frame: 0 }));
+        let err = read_err(&format!("{HEADER}0,0,1,car,1,2,3,4,,,,,,\n0,0,,,,,,,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::PlaceholderMixed { frame: 0 }));
     }
 
     #[test]
@@ -951,10 +825,7 @@ mod tests {
             text.push_str(&format!("0,0,{i},car,1,2,3,4,,,,,,\n"));
         }
         let err = read_err(&text);
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::TooManyMeasurements { frame: 0 }
-        ));
+        assert!(matches!(err.kind, CsvErrorKind::TooManyMeasurements { frame: 0 }));
         assert_eq!(err.line, Some(MAX_MEASUREMENTS_PER_FRAME as u64 + 2));
     }
 
@@ -970,13 +841,7 @@ mod tests {
         let mut sequence = sample();
         sequence.frames[2].index = 1;
         let err = write_sequence(Vec::new(), &sequence).unwrap_err();
-        assert!(matches!(
-            err.kind,
-            CsvErrorKind::FrameOrder {
-                previous: 1,
-                found: 1
-            }
-        ));
+        assert!(matches!(err.kind, CsvErrorKind::FrameOrder { previous: 1, found: 1 }));
         let mut sequence = sample();
         sequence.frames[0].measurements[0].measurement.x_m = f64::INFINITY;
         let err = write_sequence(Vec::new(), &sequence).unwrap_err();
@@ -997,17 +862,10 @@ mod tests {
         std::fs::write(dir.join("notes.txt"), "not a sequence").unwrap();
         let sequences = read_dataset_dir(&dir).unwrap();
         assert_eq!(sequences, vec![a, b]);
-        std::fs::write(
-            dir.join("c_bad.csv"),
-            format!("{HEADER}0,0,1,bus,1,2,3,4,,,,,,\n"),
-        )
-        .unwrap();
+        std::fs::write(dir.join("c_bad.csv"), format!("{HEADER}0,0,1,bus,1,2,3,4,,,,,,\n")).unwrap();
         let err = read_dataset_dir(&dir).unwrap_err();
         assert_eq!(err.path.as_deref(), Some(dir.join("c_bad.csv").as_path()));
-        assert!(
-            err.to_string().contains("c_bad.csv:line 2, column `class`"),
-            "{err}"
-        );
+        assert!(err.to_string().contains("c_bad.csv:line 2, column `class`"), "{err}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -6,11 +6,11 @@
 
 pub mod association_csv;
 pub mod measurement_csv;
-pub mod track_csv;
 mod recording;
+pub mod track_csv;
 
 pub use measurement_csv::{
-    dataset_files, read_dataset_dir, read_sequence, read_sequence_file, write_sequence,
-    write_sequence_file, CsvError, CsvErrorKind,
+    dataset_files, read_dataset_dir, read_sequence, read_sequence_file, write_sequence, write_sequence_file,
+    CsvError, CsvErrorKind,
 };
 pub use recording::{EgoPose, RecordedFrame, RecordedMeasurement, Sequence, TooManyMeasurements};

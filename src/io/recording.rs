@@ -76,37 +76,23 @@ pub struct TooManyMeasurements {
 impl RecordedFrame {
     /// An empty frame.
     pub fn new(index: u64, timestamp_s: f64) -> Self {
-        Self {
-            index,
-            timestamp_s,
-            sensor_id: None,
-            ego_pose: None,
-            measurements: Vec::new(),
-        }
+        Self { index, timestamp_s, sensor_id: None, ego_pose: None, measurements: Vec::new() }
     }
 
     /// Converts into the library's fixed-capacity [`Frame`]. Ground-truth ids, classes and
     /// sensor ids are carried through unchanged; true positions are dropped.
     pub fn to_frame(&self) -> Result<Frame, TooManyMeasurements> {
         if self.measurements.len() > MAX_MEASUREMENTS_PER_FRAME {
-            return Err(TooManyMeasurements {
-                frame: self.index,
-                count: self.measurements.len(),
-            });
+            return Err(TooManyMeasurements { frame: self.index, count: self.measurements.len() });
         }
         let mut frame = Frame::new(self.timestamp_s);
-        frame
-            .measurements
-            .extend(self.measurements.iter().map(|m| m.measurement));
+        frame.measurements.extend(self.measurements.iter().map(|m| m.measurement));
         Ok(frame)
     }
 
     /// Number of measurements of class `class`.
     pub fn count_class(&self, class: ObjectClass) -> usize {
-        self.measurements
-            .iter()
-            .filter(|m| m.measurement.class == class)
-            .count()
+        self.measurements.iter().filter(|m| m.measurement.class == class).count()
     }
 }
 
@@ -122,10 +108,7 @@ pub struct Sequence {
 impl Sequence {
     /// An empty sequence called `name`.
     pub fn new(name: impl Into<String>) -> Self {
-        Self {
-            name: name.into(),
-            frames: Vec::new(),
-        }
+        Self { name: name.into(), frames: Vec::new() }
     }
 
     /// Total number of object measurements over all frames.

@@ -48,7 +48,12 @@ impl<W: Write> TrackCsvWriter<W> {
     }
 
     /// Writes the rows of one frame (tracks updated by a measurement only).
-    pub fn write_frame(&mut self, frame: u64, timestamp_s: f64, outputs: &[TrackOutput]) -> std::io::Result<()> {
+    pub fn write_frame(
+        &mut self,
+        frame: u64,
+        timestamp_s: f64,
+        outputs: &[TrackOutput],
+    ) -> std::io::Result<()> {
         for output in outputs.iter().filter(|o| o.measurement_index.is_some()) {
             self.write_row(frame, timestamp_s, output)?;
         }

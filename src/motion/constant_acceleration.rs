@@ -87,7 +87,8 @@ impl ConstantAcceleration {
 
 impl MotionModel<6> for ConstantAcceleration {
     fn initiate(&self, measurement: &Measurement) -> Gaussian<6> {
-        let mut gaussian = initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
+        let mut gaussian =
+            initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
         let acceleration_variance = self.initial_acceleration_std_mps2.powi(2);
         gaussian.covariance[(index::AX, index::AX)] = acceleration_variance;
         gaussian.covariance[(index::AY, index::AY)] = acceleration_variance;
@@ -106,7 +107,8 @@ impl MotionModel<6> for ConstantAcceleration {
         let half_dt2 = 0.5 * dt * dt;
         // F = transition(dt), applied through its six off-diagonal terms.
         let [[x, vx, ax], [y, vy, ay]] = AXES;
-        let terms = [(x, vx, dt), (x, ax, half_dt2), (vx, ax, dt), (y, vy, dt), (y, ay, half_dt2), (vy, ay, dt)];
+        let terms =
+            [(x, vx, dt), (x, ax, half_dt2), (vx, ax, dt), (y, vy, dt), (y, ay, half_dt2), (vy, ay, dt)];
         super::propagate_linear_in_place(estimate, &terms);
         self.add_process_noise(&mut estimate.covariance, dt);
         crate::gaussian::symmetrize(&mut estimate.covariance);

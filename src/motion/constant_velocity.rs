@@ -30,7 +30,11 @@ pub struct ConstantVelocity {
 
 impl ConstantVelocity {
     /// A model with the given noise.
-    pub fn new(acceleration_psd_m2_per_s3: f64, measurement_noise_m2: Matrix2<f64>, initial_velocity: InitialVelocity) -> Self {
+    pub fn new(
+        acceleration_psd_m2_per_s3: f64,
+        measurement_noise_m2: Matrix2<f64>,
+        initial_velocity: InitialVelocity,
+    ) -> Self {
         Self { acceleration_psd_m2_per_s3, measurement_noise_m2, initial_velocity }
     }
 

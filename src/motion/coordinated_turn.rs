@@ -9,7 +9,9 @@
 //! come from Taylor series whose truncation error (`< φ⁶/5040`) is far below double precision,
 //! so the switch has no visible discontinuity and nothing divides by a vanishing `ω`.
 
-use super::{add_white_acceleration, initiate_position_velocity, InitialVelocity, MotionModel, PredictContext};
+use super::{
+    add_white_acceleration, initiate_position_velocity, InitialVelocity, MotionModel, PredictContext,
+};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use nalgebra::{Matrix2, SMatrix, SVector};
@@ -105,8 +107,11 @@ impl TurnTerms {
     fn new(state: &Vector5, dt: f64) -> Self {
         let phi = state[index::OMEGA] * dt;
         let (sin, cos) = phi.sin_cos();
-        let (s, g, ds, dg) =
-            if phi.abs() < TAYLOR_THRESHOLD { turn_functions_series(phi) } else { closed_form_from(phi, sin, cos) };
+        let (s, g, ds, dg) = if phi.abs() < TAYLOR_THRESHOLD {
+            turn_functions_series(phi)
+        } else {
+            closed_form_from(phi, sin, cos)
+        };
         Self { sin, cos, s, g, ds, dg }
     }
 
@@ -224,7 +229,8 @@ impl CoordinatedTurn {
 
 impl MotionModel<5> for CoordinatedTurn {
     fn initiate(&self, measurement: &Measurement) -> Gaussian<5> {
-        let mut gaussian = initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
+        let mut gaussian =
+            initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
         gaussian.covariance[(index::OMEGA, index::OMEGA)] = self.initial_turn_rate_std_radps.powi(2);
         gaussian
     }

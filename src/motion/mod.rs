@@ -158,7 +158,10 @@ pub(crate) fn initiate_position_velocity<const N: usize>(
 #[inline(always)]
 pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, terms: &[(usize, usize, f64)]) {
     debug_assert!(
-        terms.iter().enumerate().all(|(i, &(_, source, _))| terms[..i].iter().all(|&(target, _, _)| target != source)),
+        terms
+            .iter()
+            .enumerate()
+            .all(|(i, &(_, source, _))| terms[..i].iter().all(|&(target, _, _)| target != source)),
         "a term reads a value an earlier term changed"
     );
     let (mean, p) = (&mut gaussian.mean, &mut gaussian.covariance);
@@ -178,7 +181,11 @@ pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, ter
 /// `covariance += q·Q_axis(Δt)` on both axes' `[position, velocity]` pairs (indices 0/2 and
 /// 1/3, as CV and CT lay out their states), for acceleration PSD `q` m²/s³.
 #[inline]
-pub(crate) fn add_white_acceleration<const N: usize>(covariance: &mut nalgebra::SMatrix<f64, N, N>, q: f64, dt: f64) {
+pub(crate) fn add_white_acceleration<const N: usize>(
+    covariance: &mut nalgebra::SMatrix<f64, N, N>,
+    q: f64,
+    dt: f64,
+) {
     let block = white_acceleration_block(dt);
     for (position, velocity) in [(0, 2), (1, 3)] {
         covariance[(position, position)] += q * block[0][0];

@@ -119,7 +119,10 @@ pub struct PrModel {
 
 impl fmt::Debug for PrModel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("PrModel").field("path", &self.path).field("nodes", &self.plan.model().nodes().len()).finish()
+        f.debug_struct("PrModel")
+            .field("path", &self.path)
+            .field("nodes", &self.plan.model().nodes().len())
+            .finish()
     }
 }
 
@@ -135,16 +138,20 @@ impl PrModel {
                 let source = std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a regular file");
                 return Err(ModelError::Unreadable { path, source });
             }
-            Err(error) if error.kind() == std::io::ErrorKind::NotFound => return Err(ModelError::NotFound { path }),
+            Err(error) if error.kind() == std::io::ErrorKind::NotFound => {
+                return Err(ModelError::NotFound { path })
+            }
             Err(source) => return Err(ModelError::Unreadable { path, source }),
         }
-        let bytes = std::fs::read(&path).map_err(|source| ModelError::Unreadable { path: path.clone(), source })?;
+        let bytes =
+            std::fs::read(&path).map_err(|source| ModelError::Unreadable { path: path.clone(), source })?;
         let mut model = tract_onnx::onnx()
             .model_for_read(&mut bytes.as_slice())
             .map_err(|error| ModelError::NotOnnx { path: path.clone(), reason: format!("{error:#}") })?;
         check_signature(&path, &model)?;
         let batch = model.symbols.sym(BATCH_SYMBOL).to_dim();
-        let prepare = |error: TractError| ModelError::Preparation { path: path.clone(), reason: format!("{error:#}") };
+        let prepare =
+            |error: TractError| ModelError::Preparation { path: path.clone(), reason: format!("{error:#}") };
         model
             .set_input_fact(0, f32::fact([batch.clone(), MAX_HISTORY.to_dim(), FEATURES.to_dim()]).into())
             .map_err(prepare)?;
@@ -174,7 +181,12 @@ impl PrModel {
     /// Runs one batch: `features` holds `batch × 5 × 5` values (row-major, the layout of
     /// [`PredictionRequest::features`]), `valid` `batch × 5` and `displacements` receives
     /// `batch × 2` values `[dx, dy]` in metres. A batch of zero rows does nothing.
-    pub fn run(&mut self, features: &[f32], valid: &[f32], displacements: &mut [f32]) -> Result<(), InferenceError> {
+    pub fn run(
+        &mut self,
+        features: &[f32],
+        valid: &[f32],
+        displacements: &mut [f32],
+    ) -> Result<(), InferenceError> {
         let batch = valid.len() / MAX_HISTORY;
         if valid.len() != batch * MAX_HISTORY
             || features.len() != batch * MAX_HISTORY * FEATURES
@@ -232,7 +244,9 @@ fn check_signature(path: &Path, model: &InferenceModel) -> Result<(), ModelError
         });
     }
     for (index, (name, fixed)) in
-        [(FEATURES_INPUT, &[MAX_HISTORY, FEATURES][..]), (VALID_INPUT, &[MAX_HISTORY][..])].into_iter().enumerate()
+        [(FEATURES_INPUT, &[MAX_HISTORY, FEATURES][..]), (VALID_INPUT, &[MAX_HISTORY][..])]
+            .into_iter()
+            .enumerate()
     {
         let fact = model
             .input_fact(index)
@@ -249,7 +263,10 @@ fn check_signature(path: &Path, model: &InferenceModel) -> Result<(), ModelError
             return Err(ModelError::Shape {
                 path: path.to_path_buf(),
                 name: name.to_string(),
-                expected: format!("type F32, shape [{}] with a symbolic batch axis", expected_dims.join(", ")),
+                expected: format!(
+                    "type F32, shape [{}] with a symbolic batch axis",
+                    expected_dims.join(", ")
+                ),
                 found: describe(fact),
             });
         }
@@ -395,7 +412,8 @@ impl OnnxPredictor {
             self.last_error = Some(error.clone());
             return Err(error);
         }
-        let at = |row: usize| DVec2::new(f64::from(self.output[2 * row]), f64::from(self.output[2 * row + 1]));
+        let at =
+            |row: usize| DVec2::new(f64::from(self.output[2 * row]), f64::from(self.output[2 * row + 1]));
         for (out, &(row, start_row)) in displacements.iter_mut().zip(&self.rows) {
             let Some(row) = row else { continue };
             let displacement = match start_row {

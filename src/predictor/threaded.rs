@@ -316,7 +316,8 @@ fn inference_loop<P: DisplacementPredictor>(
     while let Ok(mut batch) = work.recv() {
         let len = batch.len;
         let Batch { requests, displacements, .. } = &mut *batch;
-        let outcome = catch_unwind(AssertUnwindSafe(|| predictor.predict(&requests[..len], &mut displacements[..len])));
+        let outcome =
+            catch_unwind(AssertUnwindSafe(|| predictor.predict(&requests[..len], &mut displacements[..len])));
         batch.completed = outcome.is_ok();
         if !batch.completed {
             batch.displacements[..len].fill(None);

@@ -22,10 +22,7 @@ pub struct ConfigError {
 
 impl ConfigError {
     fn new(field: impl Into<String>, problem: impl Into<String>) -> Self {
-        Self {
-            field: field.into(),
-            problem: problem.into(),
-        }
+        Self { field: field.into(), problem: problem.into() }
     }
 }
 
@@ -372,11 +369,7 @@ impl Default for ScenarioConfig {
 
 impl Default for SequenceConfig {
     fn default() -> Self {
-        Self {
-            duration_s: 7.0,
-            warmup_s: 5.0,
-            max_step_s: 0.02,
-        }
+        Self { duration_s: 7.0, warmup_s: 5.0, max_step_s: 0.02 }
     }
 }
 
@@ -628,8 +621,7 @@ impl std::fmt::Display for Preset {
 impl std::str::FromStr for Preset {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::from_name(s)
-            .ok_or_else(|| format!("unknown preset `{s}` (expected `default` or `robustness`)"))
+        Self::from_name(s).ok_or_else(|| format!("unknown preset `{s}` (expected `default` or `robustness`)"))
     }
 }
 
@@ -712,19 +704,13 @@ impl ScenarioConfig {
         non_negative("sequence.warmup_s", s.warmup_s)?;
         positive("sequence.max_step_s", s.max_step_s)?;
         if s.max_step_s > 0.1 {
-            return Err(ConfigError::new(
-                "sequence.max_step_s",
-                "must be at most 0.1 s",
-            ));
+            return Err(ConfigError::new("sequence.max_step_s", "must be at most 0.1 s"));
         }
 
         let r = &self.road;
         positive("road.lane_width_m", r.lane_width_m)?;
         if r.lanes_per_direction == 0 || r.lanes_per_direction > 4 {
-            return Err(ConfigError::new(
-                "road.lanes_per_direction",
-                "must be between 1 and 4",
-            ));
+            return Err(ConfigError::new("road.lanes_per_direction", "must be between 1 and 4"));
         }
         positive("road.sidewalk_offset_m", r.sidewalk_offset_m)?;
         positive("road.sidewalk_width_m", r.sidewalk_width_m)?;
@@ -737,10 +723,7 @@ impl ScenarioConfig {
         non_negative("road.stop_line_offset_m", r.stop_line_offset_m)?;
         positive("road.right_turn_radius_m", r.right_turn_radius_m)?;
         positive("road.left_turn_radius_m", r.left_turn_radius_m)?;
-        probability(
-            "road.signalised_junction_fraction",
-            r.signalised_junction_fraction,
-        )?;
+        probability("road.signalised_junction_fraction", r.signalised_junction_fraction)?;
         positive("road.signal_green_s", r.signal_green_s)?;
         non_negative("road.signal_clearance_s", r.signal_clearance_s)?;
         let half_road = r.lane_width_m * f64::from(r.lanes_per_direction);
@@ -754,20 +737,11 @@ impl ScenarioConfig {
         }
 
         let t = &self.traffic;
-        probability(
-            "traffic.pedestrian_group_probability",
-            t.pedestrian_group_probability,
-        )?;
-        probability(
-            "traffic.pedestrian_corner_spawn_probability",
-            t.pedestrian_corner_spawn_probability,
-        )?;
+        probability("traffic.pedestrian_group_probability", t.pedestrian_group_probability)?;
+        probability("traffic.pedestrian_corner_spawn_probability", t.pedestrian_corner_spawn_probability)?;
         positive("traffic.corner_spawn_distance_m", t.corner_spawn_distance_m)?;
         if t.max_group_size < 2 {
-            return Err(ConfigError::new(
-                "traffic.max_group_size",
-                "must be at least 2",
-            ));
+            return Err(ConfigError::new("traffic.max_group_size", "must be at least 2"));
         }
         interval("traffic.group_spacing_m", t.group_spacing_m, true)?;
         positive("traffic.population_radius_m", t.population_radius_m)?;
@@ -796,31 +770,16 @@ impl ScenarioConfig {
         interval("car.desired_speed_mps", c.desired_speed_mps, true)?;
         positive("car.max_speed_mps", c.max_speed_mps)?;
         if c.desired_speed_mps[1] > c.max_speed_mps {
-            return Err(ConfigError::new(
-                "car.desired_speed_mps",
-                "must not exceed car.max_speed_mps",
-            ));
+            return Err(ConfigError::new("car.desired_speed_mps", "must not exceed car.max_speed_mps"));
         }
         positive("car.max_acceleration_mps2", c.max_acceleration_mps2)?;
         positive("car.max_deceleration_mps2", c.max_deceleration_mps2)?;
         positive("car.max_jerk_mps3", c.max_jerk_mps3)?;
         positive("car.max_yaw_rate_radps", c.max_yaw_rate_radps)?;
-        positive(
-            "car.max_yaw_acceleration_radps2",
-            c.max_yaw_acceleration_radps2,
-        )?;
-        positive(
-            "car.max_lateral_acceleration_mps2",
-            c.max_lateral_acceleration_mps2,
-        )?;
-        positive(
-            "car.comfortable_acceleration_mps2",
-            c.comfortable_acceleration_mps2,
-        )?;
-        positive(
-            "car.comfortable_deceleration_mps2",
-            c.comfortable_deceleration_mps2,
-        )?;
+        positive("car.max_yaw_acceleration_radps2", c.max_yaw_acceleration_radps2)?;
+        positive("car.max_lateral_acceleration_mps2", c.max_lateral_acceleration_mps2)?;
+        positive("car.comfortable_acceleration_mps2", c.comfortable_acceleration_mps2)?;
+        positive("car.comfortable_deceleration_mps2", c.comfortable_deceleration_mps2)?;
         if c.comfortable_acceleration_mps2 > c.max_acceleration_mps2 {
             return Err(ConfigError::new(
                 "car.comfortable_acceleration_mps2",
@@ -833,10 +792,7 @@ impl ScenarioConfig {
                 "must not exceed car.max_deceleration_mps2",
             ));
         }
-        positive(
-            "car.curve_lateral_acceleration_mps2",
-            c.curve_lateral_acceleration_mps2,
-        )?;
+        positive("car.curve_lateral_acceleration_mps2", c.curve_lateral_acceleration_mps2)?;
         if c.curve_lateral_acceleration_mps2 > c.max_lateral_acceleration_mps2 {
             return Err(ConfigError::new(
                 "car.curve_lateral_acceleration_mps2",
@@ -856,11 +812,7 @@ impl ScenarioConfig {
         }
         probability("car.lane_change_probability", c.lane_change_probability)?;
         positive("car.lane_change_duration_s", c.lane_change_duration_s)?;
-        interval(
-            "car.speed_change_interval_s",
-            c.speed_change_interval_s,
-            true,
-        )?;
+        interval("car.speed_change_interval_s", c.speed_change_interval_s, true)?;
         for (name, r) in [
             ("road.right_turn_radius_m", r.right_turn_radius_m),
             ("road.left_turn_radius_m", r.left_turn_radius_m),
@@ -878,27 +830,14 @@ impl ScenarioConfig {
         positive("ego.length_m", e.length_m)?;
         positive("ego.width_m", e.width_m)?;
         if e.rear_axle_to_centre_m.abs() >= e.length_m / 2.0 {
-            return Err(ConfigError::new(
-                "ego.rear_axle_to_centre_m",
-                "must lie inside the vehicle",
-            ));
+            return Err(ConfigError::new("ego.rear_axle_to_centre_m", "must lie inside the vehicle"));
         }
         interval("ego.desired_speed_mps", e.desired_speed_mps, true)?;
         if e.desired_speed_mps[1] > self.car.max_speed_mps {
-            return Err(ConfigError::new(
-                "ego.desired_speed_mps",
-                "must not exceed car.max_speed_mps",
-            ));
+            return Err(ConfigError::new("ego.desired_speed_mps", "must not exceed car.max_speed_mps"));
         }
-        probability(
-            "ego.initial_standstill_probability",
-            e.initial_standstill_probability,
-        )?;
-        interval(
-            "ego.start_distance_to_junction_m",
-            e.start_distance_to_junction_m,
-            false,
-        )?;
+        probability("ego.initial_standstill_probability", e.initial_standstill_probability)?;
+        interval("ego.start_distance_to_junction_m", e.start_distance_to_junction_m, false)?;
 
         let p = &self.pedestrian;
         interval("pedestrian.length_m", p.length_m, true)?;
@@ -917,23 +856,14 @@ impl ScenarioConfig {
         positive("pedestrian.max_deceleration_mps2", p.max_deceleration_mps2)?;
         positive("pedestrian.max_jerk_mps3", p.max_jerk_mps3)?;
         positive("pedestrian.max_yaw_rate_radps", p.max_yaw_rate_radps)?;
-        positive(
-            "pedestrian.max_yaw_acceleration_radps2",
-            p.max_yaw_acceleration_radps2,
-        )?;
+        positive("pedestrian.max_yaw_acceleration_radps2", p.max_yaw_acceleration_radps2)?;
         non_negative("pedestrian.heading_wander_rad", p.heading_wander_rad)?;
         positive("pedestrian.heading_wander_time_s", p.heading_wander_time_s)?;
         interval("pedestrian.leg_length_m", p.leg_length_m, true)?;
         probability("pedestrian.stop_probability", p.stop_probability)?;
         interval("pedestrian.stop_duration_s", p.stop_duration_s, true)?;
-        probability(
-            "pedestrian.turn_around_probability",
-            p.turn_around_probability,
-        )?;
-        probability(
-            "pedestrian.mid_block_crossing_probability",
-            p.mid_block_crossing_probability,
-        )?;
+        probability("pedestrian.turn_around_probability", p.turn_around_probability)?;
+        probability("pedestrian.mid_block_crossing_probability", p.mid_block_crossing_probability)?;
         if p.stop_probability + p.turn_around_probability + p.mid_block_crossing_probability > 1.0 {
             return Err(ConfigError::new(
                 "pedestrian.stop_probability",
@@ -944,10 +874,7 @@ impl ScenarioConfig {
 
         let radar = &self.radar;
         if radar.sensors.is_empty() {
-            return Err(ConfigError::new(
-                "radar.sensors",
-                "must list at least one sensor",
-            ));
+            return Err(ConfigError::new("radar.sensors", "must list at least one sensor"));
         }
         for (i, sensor) in radar.sensors.iter().enumerate() {
             let field = |name: &str| format!("radar.sensors[{i}].{name}");
@@ -958,10 +885,7 @@ impl ScenarioConfig {
             finite(&field("y_m"), sensor.y_m)?;
             finite(&field("yaw_deg"), sensor.yaw_deg)?;
             if !(sensor.half_fov_deg > 0.0 && sensor.half_fov_deg < 90.0) {
-                return Err(ConfigError::new(
-                    field("half_fov_deg"),
-                    "must lie in (0, 90) degrees",
-                ));
+                return Err(ConfigError::new(field("half_fov_deg"), "must lie in (0, 90) degrees"));
             }
             positive(&field("max_range_m"), sensor.max_range_m)?;
             finite(&field("azimuth_bias_deg"), sensor.azimuth_bias_deg)?;
@@ -986,26 +910,16 @@ impl ScenarioConfig {
         non_negative("radar.scan_doppler_bias_mps", radar.scan_doppler_bias_mps)?;
         probability("radar.miss_probability", radar.miss_probability)?;
         if radar.miss_probability >= 1.0 {
-            return Err(ConfigError::new(
-                "radar.miss_probability",
-                "must be below 1",
-            ));
+            return Err(ConfigError::new("radar.miss_probability", "must be below 1"));
         }
-        probability(
-            "radar.occluded_point_probability",
-            radar.occluded_point_probability,
-        )?;
+        probability("radar.occluded_point_probability", radar.occluded_point_probability)?;
         probability("radar.fade_start_fraction", radar.fade_start_fraction)?;
 
-        for (prefix, refl) in [
-            ("car_reflection", &self.car_reflection),
-            ("pedestrian_reflection", &self.pedestrian_reflection),
-        ] {
+        for (prefix, refl) in
+            [("car_reflection", &self.car_reflection), ("pedestrian_reflection", &self.pedestrian_reflection)]
+        {
             let field = |name: &str| format!("{prefix}.{name}");
-            positive(
-                &field("mean_points_at_reference"),
-                refl.mean_points_at_reference,
-            )?;
+            positive(&field("mean_points_at_reference"), refl.mean_points_at_reference)?;
             positive(&field("reference_range_m"), refl.reference_range_m)?;
             if refl.max_points == 0 {
                 return Err(ConfigError::new(field("max_points"), "must be at least 1"));
@@ -1016,10 +930,7 @@ impl ScenarioConfig {
             finite(&field("rcs_side_dbsm"), refl.rcs_side_dbsm)?;
             non_negative(&field("rcs_fluctuation_db"), refl.rcs_fluctuation_db)?;
             positive(&field("detection_range_m"), refl.detection_range_m)?;
-            non_negative(
-                &field("micro_doppler_fraction"),
-                refl.micro_doppler_fraction,
-            )?;
+            non_negative(&field("micro_doppler_fraction"), refl.micro_doppler_fraction)?;
         }
         Ok(())
     }
@@ -1042,10 +953,7 @@ fn positive(field: &str, value: f64) -> Result<(), ConfigError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(ConfigError::new(
-            field,
-            format!("must be a positive number (got {value})"),
-        ))
+        Err(ConfigError::new(field, format!("must be a positive number (got {value})")))
     }
 }
 
@@ -1053,10 +961,7 @@ fn non_negative(field: &str, value: f64) -> Result<(), ConfigError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(ConfigError::new(
-            field,
-            format!("must be a non-negative number (got {value})"),
-        ))
+        Err(ConfigError::new(field, format!("must be a non-negative number (got {value})")))
     }
 }
 
@@ -1064,10 +969,7 @@ fn probability(field: &str, value: f64) -> Result<(), ConfigError> {
     if (0.0..=1.0).contains(&value) {
         Ok(())
     } else {
-        Err(ConfigError::new(
-            field,
-            format!("must be a probability in [0, 1] (got {value})"),
-        ))
+        Err(ConfigError::new(field, format!("must be a probability in [0, 1] (got {value})")))
     }
 }
 
@@ -1080,10 +982,7 @@ fn interval(field: &str, value: Interval, strictly_positive: bool) -> Result<(),
         ));
     }
     if strictly_positive && lo <= 0.0 {
-        return Err(ConfigError::new(
-            field,
-            format!("must be positive (got [{lo}, {hi}])"),
-        ));
+        return Err(ConfigError::new(field, format!("must be positive (got [{lo}, {hi}])")));
     }
     Ok(())
 }

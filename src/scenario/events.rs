@@ -40,10 +40,8 @@ impl std::ops::AddAssign for EventCounts {
 /// (measured in that frame or not), judged on ground truth.
 pub fn count_events(generated: &GeneratedSequence) -> EventCounts {
     let mut counts = EventCounts::default();
-    let (min_diff, max_diff) = (
-        CROSSING_MIN_HEADING_DIFF_DEG.to_radians(),
-        CROSSING_MAX_HEADING_DIFF_DEG.to_radians(),
-    );
+    let (min_diff, max_diff) =
+        (CROSSING_MIN_HEADING_DIFF_DEG.to_radians(), CROSSING_MAX_HEADING_DIFF_DEG.to_radians());
     for (frame, truth) in generated.sequence.frames.iter().zip(&generated.truth) {
         let mut close = false;
         let mut crossing = false;

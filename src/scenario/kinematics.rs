@@ -41,13 +41,7 @@ pub(crate) fn wrap_angle(angle: f64) -> f64 {
 
 impl Kinematics {
     pub(crate) fn new(position: DVec2, heading: f64, speed: f64) -> Self {
-        Self {
-            position,
-            heading: wrap_angle(heading),
-            speed,
-            accel: 0.0,
-            yaw_rate: 0.0,
-        }
+        Self { position, heading: wrap_angle(heading), speed, accel: 0.0, yaw_rate: 0.0 }
     }
 
     /// Unit vector of the heading.
@@ -81,11 +75,7 @@ impl Kinematics {
         let mut moving_time = dt;
         if speed <= 0.0 {
             // Standstill within this step.
-            moving_time = if accel < 0.0 {
-                (old_speed / -accel).min(dt)
-            } else {
-                dt
-            };
+            moving_time = if accel < 0.0 { (old_speed / -accel).min(dt) } else { dt };
             speed = 0.0;
             accel_applied = 0.0;
         } else if speed > limits.max_speed {
@@ -100,11 +90,8 @@ impl Kinematics {
         let yaw_rate = (self.yaw_rate + (yaw_target - self.yaw_rate).clamp(-yaw_step, yaw_step))
             .clamp(-yaw_cap, yaw_cap);
 
-        let distance = if moving_time < dt {
-            0.5 * old_speed * moving_time
-        } else {
-            0.5 * (old_speed + speed) * dt
-        };
+        let distance =
+            if moving_time < dt { 0.5 * old_speed * moving_time } else { 0.5 * (old_speed + speed) * dt };
         let mid_heading = self.heading + 0.5 * yaw_rate * dt;
         self.position += DVec2::from_angle(mid_heading) * distance;
         self.heading = wrap_angle(self.heading + yaw_rate * dt);
@@ -138,11 +125,7 @@ mod tests {
         let dt = 0.015;
         let mut previous = k;
         for step in 0..2000 {
-            let (a, w) = if step < 800 {
-                (10.0, 2.0)
-            } else {
-                (-10.0, -2.0)
-            };
+            let (a, w) = if step < 800 { (10.0, 2.0) } else { (-10.0, -2.0) };
             k.step(a, w, dt, &l);
             assert!(k.speed >= 0.0 && k.speed <= l.max_speed + 1e-9);
             assert!(k.accel <= l.max_accel + 1e-9 && k.accel >= -l.max_decel - 1e-9);
@@ -155,10 +138,7 @@ mod tests {
                 );
             }
             let moved = k.position.distance(previous.position);
-            assert!(
-                (moved - 0.5 * (k.speed + previous.speed) * dt).abs()
-                    < 1e-6 + previous.speed * dt * 0.5
-            );
+            assert!((moved - 0.5 * (k.speed + previous.speed) * dt).abs() < 1e-6 + previous.speed * dt * 0.5);
             previous = k;
         }
         assert_eq!(k.speed, 0.0);

@@ -179,11 +179,7 @@ impl ScenarioGenerator {
             Split::Validation => SPLIT_SEED_STRIDE,
             Split::Evaluation => 2 * SPLIT_SEED_STRIDE,
         };
-        self.config
-            .splits
-            .seed_base
-            .wrapping_add(offset)
-            .wrapping_add(u64::from(index))
+        self.config.splits.seed_base.wrapping_add(offset).wrapping_add(u64::from(index))
     }
 
     /// Generates sequence `index` of `split`, named `<split>_<index:04>`.
@@ -208,11 +204,7 @@ impl ScenarioGenerator {
             rng
         };
         let mut world = world::World::new(cfg, rng_for(STREAM_WORLD));
-        let scans = radar::schedule(
-            &cfg.radar,
-            cfg.sequence.duration_s,
-            &mut rng_for(STREAM_SCHEDULE),
-        );
+        let scans = radar::schedule(&cfg.radar, cfg.sequence.duration_s, &mut rng_for(STREAM_SCHEDULE));
         let mut sensor_rng = rng_for(STREAM_SENSOR);
         let warmup = cfg.sequence.warmup_s;
         let mut sequence = Sequence::new(name);
@@ -253,11 +245,6 @@ impl ScenarioGenerator {
                     .collect(),
             });
         }
-        GeneratedSequence {
-            split: None,
-            seed,
-            sequence,
-            truth,
-        }
+        GeneratedSequence { split: None, seed, sequence, truth }
     }
 }

@@ -14,12 +14,7 @@ pub(crate) enum Leg {
     Line { a: DVec2, b: DVec2 },
     /// Circular arc around `centre`, starting at angle `start` and sweeping `sweep` radians
     /// (positive counter-clockwise).
-    Arc {
-        centre: DVec2,
-        radius: f64,
-        start: f64,
-        sweep: f64,
-    },
+    Arc { centre: DVec2, radius: f64, start: f64, sweep: f64 },
 }
 
 impl Leg {
@@ -41,12 +36,7 @@ impl Leg {
                     a + (b - a) * (u / len)
                 }
             }
-            Leg::Arc {
-                centre,
-                radius,
-                start,
-                sweep,
-            } => {
+            Leg::Arc { centre, radius, start, sweep } => {
                 let angle = start + sweep.signum() * u / radius;
                 centre + DVec2::from_angle(angle) * radius
             }
@@ -65,12 +55,7 @@ impl Leg {
                     ((p - a).dot(d) / len2).clamp(0.0, 1.0) * len2.sqrt()
                 }
             }
-            Leg::Arc {
-                centre,
-                radius,
-                start,
-                sweep,
-            } => {
+            Leg::Arc { centre, radius, start, sweep } => {
                 let angle = (p - centre).to_angle();
                 let mut delta = (angle - start) * sweep.signum();
                 delta = delta.rem_euclid(2.0 * PI);
@@ -78,11 +63,7 @@ impl Leg {
                 if delta > sweep.abs() {
                     let past_end = delta - sweep.abs();
                     let before_start = 2.0 * PI - delta;
-                    delta = if past_end < before_start {
-                        sweep.abs()
-                    } else {
-                        0.0
-                    };
+                    delta = if past_end < before_start { sweep.abs() } else { 0.0 };
                 }
                 delta * radius
             }
@@ -93,12 +74,7 @@ impl Leg {
     pub(crate) fn tangent_at(&self, u: f64) -> DVec2 {
         match *self {
             Leg::Line { a, b } => (b - a).normalize_or_zero(),
-            Leg::Arc {
-                radius,
-                start,
-                sweep,
-                ..
-            } => {
+            Leg::Arc { radius, start, sweep, .. } => {
                 let angle = start + sweep.signum() * u.clamp(0.0, self.length()) / radius;
                 DVec2::from_angle(angle).perp() * sweep.signum()
             }
@@ -120,11 +96,7 @@ pub(crate) enum MarkKind {
     /// A signalised stop line for traffic along `axis` at junction `junction` (vehicles).
     StopLine { junction: JunctionId, axis: Axis },
     /// The start of a signalised crosswalk walked along `axis` (pedestrians).
-    Crosswalk {
-        junction: JunctionId,
-        axis: Axis,
-        length_m: f64,
-    },
+    Crosswalk { junction: JunctionId, axis: Axis, length_m: f64 },
     /// Stand still for a while (pedestrians).
     Wait { duration_s: f64 },
     /// Change the walking speed from here on (pedestrians).
@@ -173,11 +145,7 @@ impl Path {
 
     /// Adds a mark; marks are kept sorted by `s`.
     pub(crate) fn add_mark(&mut self, mark: Mark) {
-        let index = self
-            .marks
-            .iter()
-            .position(|m| m.s > mark.s)
-            .unwrap_or(self.marks.len());
+        let index = self.marks.iter().position(|m| m.s > mark.s).unwrap_or(self.marks.len());
         self.marks.insert(index, mark);
     }
 
@@ -185,10 +153,7 @@ impl Path {
         if self.legs.is_empty() {
             return None;
         }
-        let index = self
-            .legs
-            .iter()
-            .position(|(start, leg)| s < start + leg.length());
+        let index = self.legs.iter().position(|(start, leg)| s < start + leg.length());
         Some(index.unwrap_or(self.legs.len() - 1))
     }
 
@@ -258,11 +223,7 @@ impl Path {
 
     /// Arcs overlapping `[s, s + horizon]`: (distance from `s` to the arc start, clamped at 0,
     /// radius).
-    pub(crate) fn arcs_ahead(
-        &self,
-        s: f64,
-        horizon_m: f64,
-    ) -> impl Iterator<Item = (f64, f64)> + '_ {
+    pub(crate) fn arcs_ahead(&self, s: f64, horizon_m: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
         self.legs.iter().filter_map(move |(start, leg)| {
             let end = start + leg.length();
             if end < s || *start > s + horizon_m {
@@ -279,24 +240,14 @@ mod tests {
 
     #[test]
     fn arc_points_and_projection_agree() {
-        let leg = Leg::Arc {
-            centre: DVec2::new(1.0, 2.0),
-            radius: 8.0,
-            start: -PI / 2.0,
-            sweep: PI / 2.0,
-        };
+        let leg = Leg::Arc { centre: DVec2::new(1.0, 2.0), radius: 8.0, start: -PI / 2.0, sweep: PI / 2.0 };
         assert!((leg.length() - 4.0 * PI).abs() < 1e-12);
         for k in 0..=10 {
             let u = leg.length() * k as f64 / 10.0;
             let p = leg.point_at(u);
             assert!((leg.project(p) - u).abs() < 1e-9);
         }
-        let cw = Leg::Arc {
-            centre: DVec2::ZERO,
-            radius: 5.0,
-            start: PI / 2.0,
-            sweep: -PI / 2.0,
-        };
+        let cw = Leg::Arc { centre: DVec2::ZERO, radius: 5.0, start: PI / 2.0, sweep: -PI / 2.0 };
         let end = cw.point_at(cw.length());
         assert!(end.distance(DVec2::new(5.0, 0.0)) < 1e-9);
     }
@@ -304,16 +255,8 @@ mod tests {
     #[test]
     fn path_advances_across_legs() {
         let mut path = Path::default();
-        path.push(Leg::Line {
-            a: DVec2::ZERO,
-            b: DVec2::new(10.0, 0.0),
-        });
-        path.push(Leg::Arc {
-            centre: DVec2::new(10.0, 5.0),
-            radius: 5.0,
-            start: -PI / 2.0,
-            sweep: PI / 2.0,
-        });
+        path.push(Leg::Line { a: DVec2::ZERO, b: DVec2::new(10.0, 0.0) });
+        path.push(Leg::Arc { centre: DVec2::new(10.0, 5.0), radius: 5.0, start: -PI / 2.0, sweep: PI / 2.0 });
         let s = path.advance(0.0, DVec2::new(12.0, 0.3), 0.0);
         assert!(s > 10.0 && s < 10.0 + 5.0 * PI / 2.0, "s = {s}");
         assert!(path.point_at(s).unwrap().distance(DVec2::new(12.0, 0.3)) < 0.6);

@@ -37,9 +37,7 @@ pub(crate) fn schedule(radar: &RadarConfig, duration_s: f64, rng: &mut ChaCha12R
     let slot = period / n as f64;
     let mut order: Vec<usize> = (0..n).collect();
     order.shuffle(rng);
-    let phase: Vec<f64> = (0..n)
-        .map(|_| symmetric(rng, radar.phase_jitter_s))
-        .collect();
+    let phase: Vec<f64> = (0..n).map(|_| symmetric(rng, radar.phase_jitter_s)).collect();
     let mut scans = Vec::new();
     let mut cycle = 0u64;
     loop {
@@ -68,10 +66,7 @@ fn symmetric(rng: &mut ChaCha12Rng, half_width: f64) -> f64 {
 
 /// World pose of a sensor: position and boresight heading.
 pub(crate) fn sensor_pose(ego: &EgoPose, mount: &RadarMount) -> (DVec2, f64) {
-    (
-        ego.car_to_world(DVec2::new(mount.x_m, mount.y_m)),
-        ego.yaw_rad + mount.yaw_deg.to_radians(),
-    )
+    (ego.car_to_world(DVec2::new(mount.x_m, mount.y_m)), ego.yaw_rad + mount.yaw_deg.to_radians())
 }
 
 /// Whether the segment from `a` to `b` passes through the box of `agent`.
@@ -160,11 +155,7 @@ pub(crate) fn scan(
             let mid = 0.5 * (a + b);
             let to_sensor = (origin - mid).normalize_or_zero();
             let facing = outward.dot(to_sensor);
-            let weight = if facing > 0.0 {
-                edge.length() * facing
-            } else {
-                0.0
-            };
+            let weight = if facing > 0.0 { edge.length() * facing } else { 0.0 };
             faces[k] = (k, weight);
             total += weight;
         }
@@ -175,13 +166,8 @@ pub(crate) fn scan(
         // Number of candidate points: more for near objects.
         let scale = (refl.reference_range_m / range.max(1.0)).clamp(0.3, 3.0);
         let mean = (refl.mean_points_at_reference * scale - 1.0).max(0.0);
-        let extra = if mean > 0.0 {
-            Poisson::new(mean)
-                .map(|d| d.sample(rng) as u32)
-                .unwrap_or(0)
-        } else {
-            0
-        };
+        let extra =
+            if mean > 0.0 { Poisson::new(mean).map(|d| d.sample(rng) as u32).unwrap_or(0) } else { 0 };
         let candidates = (1 + extra).min(refl.max_points);
 
         let velocity = object.kin.velocity();
@@ -231,19 +217,20 @@ pub(crate) fn scan(
                     continue;
                 }
             }
-            let hidden = world.agents.iter().enumerate().any(|(j, other)| {
-                j != index && !other.is_ego && segment_hits_box(origin, point, other)
-            });
+            let hidden = world
+                .agents
+                .iter()
+                .enumerate()
+                .any(|(j, other)| j != index && !other.is_ego && segment_hits_box(origin, point, other));
             if hidden && !rng.random_bool(radar.occluded_point_probability) {
                 continue;
             }
 
             // Measured point: range and azimuth noise in the sensor's polar frame.
-            let sigma_az = radar.azimuth_noise_deg.to_radians() * mount.azimuth_noise_scale
-                / azimuth.cos().max(0.5);
+            let sigma_az =
+                radar.azimuth_noise_deg.to_radians() * mount.azimuth_noise_scale / azimuth.cos().max(0.5);
             let measured_range = point_range + radar.range_noise_m * unit.sample(rng);
-            let measured_az =
-                azimuth + mount.azimuth_bias_deg.to_radians() + sigma_az * unit.sample(rng);
+            let measured_az = azimuth + mount.azimuth_bias_deg.to_radians() + sigma_az * unit.sample(rng);
             let measured = origin + DVec2::from_angle(boresight + measured_az) * measured_range;
 
             // Doppler: velocity of the reflecting point along the line of sight.
@@ -251,9 +238,7 @@ pub(crate) fn scan(
             let lever = point - centre;
             let point_velocity = velocity + DVec2::new(-lever.y, lever.x) * object.kin.yaw_rate;
             let micro = refl.micro_doppler_fraction * object.kin.speed * unit.sample(rng);
-            let vr = point_velocity.dot(line_of_sight)
-                + radar.doppler_noise_mps * unit.sample(rng)
-                + micro;
+            let vr = point_velocity.dot(line_of_sight) + radar.doppler_noise_mps * unit.sample(rng) + micro;
 
             // RCS: side views reflect more than head-on views; each point fluctuates.
             let aspect = heading.perp_dot(-line_of_sight).abs();
@@ -306,11 +291,7 @@ mod tests {
             assert_ne!(pair[1].sensor, pair[0].sensor);
         }
         for sensor in 0..radar.sensors.len() {
-            let times: Vec<f64> = scans
-                .iter()
-                .filter(|s| s.sensor == sensor)
-                .map(|s| s.t)
-                .collect();
+            let times: Vec<f64> = scans.iter().filter(|s| s.sensor == sensor).map(|s| s.t).collect();
             for pair in times.windows(2) {
                 let gap = pair[1] - pair[0];
                 assert!((gap - radar.scan_period_s).abs() <= 2.0 * radar.scan_jitter_s + 1e-12);

@@ -100,10 +100,7 @@ impl RoadGrid {
 
     /// The junction nearest to `point`.
     pub(crate) fn nearest_junction(&self, point: DVec2) -> JunctionId {
-        (
-            (point.x / self.block_m).round() as i64,
-            (point.y / self.block_m).round() as i64,
-        )
+        ((point.x / self.block_m).round() as i64, (point.y / self.block_m).round() as i64)
     }
 
     /// Length of one signal cycle, seconds.
@@ -176,12 +173,7 @@ impl RoadGrid {
         let y0 = block.1 as f64 * self.block_m + self.sidewalk_m;
         let x1 = (block.0 + 1) as f64 * self.block_m - self.sidewalk_m;
         let y1 = (block.1 + 1) as f64 * self.block_m - self.sidewalk_m;
-        [
-            DVec2::new(x0, y0),
-            DVec2::new(x1, y0),
-            DVec2::new(x1, y1),
-            DVec2::new(x0, y1),
-        ]
+        [DVec2::new(x0, y0), DVec2::new(x1, y0), DVec2::new(x1, y1), DVec2::new(x0, y1)]
     }
 
     /// Perimeter of a ring, metres.
@@ -231,10 +223,7 @@ impl RoadGrid {
 
     /// The block whose ring is nearest to `point`.
     pub(crate) fn block_of(&self, point: DVec2) -> (i64, i64) {
-        (
-            (point.x / self.block_m).floor() as i64,
-            (point.y / self.block_m).floor() as i64,
-        )
+        ((point.x / self.block_m).floor() as i64, (point.y / self.block_m).floor() as i64)
     }
 }
 
@@ -262,10 +251,7 @@ mod tests {
     #[test]
     fn signals_alternate_and_never_both_green() {
         let g = grid();
-        let id = (-50..50)
-            .map(|i| (i, 4))
-            .find(|&id| g.is_signalised(id))
-            .expect("a signalised junction");
+        let id = (-50..50).map(|i| (i, 4)).find(|&id| g.is_signalised(id)).expect("a signalised junction");
         let mut x_green = 0;
         let mut y_green = 0;
         for k in 0..4000 {
@@ -287,16 +273,11 @@ mod tests {
     #[test]
     fn signalised_fraction_is_respected() {
         let g = grid();
-        let signalised = (0..40)
-            .flat_map(|i| (0..40).map(move |j| (i, j)))
-            .filter(|&id| g.is_signalised(id))
-            .count();
+        let signalised =
+            (0..40).flat_map(|i| (0..40).map(move |j| (i, j))).filter(|&id| g.is_signalised(id)).count();
         let share = signalised as f64 / 1600.0;
         assert!((share - 0.5).abs() < 0.05, "signalised share {share}");
-        let unsignalised = (0..40)
-            .map(|i| (i, 0))
-            .find(|&id| !g.is_signalised(id))
-            .unwrap();
+        let unsignalised = (0..40).map(|i| (i, 0)).find(|&id| !g.is_signalised(id)).unwrap();
         assert!(g.is_green(unsignalised, Axis::X, 3.0) && g.is_green(unsignalised, Axis::Y, 3.0));
     }
 }

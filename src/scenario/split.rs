@@ -126,10 +126,7 @@ pub fn format_table(summaries: &[SplitSummary]) -> String {
     );
     for s in summaries {
         let (close, crossing) = match s.events {
-            Some(e) => (
-                thousands(e.close_proximity_frames),
-                thousands(e.crossing_frames),
-            ),
+            Some(e) => (thousands(e.close_proximity_frames), thousands(e.crossing_frames)),
             None => ("-".to_owned(), "-".to_owned()),
         };
         let mut name = s.split.name().to_owned();

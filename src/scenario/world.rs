@@ -189,11 +189,7 @@ impl<'c> World<'c> {
     pub(crate) fn ego_pose(&self) -> EgoPose {
         let ego = self.ego();
         let rear = ego.kin.position - ego.kin.direction() * self.cfg.ego.rear_axle_to_centre_m;
-        EgoPose {
-            x_m: rear.x,
-            y_m: rear.y,
-            yaw_rad: ego.kin.heading,
-        }
+        EgoPose { x_m: rear.x, y_m: rear.y, yaw_rad: ego.kin.heading }
     }
 
     /// Runs the simulation up to time `t_end`.
@@ -212,11 +208,7 @@ impl<'c> World<'c> {
                 _ => &self.car_limits,
             };
             agent.kin.step(accel, yaw_rate, dt, limits);
-            let reach = if agent.class == ObjectClass::Pedestrian {
-                0.35
-            } else {
-                0.0
-            };
+            let reach = if agent.class == ObjectClass::Pedestrian { 0.35 } else { 0.0 };
             agent.s = agent.path.advance(agent.s, agent.kin.position, reach);
         }
         self.t += dt;
@@ -248,10 +240,7 @@ impl<'c> World<'c> {
 
         // Pure pursuit on the planned path.
         let look = (0.7 * v + 2.5).clamp(3.5, 18.0);
-        let target = me
-            .path
-            .point_at(me.s + look)
-            .unwrap_or(position + heading * look);
+        let target = me.path.point_at(me.s + look).unwrap_or(position + heading * look);
         let to = target - position;
         let distance = to.length().max(0.1);
         let alpha = wrap_angle(to.to_angle() - me.kin.heading);
@@ -289,16 +278,9 @@ impl<'c> World<'c> {
             if lon <= 0.0 {
                 continue;
             }
-            let on_path = me
-                .path
-                .point_at(me.s + lon)
-                .unwrap_or(position + heading * lon);
+            let on_path = me.path.point_at(me.s + lon).unwrap_or(position + heading * lon);
             let lateral = other.kin.position.distance(on_path);
-            let margin = if other.class == ObjectClass::Pedestrian {
-                0.9
-            } else {
-                0.3
-            };
+            let margin = if other.class == ObjectClass::Pedestrian { 0.9 } else { 0.3 };
             if lateral > me.width / 2.0 + other.width / 2.0 + margin {
                 continue;
             }
@@ -364,8 +346,8 @@ impl<'c> World<'c> {
                         && their_distance > -1.0
                         && their_distance < 30.0 =>
                 {
-                    let eta = (their_distance.max(0.0) + self.grid.stop_distance_m)
-                        / other.kin.speed.max(1.0);
+                    let eta =
+                        (their_distance.max(0.0) + self.grid.stop_distance_m) / other.kin.speed.max(1.0);
                     eta < my_eta || (eta == my_eta && other.id < me.id)
                 }
                 _ => false,
@@ -377,12 +359,8 @@ impl<'c> World<'c> {
         let me = &self.agents[i];
         let p = &self.cfg.pedestrian;
         let position = me.kin.position;
-        let leader = brain.follow.and_then(|f| {
-            self.agents
-                .iter()
-                .find(|a| a.id == f.leader)
-                .map(|a| (a, f.offset))
-        });
+        let leader =
+            brain.follow.and_then(|f| self.agents.iter().find(|a| a.id == f.leader).map(|a| (a, f.offset)));
         let (mut target_speed, desired_heading) = if let Some((leader, offset)) = leader {
             let slot = leader.kin.position + leader.kin.direction().rotate(offset);
             let error = slot - position;
@@ -405,10 +383,7 @@ impl<'c> World<'c> {
             };
             let mut speed = if waiting { 0.0 } else { brain.speed };
             for mark in &me.path.marks {
-                let stop_here = matches!(
-                    mark.kind,
-                    MarkKind::Wait { .. } | MarkKind::Crosswalk { .. }
-                );
+                let stop_here = matches!(mark.kind, MarkKind::Wait { .. } | MarkKind::Crosswalk { .. });
                 if stop_here {
                     let d = mark.s - me.s;
                     speed = speed.min((2.0 * 0.8 * (d - 0.1).max(0.0)).sqrt());
@@ -436,14 +411,10 @@ impl<'c> World<'c> {
         match &mut agent.brain {
             Brain::Car(brain) => {
                 if t >= brain.next_speed_change {
-                    let range = if agent.is_ego {
-                        cfg.ego.desired_speed_mps
-                    } else {
-                        cfg.car.desired_speed_mps
-                    };
+                    let range =
+                        if agent.is_ego { cfg.ego.desired_speed_mps } else { cfg.car.desired_speed_mps };
                     brain.desired_speed = uniform(&mut self.rng, range);
-                    brain.next_speed_change =
-                        t + uniform(&mut self.rng, cfg.car.speed_change_interval_s);
+                    brain.next_speed_change = t + uniform(&mut self.rng, cfg.car.speed_change_interval_s);
                 }
                 let front = agent.s + agent.length / 2.0;
                 while agent.path.marks.front().is_some_and(|m| m.s < front - 1.0) {
@@ -464,9 +435,7 @@ impl<'c> World<'c> {
                 let noise = Normal::new(0.0, 1.0).expect("unit normal");
                 brain.wander += -brain.wander / tau * dt
                     + p.heading_wander_rad * (2.0 * dt / tau).sqrt() * noise.sample(&mut self.rng);
-                brain.wander = brain
-                    .wander
-                    .clamp(-3.0 * p.heading_wander_rad, 3.0 * p.heading_wander_rad);
+                brain.wander = brain.wander.clamp(-3.0 * p.heading_wander_rad, 3.0 * p.heading_wander_rad);
                 while let Some(mark) = agent.path.marks.front().copied() {
                     let d = mark.s - agent.s;
                     let done = match mark.kind {
@@ -486,15 +455,9 @@ impl<'c> World<'c> {
                                 false
                             }
                         }
-                        MarkKind::Crosswalk {
-                            junction,
-                            axis,
-                            length_m,
-                        } => {
+                        MarkKind::Crosswalk { junction, axis, length_m } => {
                             let needed = 0.6 * length_m / brain.speed.max(0.5);
-                            d < -0.5
-                                || (d < 3.0
-                                    && self.grid.green_remaining(junction, axis, t) >= needed)
+                            d < -0.5 || (d < 3.0 && self.grid.green_remaining(junction, axis, t) >= needed)
                         }
                         MarkKind::StopLine { .. } => true,
                     };
@@ -529,19 +492,12 @@ impl<'c> World<'c> {
         // Place the ego so that, when recording starts after the warm-up, it is typically
         // approaching the junction at the end of its block, clear of the junction areas.
         let clear = self.grid.stop_distance_m + 5.0;
-        let ahead = uniform(&mut self.rng, cfg.ego.start_distance_to_junction_m)
-            + speed * cfg.sequence.warmup_s;
+        let ahead =
+            uniform(&mut self.rng, cfg.ego.start_distance_to_junction_m) + speed * cfg.sequence.warmup_s;
         let along_dir = (b - ahead).clamp(clear, b - clear);
-        let along = if dir.x + dir.y > 0.0 {
-            along_dir
-        } else {
-            b - along_dir
-        };
-        let axis_point = if Axis::of(dir) == Axis::X {
-            DVec2::new(along, 0.0)
-        } else {
-            DVec2::new(0.0, along)
-        };
+        let along = if dir.x + dir.y > 0.0 { along_dir } else { b - along_dir };
+        let axis_point =
+            if Axis::of(dir) == Axis::X { DVec2::new(along, 0.0) } else { DVec2::new(0.0, along) };
         let pos = axis_point + right_of(dir) * self.grid.lane_offset(lane);
         let brain = CarBrain {
             cursor: LaneCursor { pos, dir, lane },
@@ -596,8 +552,7 @@ impl<'c> World<'c> {
     fn maintain_population(&mut self, initial: bool) {
         let ego_pos = self.ego().kin.position;
         let despawn = self.cfg.traffic.despawn_radius_m;
-        self.agents
-            .retain(|a| a.is_ego || a.kin.position.distance(ego_pos) <= despawn);
+        self.agents.retain(|a| a.is_ego || a.kin.position.distance(ego_pos) <= despawn);
 
         // Group members whose leader left walk on their own.
         let ids: Vec<u64> = self.agents.iter().map(|a| a.id).collect();
@@ -609,11 +564,7 @@ impl<'c> World<'c> {
         }
 
         let traffic = &self.cfg.traffic;
-        let mut cars = self
-            .agents
-            .iter()
-            .filter(|a| !a.is_ego && a.class == ObjectClass::Car)
-            .count();
+        let mut cars = self.agents.iter().filter(|a| !a.is_ego && a.class == ObjectClass::Car).count();
         let mut tries = 0;
         while cars < traffic.car_count as usize && tries < 60 {
             tries += 1;
@@ -621,11 +572,7 @@ impl<'c> World<'c> {
                 cars += 1;
             }
         }
-        let mut peds = self
-            .agents
-            .iter()
-            .filter(|a| a.class == ObjectClass::Pedestrian)
-            .count();
+        let mut peds = self.agents.iter().filter(|a| a.class == ObjectClass::Pedestrian).count();
         let mut tries = 0;
         while peds < traffic.pedestrian_count as usize && tries < 60 {
             tries += 1;
@@ -660,15 +607,9 @@ impl<'c> World<'c> {
         }
         let c = &cfg.car;
         let (length, width) = if self.rng.random_bool(c.large_vehicle_probability) {
-            (
-                uniform(&mut self.rng, c.large_length_m),
-                uniform(&mut self.rng, c.large_width_m),
-            )
+            (uniform(&mut self.rng, c.large_length_m), uniform(&mut self.rng, c.large_width_m))
         } else {
-            (
-                uniform(&mut self.rng, c.length_m),
-                uniform(&mut self.rng, c.width_m),
-            )
+            (uniform(&mut self.rng, c.length_m), uniform(&mut self.rng, c.width_m))
         };
         let desired = uniform(&mut self.rng, c.desired_speed_mps);
         let speed = desired * self.rng.random_range(0.5..=1.0);
@@ -704,23 +645,16 @@ impl<'c> World<'c> {
         let cfg = self.cfg;
         let radius = cfg.traffic.population_radius_m;
         let ego = self.ego().kin.position;
-        let point = ego
-            + DVec2::new(
-                self.rng.random_range(-radius..radius),
-                self.rng.random_range(-radius..radius),
-            );
+        let point =
+            ego + DVec2::new(self.rng.random_range(-radius..radius), self.rng.random_range(-radius..radius));
         let block = self.grid.block_of(point);
         let mut p = self.grid.ring_project(block, point);
-        if self
-            .rng
-            .random_bool(cfg.traffic.pedestrian_corner_spawn_probability)
-        {
+        if self.rng.random_bool(cfg.traffic.pedestrian_corner_spawn_probability) {
             // Street corners are where pedestrians gather and cross.
             let side = self.grid.ring_side_m();
             let corner = (p / side).round() * side;
             let reach = cfg.traffic.corner_spawn_distance_m.min(side / 2.0);
-            p = (corner + self.rng.random_range(-reach..=reach))
-                .rem_euclid(self.grid.ring_length_m());
+            p = (corner + self.rng.random_range(-reach..=reach)).rem_euclid(self.grid.ring_length_m());
         }
         let dir = if self.rng.random_bool(0.5) { 1.0 } else { -1.0 };
         let lateral = self.rng.random_range(-0.6..=0.6) * self.grid.sidewalk_half_width_m;
@@ -737,27 +671,14 @@ impl<'c> World<'c> {
             follow: None,
         };
         let mut path = Path::default();
-        path.push(Leg::Line {
-            a: pos,
-            b: pos + self.grid.ring_tangent(p) * dir * 0.5,
-        });
+        path.push(Leg::Line { a: pos, b: pos + self.grid.ring_tangent(p) * dir * 0.5 });
         brain.cursor.p = (p + dir * 0.5).rem_euclid(self.grid.ring_length_m());
         while path.end_s() < PED_PLAN_AHEAD_M {
             plan_pedestrian(&self.grid, cfg, &mut self.rng, &mut brain, &mut path);
         }
-        let speed = if self.rng.random_bool(0.15) {
-            0.0
-        } else {
-            brain.speed
-        };
-        let group_size = if budget >= 2
-            && self
-                .rng
-                .random_bool(cfg.traffic.pedestrian_group_probability)
-        {
-            self.rng
-                .random_range(2..=cfg.traffic.max_group_size as usize)
-                .min(budget)
+        let speed = if self.rng.random_bool(0.15) { 0.0 } else { brain.speed };
+        let group_size = if budget >= 2 && self.rng.random_bool(cfg.traffic.pedestrian_group_probability) {
+            self.rng.random_range(2..=cfg.traffic.max_group_size as usize).min(budget)
         } else {
             1
         };
@@ -767,33 +688,18 @@ impl<'c> World<'c> {
         for k in 1..group_size {
             let spacing = uniform(&mut self.rng, cfg.traffic.group_spacing_m);
             let side = if k % 2 == 1 { 1.0 } else { -1.0 };
-            let offset = DVec2::new(
-                self.rng.random_range(-0.6..=0.3),
-                side * spacing * (k.div_ceil(2)) as f64,
-            );
+            let offset =
+                DVec2::new(self.rng.random_range(-0.6..=0.3), side * spacing * (k.div_ceil(2)) as f64);
             let member_pos = pos + DVec2::from_angle(heading).rotate(offset);
-            let member_brain = PedBrain {
-                follow: Some(Follow {
-                    leader: leader_id,
-                    offset,
-                }),
-                ..brain.clone()
-            };
-            let member =
-                self.new_pedestrian(member_pos, heading, speed, Path::default(), member_brain);
+            let member_brain =
+                PedBrain { follow: Some(Follow { leader: leader_id, offset }), ..brain.clone() };
+            let member = self.new_pedestrian(member_pos, heading, speed, Path::default(), member_brain);
             self.agents.push(member);
         }
         group_size
     }
 
-    fn new_pedestrian(
-        &mut self,
-        pos: DVec2,
-        heading: f64,
-        speed: f64,
-        path: Path,
-        brain: PedBrain,
-    ) -> Agent {
+    fn new_pedestrian(&mut self, pos: DVec2, heading: f64, speed: f64, path: Path, brain: PedBrain) -> Agent {
         let p = &self.cfg.pedestrian;
         let id = self.next_id;
         self.next_id += 1;
@@ -823,10 +729,7 @@ impl<'c> World<'c> {
         let pos = self.agents[i].kin.position;
         let block = self.grid.block_of(pos);
         let p = self.grid.ring_project(block, pos);
-        let along = self.agents[i]
-            .kin
-            .direction()
-            .dot(self.grid.ring_tangent(p));
+        let along = self.agents[i].kin.direction().dot(self.grid.ring_tangent(p));
         let dir = if along >= 0.0 { 1.0 } else { -1.0 };
         let start = self.grid.ring_point(block, p);
         let cfg = self.cfg;
@@ -839,10 +742,7 @@ impl<'c> World<'c> {
             let mut path = Path::default();
             path.push(Leg::Line { a: pos, b: start });
             if path.is_empty() {
-                path.push(Leg::Line {
-                    a: pos,
-                    b: pos + grid.ring_tangent(p) * dir * 0.5,
-                });
+                path.push(Leg::Line { a: pos, b: pos + grid.ring_tangent(p) * dir * 0.5 });
                 brain.cursor.p = (p + dir * 0.5).rem_euclid(grid.ring_length_m());
             }
             while path.end_s() < PED_PLAN_AHEAD_M {
@@ -877,11 +777,7 @@ fn plan_car(
     // The junction ahead on this road.
     let coord = cursor.pos.dot(d.abs());
     let sign = d.x + d.y;
-    let next = if sign > 0.0 {
-        (coord / b).floor() + 1.0
-    } else {
-        (coord / b).ceil() - 1.0
-    } * b;
+    let next = if sign > 0.0 { (coord / b).floor() + 1.0 } else { (coord / b).ceil() - 1.0 } * b;
     let dist_j = (next - coord) * sign;
     let centre_line = cursor.pos - r * grid.lane_offset(cursor.lane);
     let junction = centre_line + d * dist_j;
@@ -893,14 +789,7 @@ fn plan_car(
     let r_left = grid.left_turn_radius_m;
     let right_entry = dist_j - (grid.lane_offset(outer) + r_right);
     let left_entry = dist_j + grid.lane_offset(0) - r_left;
-    let feasible = |entry: f64, lane: u32| {
-        entry
-            >= if lane == cursor.lane {
-                1.0
-            } else {
-                lane_change_room
-            }
-    };
+    let feasible = |entry: f64, lane: u32| entry >= if lane == cursor.lane { 1.0 } else { lane_change_room };
 
     #[derive(PartialEq)]
     enum Manoeuvre {
@@ -926,10 +815,7 @@ fn plan_car(
         Manoeuvre::Left => 0,
         Manoeuvre::Straight => {
             let room = dist_j - grid.stop_distance_m;
-            if grid.lanes > 1
-                && room >= lane_change_room
-                && rng.random_bool(c.lane_change_probability)
-            {
+            if grid.lanes > 1 && room >= lane_change_room && rng.random_bool(c.lane_change_probability) {
                 let other = rng.random_range(0..grid.lanes - 1);
                 if other >= cursor.lane {
                     other + 1
@@ -947,10 +833,7 @@ fn plan_car(
         let start = current + d * 8.0;
         let shift = grid.lane_offset(target_lane) - grid.lane_offset(cursor.lane);
         let end = current + d * (8.0 + lane_change_m) + r * shift;
-        path.push(Leg::Line {
-            a: current,
-            b: start,
-        });
+        path.push(Leg::Line { a: current, b: start });
         path.push(Leg::Line { a: start, b: end });
         current = end;
     }
@@ -964,15 +847,8 @@ fn plan_car(
     match manoeuvre {
         Manoeuvre::Straight => {
             let exit = junction + d * (hw + 1.0) + r * o_in;
-            path.push(Leg::Line {
-                a: current,
-                b: exit,
-            });
-            brain.cursor = LaneCursor {
-                pos: exit,
-                dir: d,
-                lane: target_lane,
-            };
+            path.push(Leg::Line { a: current, b: exit });
+            brain.cursor = LaneCursor { pos: exit, dir: d, lane: target_lane };
         }
         Manoeuvre::Right => {
             let o_out = grid.lane_offset(outer);
@@ -980,21 +856,14 @@ fn plan_car(
             let entry = corner - d * r_right;
             let exit = corner + r * r_right;
             let centre = corner - d * r_right + r * r_right;
-            path.push(Leg::Line {
-                a: current,
-                b: entry,
-            });
+            path.push(Leg::Line { a: current, b: entry });
             path.push(Leg::Arc {
                 centre,
                 radius: r_right,
                 start: (entry - centre).to_angle(),
                 sweep: -PI / 2.0,
             });
-            brain.cursor = LaneCursor {
-                pos: exit,
-                dir: r,
-                lane: outer,
-            };
+            brain.cursor = LaneCursor { pos: exit, dir: r, lane: outer };
         }
         Manoeuvre::Left => {
             let o_out = grid.lane_offset(0);
@@ -1002,31 +871,18 @@ fn plan_car(
             let entry = corner - d * r_left;
             let exit = corner - r * r_left;
             let centre = corner - d * r_left - r * r_left;
-            path.push(Leg::Line {
-                a: current,
-                b: entry,
-            });
+            path.push(Leg::Line { a: current, b: entry });
             path.push(Leg::Arc {
                 centre,
                 radius: r_left,
                 start: (entry - centre).to_angle(),
                 sweep: PI / 2.0,
             });
-            brain.cursor = LaneCursor {
-                pos: exit,
-                dir: -r,
-                lane: 0,
-            };
+            brain.cursor = LaneCursor { pos: exit, dir: -r, lane: 0 };
         }
     }
     if stop_ahead > 0.0 {
-        path.add_mark(Mark {
-            s: stop_s,
-            kind: MarkKind::StopLine {
-                junction: junction_id,
-                axis,
-            },
-        });
+        path.add_mark(Mark { s: stop_s, kind: MarkKind::StopLine { junction: junction_id, axis } });
     }
 }
 
@@ -1042,17 +898,11 @@ fn plan_pedestrian(
     let side = grid.ring_side_m();
     let ring = grid.ring_length_m();
     let jitter_width = 0.7 * grid.sidewalk_half_width_m;
-    let start = path
-        .end_point()
-        .unwrap_or_else(|| grid.ring_point(brain.cursor.block, brain.cursor.p));
+    let start = path.end_point().unwrap_or_else(|| grid.ring_point(brain.cursor.block, brain.cursor.p));
     let cursor = &mut brain.cursor;
     let p = cursor.p;
     let k = (p / side).floor();
-    let mut to_corner = if cursor.dir > 0.0 {
-        (k + 1.0) * side - p
-    } else {
-        p - k * side
-    };
+    let mut to_corner = if cursor.dir > 0.0 { (k + 1.0) * side - p } else { p - k * side };
     if to_corner < 0.05 {
         to_corner += side;
     }
@@ -1064,10 +914,7 @@ fn plan_pedestrian(
         } else {
             uniform(rng, p_cfg.desired_speed_mps)
         };
-        path.add_mark(Mark {
-            s: path.end_s(),
-            kind: MarkKind::SetSpeed { speed_mps: speed },
-        });
+        path.add_mark(Mark { s: path.end_s(), kind: MarkKind::SetSpeed { speed_mps: speed } });
     }
 
     let leg = uniform(rng, p_cfg.leg_length_m);
@@ -1075,39 +922,26 @@ fn plan_pedestrian(
         cursor.p = (p + cursor.dir * leg).rem_euclid(ring);
         let waypoint = grid.ring_point(cursor.block, cursor.p)
             + grid.ring_outward(cursor.p) * rng.random_range(-jitter_width..=jitter_width);
-        path.push(Leg::Line {
-            a: start,
-            b: waypoint,
-        });
+        path.push(Leg::Line { a: start, b: waypoint });
         let u: f64 = rng.random();
         let stop = p_cfg.stop_probability;
         let turn = stop + p_cfg.turn_around_probability;
         let cross = turn + p_cfg.mid_block_crossing_probability;
         if u < stop {
             let duration_s = uniform(rng, p_cfg.stop_duration_s);
-            path.add_mark(Mark {
-                s: path.end_s(),
-                kind: MarkKind::Wait { duration_s },
-            });
+            path.add_mark(Mark { s: path.end_s(), kind: MarkKind::Wait { duration_s } });
         } else if u < turn {
             cursor.dir = -cursor.dir;
         } else if u < cross {
             // Cross the adjacent road straight over to the facing block.
             let out = grid.ring_outward(cursor.p);
             let here = grid.ring_point(cursor.block, cursor.p);
-            let across =
-                here + out * (2.0 * grid.sidewalk_m) + out.perp() * rng.random_range(-1.0..=1.0);
+            let across = here + out * (2.0 * grid.sidewalk_m) + out.perp() * rng.random_range(-1.0..=1.0);
             if rng.random_bool(0.5) {
                 let duration_s = rng.random_range(0.5..=2.0);
-                path.add_mark(Mark {
-                    s: path.end_s(),
-                    kind: MarkKind::Wait { duration_s },
-                });
+                path.add_mark(Mark { s: path.end_s(), kind: MarkKind::Wait { duration_s } });
             }
-            path.push(Leg::Line {
-                a: waypoint,
-                b: across,
-            });
+            path.push(Leg::Line { a: waypoint, b: across });
             cursor.block = grid.block_of(across);
             cursor.p = grid.ring_project(cursor.block, across);
             cursor.dir = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
@@ -1119,10 +953,7 @@ fn plan_pedestrian(
     cursor.p = (((p + cursor.dir * to_corner) / side).round() * side).rem_euclid(ring);
     let corner = grid.ring_point(cursor.block, cursor.p);
     let waypoint = corner + DVec2::new(rng.random_range(-0.3..=0.3), rng.random_range(-0.3..=0.3));
-    path.push(Leg::Line {
-        a: start,
-        b: waypoint,
-    });
+    path.push(Leg::Line { a: start, b: waypoint });
     let u: f64 = rng.random();
     if u < p_cfg.crosswalk_probability {
         // The two roads meeting at this corner lie along the outward normals of the two sides.
@@ -1134,16 +965,9 @@ fn plan_pedestrian(
         let junction = grid.nearest_junction(corner + v * grid.sidewalk_m);
         path.add_mark(Mark {
             s: path.end_s(),
-            kind: MarkKind::Crosswalk {
-                junction,
-                axis: Axis::of(v),
-                length_m: crossing_m,
-            },
+            kind: MarkKind::Crosswalk { junction, axis: Axis::of(v), length_m: crossing_m },
         });
-        path.push(Leg::Line {
-            a: waypoint,
-            b: target,
-        });
+        path.push(Leg::Line { a: waypoint, b: target });
         cursor.block = grid.block_of(target);
         cursor.p = (grid.ring_project(cursor.block, target) / side).round() * side % ring;
         let forward = grid.ring_tangent(cursor.p);

@@ -112,7 +112,9 @@ impl AccuracyMonitor {
         let mut track_of_measurement = vec![None; pending.measurements.len()];
         if tracked {
             for track in frame.valid_tracks() {
-                if let Some(slot) = track.measurement_index().and_then(|index| track_of_measurement.get_mut(index)) {
+                if let Some(slot) =
+                    track.measurement_index().and_then(|index| track_of_measurement.get_mut(index))
+                {
                     *slot = Some(*track);
                 }
             }

@@ -279,7 +279,10 @@ impl<T: Debug + ZeroCopySend + 'static> Stream<T> {
 }
 
 /// Opens (or creates) `primm/measurements` and its event service.
-pub fn measurements(node: &Node<Ipc>, names: &ServiceNames) -> Result<Stream<MeasurementFrame>, ConnectError> {
+pub fn measurements(
+    node: &Node<Ipc>,
+    names: &ServiceNames,
+) -> Result<Stream<MeasurementFrame>, ConnectError> {
     Stream::open(node, names.measurements(), MEASUREMENTS_QOS)
 }
 

@@ -32,7 +32,8 @@ mod tests {
     #[test]
     fn logs_the_first_ten_then_powers_of_two() {
         let mut limiter = LogLimiter::default();
-        let logged: Vec<u64> = (1..=100).filter(|_| limiter.occur()).collect::<Vec<_>>().iter().map(|&i| i as u64).collect();
+        let logged: Vec<u64> =
+            (1..=100).filter(|_| limiter.occur()).collect::<Vec<_>>().iter().map(|&i| i as u64).collect();
         assert_eq!(logged, vec![1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 16, 32, 64]);
         assert_eq!(limiter.occurrences(), 100);
     }

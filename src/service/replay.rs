@@ -7,8 +7,8 @@ use super::clock::monotonic_ns;
 use super::shutdown::ShutdownFlag;
 use crate::io::{RecordedFrame, Sequence};
 use crate::wire::{
-    MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, TrackFrame, WireMeasurement, FRAME_FLAG_STREAM_END,
-    FRAME_FLAG_STREAM_START, MEASUREMENT_CAPACITY,
+    MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, TrackFrame, WireMeasurement,
+    FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, MEASUREMENT_CAPACITY,
 };
 use iceoryx2::node::Node;
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
@@ -163,7 +163,12 @@ impl Replayer {
     }
 
     /// Sends one frame with the given `FRAME_FLAG_*` bits; returns its sequence number.
-    pub fn send(&mut self, sequence_name: &str, frame: &RecordedFrame, flags: u32) -> Result<u64, ReplayError> {
+    pub fn send(
+        &mut self,
+        sequence_name: &str,
+        frame: &RecordedFrame,
+        flags: u32,
+    ) -> Result<u64, ReplayError> {
         if frame.measurements.len() > MEASUREMENT_CAPACITY {
             return Err(ReplayError::TooManyMeasurements {
                 sequence: sequence_name.to_owned(),
@@ -223,7 +228,12 @@ impl Replayer {
     }
 
     /// Waits until at most `max` frames are unanswered.
-    fn wait_in_flight(&mut self, max: u64, timeout: Duration, shutdown: &ShutdownFlag) -> Result<(), ReplayError> {
+    fn wait_in_flight(
+        &mut self,
+        max: u64,
+        timeout: Duration,
+        shutdown: &ShutdownFlag,
+    ) -> Result<(), ReplayError> {
         let deadline = Instant::now() + timeout;
         loop {
             self.collect_answers()?;
@@ -232,7 +242,10 @@ impl Replayer {
             }
             let now = Instant::now();
             if now >= deadline {
-                return Err(ReplayError::AnswerTimeout { sequence: self.next_sequence - self.in_flight(), timeout });
+                return Err(ReplayError::AnswerTimeout {
+                    sequence: self.next_sequence - self.in_flight(),
+                    timeout,
+                });
             }
             if let Some((_, listener)) = &self.answers {
                 match listener.timed_wait(|_| {}, (deadline - now).min(Duration::from_millis(20))) {
@@ -244,7 +257,11 @@ impl Replayer {
     }
 
     /// Waits until every frame sent so far is answered (flow control only).
-    pub fn wait_all_answered(&mut self, timeout: Duration, shutdown: &ShutdownFlag) -> Result<(), ReplayError> {
+    pub fn wait_all_answered(
+        &mut self,
+        timeout: Duration,
+        shutdown: &ShutdownFlag,
+    ) -> Result<(), ReplayError> {
         self.wait_in_flight(0, timeout, shutdown)
     }
 
@@ -290,7 +307,8 @@ impl Replayer {
                     let last_of_replay = !options.repeat
                         && sequence_index + 1 == sequences.len()
                         && frame_index + 1 == sequence.frames.len();
-                    let last_of_limit = options.frame_limit.is_some_and(|limit| summary.frames_sent + 1 >= limit);
+                    let last_of_limit =
+                        options.frame_limit.is_some_and(|limit| summary.frames_sent + 1 >= limit);
                     let mut flags = 0;
                     if frame_index == 0 {
                         flags |= FRAME_FLAG_STREAM_START;

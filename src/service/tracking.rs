@@ -21,22 +21,22 @@ use super::clock::monotonic_ns;
 use super::latency::{LatencyHistograms, StageTimer};
 use super::log_limit::LogLimiter;
 use super::shutdown::ShutdownFlag;
-use iceoryx2::identifiers::UniquePublisherId;
 use crate::predictor::DisplacementPredictor;
 use crate::tracker::{StepError, Tracker};
 use crate::validation::FrameError;
 use crate::wire::{
     FrameStatus, LatencyReport, LatencyStage, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
-    TrackFrameWriter, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, STAGE_CAPACITY, TRACK_FLAG_SEQUENCE_GAP,
-    TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
+    TrackFrameWriter, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, STAGE_CAPACITY,
+    TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
 };
+use iceoryx2::identifiers::UniquePublisherId;
 use iceoryx2::node::Node;
 use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::ReceiveError;
 use iceoryx2::port::update_connections::ConnectionFailure;
+use iceoryx2::port::ReceiveError;
 use iceoryx2::sample::Sample;
 use std::time::{Duration, Instant};
 
@@ -208,7 +208,8 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             },
             None => {
                 let deadline = Instant::now() + timeout;
-                while !self.input.has_samples().map_err(TrackingLoopError::Poll)? && Instant::now() < deadline {
+                while !self.input.has_samples().map_err(TrackingLoopError::Poll)? && Instant::now() < deadline
+                {
                     std::hint::spin_loop();
                 }
             }
@@ -287,7 +288,8 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         };
         let stats = self.tracker.stats();
         let accepted = stats.measurements_accepted - stats_before.measurements_accepted;
-        let rejected = (stats.measurements_rejected_unknown_class + stats.measurements_rejected_non_finite
+        let rejected = (stats.measurements_rejected_unknown_class
+            + stats.measurements_rejected_non_finite
             + stats.measurements_rejected_out_of_range)
             - (stats_before.measurements_rejected_unknown_class
                 + stats_before.measurements_rejected_non_finite
@@ -376,7 +378,12 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 self.counters.frames_lost += lost;
                 flags |= TRACK_FLAG_SEQUENCE_GAP;
                 if self.logs.lost.occur() {
-                    tracing::warn!(lost, after = last, occurrences = self.logs.lost.occurrences(), "measurement frames lost");
+                    tracing::warn!(
+                        lost,
+                        after = last,
+                        occurrences = self.logs.lost.occurrences(),
+                        "measurement frames lost"
+                    );
                 }
             }
         }

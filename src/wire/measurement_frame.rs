@@ -219,8 +219,11 @@ impl<'a> MeasurementFrameWriter<'a> {
     pub fn finish(self, header: &MeasurementFrameHeader) -> usize {
         let frame = self.frame.as_mut_ptr();
         let (ego_x_m, ego_y_m, ego_yaw_rad) = header.ego.unwrap_or((0.0, 0.0, 0.0));
-        let flags =
-            if header.ego.is_some() { header.flags | FRAME_FLAG_EGO_VALID } else { header.flags & !FRAME_FLAG_EGO_VALID };
+        let flags = if header.ego.is_some() {
+            header.flags | FRAME_FLAG_EGO_VALID
+        } else {
+            header.flags & !FRAME_FLAG_EGO_VALID
+        };
         // SAFETY: as in `push`: raw field pointers into a live, aligned allocation.
         unsafe {
             addr_of_mut!((*frame).sequence).write(header.sequence);

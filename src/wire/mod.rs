@@ -22,8 +22,9 @@ mod track_frame;
 
 pub use latency_report::{LatencyReport, LatencyStage, StageLatency, STAGE_CAPACITY, STAGE_NAME_LEN};
 pub use measurement_frame::{
-    FrameFull, MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, WireMeasurement, FRAME_FLAG_EGO_VALID,
-    FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, GROUND_TRUTH_UNKNOWN, MEASUREMENT_CAPACITY, SENSOR_UNKNOWN,
+    FrameFull, MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, WireMeasurement,
+    FRAME_FLAG_EGO_VALID, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, GROUND_TRUTH_UNKNOWN,
+    MEASUREMENT_CAPACITY, SENSOR_UNKNOWN,
 };
 pub use track_frame::{
     FrameStatus, TrackFrame, TrackFrameHeader, TrackFrameWriter, WireTrack, MEASUREMENT_INDEX_NONE,

@@ -67,10 +67,16 @@ impl FrameStatus {
     /// The status reporting a failed step.
     pub fn of_error(error: &StepError) -> Self {
         match error {
-            StepError::InvalidFrame(FrameError::NonFiniteTimestamp { .. }) => Self::RejectedNonFiniteTimestamp,
-            StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. }) => Self::RejectedTimestampNotIncreasing,
+            StepError::InvalidFrame(FrameError::NonFiniteTimestamp { .. }) => {
+                Self::RejectedNonFiniteTimestamp
+            }
+            StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. }) => {
+                Self::RejectedTimestampNotIncreasing
+            }
             StepError::InvalidFrame(FrameError::IntervalTooLong { .. }) => Self::RejectedIntervalTooLong,
-            StepError::InvalidFrame(FrameError::TooManyMeasurements { .. }) => Self::RejectedTooManyMeasurements,
+            StepError::InvalidFrame(FrameError::TooManyMeasurements { .. }) => {
+                Self::RejectedTooManyMeasurements
+            }
             StepError::Association(_) => Self::AssociationFailed,
         }
     }
@@ -143,7 +149,12 @@ impl WireTrack {
             id: output.id,
             x_m: output.position_m.x,
             y_m: output.position_m.y,
-            covariance_m2: [covariance.x_axis.x, covariance.y_axis.x, covariance.x_axis.y, covariance.y_axis.y],
+            covariance_m2: [
+                covariance.x_axis.x,
+                covariance.y_axis.x,
+                covariance.x_axis.y,
+                covariance.y_axis.y,
+            ],
             vx_mps: output.velocity_mps.x,
             vy_mps: output.velocity_mps.y,
             prior_x_m: prior.map_or(0.0, |p| p.x),
@@ -274,7 +285,10 @@ impl<'a> TrackFrameWriter<'a> {
         // SAFETY: `frame` points to a live, aligned `TrackFrame` allocation and
         // `self.count < TRACK_CAPACITY`; only raw pointers are formed.
         unsafe {
-            addr_of_mut!((*frame).tracks).cast::<WireTrack>().add(self.count).write(WireTrack::from_output(output));
+            addr_of_mut!((*frame).tracks)
+                .cast::<WireTrack>()
+                .add(self.count)
+                .write(WireTrack::from_output(output));
         }
         self.count += 1;
     }

@@ -52,7 +52,13 @@ pub fn radial_velocity(position: [f64; 2], velocity: [f64; 2]) -> f64 {
 
 /// True planar motion sampled at irregular times: straight, then a constant-rate turn, then
 /// straight again. Returns (t, position, velocity, turn rate) per step.
-pub fn straight_turn_straight(dt: &[f64], speed: f64, turn_start_s: f64, turn_end_s: f64, turn_rate: f64) -> Vec<(f64, [f64; 2], [f64; 2], f64)> {
+pub fn straight_turn_straight(
+    dt: &[f64],
+    speed: f64,
+    turn_start_s: f64,
+    turn_end_s: f64,
+    turn_rate: f64,
+) -> Vec<(f64, [f64; 2], [f64; 2], f64)> {
     let mut t = 0.0;
     let (mut x, mut y, mut heading) = (10.0, -20.0, 0.3_f64);
     let mut out = Vec::with_capacity(dt.len() + 1);
@@ -95,7 +101,13 @@ impl SceneObject {
 }
 
 /// Frames of a scene at a fixed interval, with Gaussian position noise of `noise_std` m.
-pub fn scene_frames(objects: &[SceneObject], frames: usize, dt: f64, noise_std: f64, seed: u64) -> Vec<Frame> {
+pub fn scene_frames(
+    objects: &[SceneObject],
+    frames: usize,
+    dt: f64,
+    noise_std: f64,
+    seed: u64,
+) -> Vec<Frame> {
     let mut rng = rng(seed);
     (0..frames)
         .map(|k| {
@@ -106,7 +118,8 @@ pub fn scene_frames(objects: &[SceneObject], frames: usize, dt: f64, noise_std: 
                 frame.measurements.push(Measurement {
                     x_m: p[0] + standard_normal(&mut rng) * noise_std,
                     y_m: p[1] + standard_normal(&mut rng) * noise_std,
-                    radial_velocity_mps: radial_velocity(p, object.velocity) + standard_normal(&mut rng) * 0.1,
+                    radial_velocity_mps: radial_velocity(p, object.velocity)
+                        + standard_normal(&mut rng) * 0.1,
                     rcs_dbsm: 10.0,
                     class: object.class,
                     sensor_id: Some(0),
@@ -123,7 +136,8 @@ pub fn lanes(count: usize) -> Vec<SceneObject> {
     (0..count)
         .map(|i| {
             let class = if i % 2 == 0 { ObjectClass::Car } else { ObjectClass::Pedestrian };
-            let speed = if class == ObjectClass::Car { 8.0 + (i % 5) as f64 } else { 1.2 + 0.1 * (i % 4) as f64 };
+            let speed =
+                if class == ObjectClass::Car { 8.0 + (i % 5) as f64 } else { 1.2 + 0.1 * (i % 4) as f64 };
             SceneObject {
                 id: i as u64 + 1,
                 class,
@@ -144,7 +158,11 @@ pub struct LaneOracle {
 impl primm::predictor::DisplacementPredictor for LaneOracle {
     fn submit(&mut self, _requests: &[primm::predictor::PredictionRequest]) {}
     fn collect(&mut self, _displacements: &mut [Option<glam::DVec2>]) {}
-    fn predict(&mut self, requests: &[primm::predictor::PredictionRequest], displacements: &mut [Option<glam::DVec2>]) {
+    fn predict(
+        &mut self,
+        requests: &[primm::predictor::PredictionRequest],
+        displacements: &mut [Option<glam::DVec2>],
+    ) {
         for (request, out) in requests.iter().zip(displacements.iter_mut()) {
             let step = -f64::from(request.features[request.len - 1][4]);
             let t = request.prediction_time_s - step;

@@ -2,17 +2,17 @@
 //! publisher with its answer subscriber, and child processes that die with the test.
 #![allow(dead_code)]
 
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
 use primm::measurement::Frame;
 use primm::service::catalog::{self, Ipc, ServiceNames};
 use primm::service::clock::monotonic_ns;
 use primm::wire::{
     MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, TrackFrame, WireMeasurement,
 };
-use iceoryx2::node::Node;
-use iceoryx2::port::listener::Listener;
-use iceoryx2::port::notifier::Notifier;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -22,7 +22,12 @@ pub fn unique_prefix(test: &str) -> String {
 }
 
 /// Writes an owned frame into a loaned sample's payload.
-pub fn write_frame(slot: &mut std::mem::MaybeUninit<MeasurementFrame>, frame: &Frame, sequence: u64, flags: u32) {
+pub fn write_frame(
+    slot: &mut std::mem::MaybeUninit<MeasurementFrame>,
+    frame: &Frame,
+    sequence: u64,
+    flags: u32,
+) {
     let mut writer = MeasurementFrameWriter::new(slot);
     for measurement in &frame.measurements {
         writer.push(WireMeasurement::new(measurement, None)).unwrap();
@@ -41,7 +46,8 @@ pub fn write_frame(slot: &mut std::mem::MaybeUninit<MeasurementFrame>, frame: &F
 pub fn wire_frame(frame: &Frame, sequence: u64) -> Box<MeasurementFrame> {
     let mut boxed = MeasurementFrame::boxed_zeroed();
     // SAFETY: a `Box<MeasurementFrame>` is a valid `MaybeUninit<MeasurementFrame>` location.
-    let slot = unsafe { &mut *(std::ptr::addr_of_mut!(*boxed).cast::<std::mem::MaybeUninit<MeasurementFrame>>()) };
+    let slot =
+        unsafe { &mut *(std::ptr::addr_of_mut!(*boxed).cast::<std::mem::MaybeUninit<MeasurementFrame>>()) };
     write_frame(slot, frame, sequence, 0);
     boxed
 }
@@ -107,7 +113,11 @@ impl TestClient {
 
     /// [`next_answer`](Self::next_answer) spinning on the subscriber instead of sleeping on
     /// the event service (for busy-poll latency measurements).
-    pub fn next_answer_spinning<R>(&self, timeout: Duration, read: impl FnOnce(&TrackFrame) -> R) -> Option<R> {
+    pub fn next_answer_spinning<R>(
+        &self,
+        timeout: Duration,
+        read: impl FnOnce(&TrackFrame) -> R,
+    ) -> Option<R> {
         let deadline = Instant::now() + timeout;
         loop {
             if let Some(sample) = self.answers.receive().unwrap() {
