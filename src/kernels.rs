@@ -2,9 +2,9 @@
 //! fusion, Kalman and mode-probability updates).
 //!
 //! Each loop is compiled twice, for baseline x86-64 and for x86-64 with AVX, AVX2 and FMA, and
-//! the version the CPU supports is chosen once, on the first call ([`multiversion`]). The
-//! released binary therefore runs on any x86-64 and still uses the wider registers where they
-//! exist. Both versions compute bit-identical results: Rust never contracts a multiply and an
+//! the version the CPU supports is chosen once, on the first call (the
+//! [`multiversion`](mod@multiversion) crate). The released binary therefore runs on any x86-64
+//! and still uses the wider registers where they exist. Both versions compute bit-identical results: Rust never contracts a multiply and an
 //! add into a fused multiply-add on its own, so the extra instructions change how values move
 //! between registers, not what is computed. Other architectures get the baseline loop.
 
