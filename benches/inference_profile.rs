@@ -74,6 +74,16 @@ fn main() -> TractResult<()> {
     for (op, (d, n)) in ops.iter().take(15) {
         println!("  {:>8.1}  {:>3}  {}", d.as_secs_f64() * 1e6, n, op);
     }
+    let start = Instant::now();
+    for _ in 0..runs {
+        state.run(inputs.clone())?;
+    }
+    let plain_time = start.elapsed() / runs;
+    println!(
+        "the same plan without the profiler: {:.1} us per run ({:.2} us/sample)",
+        plain_time.as_secs_f64() * 1e6,
+        plain_time.as_secs_f64() * 1e6 / batch as f64
+    );
     let fixed = load(&path, Some(batch))?;
     let mut fixed_state = fixed.spawn()?;
     let start = Instant::now();

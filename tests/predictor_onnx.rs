@@ -86,6 +86,35 @@ fn each_sample_gets_the_same_output_alone_as_in_a_batch_and_padded_rows_are_igno
 }
 
 #[test]
+fn batches_of_any_size_run_in_planned_chunks_and_every_row_gets_its_own_output() {
+    let parity = parity();
+    let mut model = model();
+    let (features, valid) = flatten(&parity.features, &parity.valid);
+    let mut reference = vec![0.0f32; 2 * parity.features.len()];
+    model.run(&features, &valid, &mut reference).unwrap();
+    let samples = parity.features.len();
+    // Sizes on, between and above the planned ones: padded remainders, several full chunks.
+    for batch in [1, 3, 9, 33, 57, 63, 64, 65, 100, 129, 200] {
+        // Sample `(i * 7) % samples` in row `i`: neighbouring rows differ from the fixture's order.
+        let pick = |i: usize| (i * 7) % samples;
+        let mut batch_features = Vec::with_capacity(batch * MAX_HISTORY * FEATURES);
+        let mut batch_valid = Vec::with_capacity(batch * MAX_HISTORY);
+        for i in 0..batch {
+            batch_features.extend_from_slice(parity.features[pick(i)].as_flattened());
+            batch_valid.extend_from_slice(&parity.valid[pick(i)]);
+        }
+        let mut out = vec![f32::NAN; 2 * batch];
+        model.run(&batch_features, &batch_valid, &mut out).unwrap();
+        for i in 0..batch {
+            for axis in 0..2 {
+                let (got, want) = (out[2 * i + axis], reference[2 * pick(i) + axis]);
+                assert!((got - want).abs() <= 1e-5, "batch {batch} row {i} axis {axis}: {got} vs {want}");
+            }
+        }
+    }
+}
+
+#[test]
 fn the_valid_rows_matter() {
     // Changing a valid row changes the prediction (the model reads its input).
     let parity = parity();

@@ -18,12 +18,18 @@ with ``cargo bench --bench inference_profile`` (``benches/results/pr_inference.m
   sums (already broadcast to every column), one ``Div``. No row maximum is subtracted while the
   weight-derived score bound (``model.score_bound``) stays below ``SCORE_BOUND_WITHOUT_MAX``;
   above it the graph subtracts each row's maximum.
-* Normalisation, embedding, LayerNorms (``LayerNormalization``, opset 17), feed-forward blocks,
-  residuals and the two heads as in the trained model; the last layer computes only the two
-  query tokens.
+* **Normalisations folded into weights** (``fold_normalisations``): each LayerNorm's scale and
+  shift move into the linear layers that read it (queries, keys and values; the first
+  feed-forward layer; the two output heads), and the input normalisation moves into the
+  embedding and the token table. The graph's LayerNorms (``LayerNormalization``, opset 17) only
+  normalise, which tract plans without the element-wise scale and shift, and the inputs go
+  straight into the embedding product.
+* Embedding, feed-forward blocks, residuals and the two heads as in the trained model; the last
+  layer computes only the two query tokens.
 
-``weights_from_onnx`` reads the weights back from an exported file of either graph form, so a
-model can be re-exported without retraining; ``reference_forward`` is the plain NumPy forward
+``weights_from_onnx`` reads the weights back from an exported file of either graph form (from
+this one, in their folded but equivalent form), so a model can be re-exported without
+retraining; ``reference_forward`` is the plain NumPy forward
 pass of the trained model (the check for both).
 """
 
@@ -40,7 +46,8 @@ SCORE_BOUND_WITHOUT_MAX = 60.0
 EXPORTER = "training/onnx_graph.py build_graph (onnx.helper, node by node)"
 GRAPH_DESCRIPTION = (
     "heads as reshaped rows of one product (no transposes), key mask multiplied after exp, "
-    "softmax as exp / (exp @ ones); see training/onnx_graph.py"
+    "softmax as exp / (exp @ ones), LayerNorm affines and input normalisation folded into the "
+    "following linear layers; see training/onnx_graph.py"
 )
 INPUT_NAMES = ["features", "valid"]
 OUTPUT_NAMES = ["displacement"]
@@ -48,6 +55,36 @@ OUTPUT_NAMES = ["displacement"]
 
 def layer_count(weights: dict) -> int:
     return len({key.split(".")[1] for key in weights if key.startswith("layers.")})
+
+
+def fold_normalisations(weights: dict) -> dict:
+    """The same function with fewer element-wise steps: every LayerNorm's scale ``g`` and shift
+    ``b`` folded into the linear layers that read the normalised tokens (``W x + c`` of
+    ``g * n + b`` is ``(W * g) n + (W b + c)``), and the input normalisation ``(x - mean) *
+    inv_std`` folded into the embedding and the history rows of the token table (the two query
+    rows are zero after normalisation, so theirs stay). In float64, and idempotent: folding
+    folded weights changes nothing."""
+    w = {k: np.asarray(v, np.float64).copy() for k, v in weights.items()}
+
+    def fold(norm, readers):
+        scale, shift = w[norm + ".weight"], w[norm + ".bias"]
+        for reader in readers:
+            matrix = w[reader + ".weight"]  # [out, in]
+            w[reader + ".bias"] = w[reader + ".bias"] + matrix @ shift
+            w[reader + ".weight"] = matrix * scale[None, :]
+        w[norm + ".weight"], w[norm + ".bias"] = np.ones_like(scale), np.zeros_like(shift)
+
+    for index in range(layer_count(weights)):
+        p = f"layers.{index}"
+        fold(f"{p}.norm_attention", [f"{p}.attention.query", f"{p}.attention.key", f"{p}.attention.value"])
+        fold(f"{p}.norm_ff", [f"{p}.ff_in"])
+    fold("final_norm", ["head_x", "head_y"])
+    mean, inv_std = w["feature_mean"], w["feature_inv_std"]
+    embedding = w["embedding.weight"]  # [d, features]
+    w["token_table"][:MAX_HISTORY] -= embedding @ (mean * inv_std)
+    w["embedding.weight"] = embedding * inv_std[None, :]
+    w["feature_mean"], w["feature_inv_std"] = np.zeros_like(mean), np.ones_like(inv_std)
+    return w
 
 
 def reference_forward(weights: dict, features: np.ndarray, valid: np.ndarray, heads: int) -> np.ndarray:
@@ -103,14 +140,18 @@ class GraphBuilder:
     an encoder layer, the output heads and the finished, checked model."""
 
     def __init__(self, weights: dict):
-        self.w = {k: np.asarray(v, np.float32) for k, v in weights.items()}
+        # float64 while the graph is built; initializers are written as float32 (``const``).
+        self.w = {k: np.asarray(v, np.float64) for k, v in weights.items()}
         self.d = self.w["token_table"].shape[1]
         self.nodes, self.initializers = [], []
 
     def const(self, name, value):
         from onnx import numpy_helper
 
-        self.initializers.append(numpy_helper.from_array(np.asarray(value), name))
+        value = np.asarray(value)
+        if value.dtype == np.float64:
+            value = value.astype(np.float32)
+        self.initializers.append(numpy_helper.from_array(value, name))
         return name
 
     def node(self, op, inputs, name, **attributes):
@@ -130,10 +171,13 @@ class GraphBuilder:
         return self.node("Add", [product, self.const(prefix + ".bias_row", bias)], out)
 
     def embedded_tokens(self):
-        """Normalisation, two zero query rows, embedding plus the token table: ``[B, 7, d]``."""
+        """Normalisation (none once folded), two zero query rows, embedding plus the token
+        table: ``[B, 7, d]``."""
         w, node, const = self.w, self.node, self.const
-        x = node("Sub", ["features", const("feature_mean", w["feature_mean"])], "centred")
-        x = node("Mul", [x, const("feature_inv_std", w["feature_inv_std"])], "normalised")
+        x = "features"
+        if np.any(w["feature_mean"] != 0.0) or np.any(w["feature_inv_std"] != 1.0):
+            x = node("Sub", [x, const("feature_mean", w["feature_mean"])], "centred")
+            x = node("Mul", [x, const("feature_inv_std", w["feature_inv_std"])], "normalised")
         x = node("Pad", [x, const("token_pad", np.array([0, 0, 0, 0, QUERIES, 0], np.int64))], "padded")
         x = node("MatMul", [x, const("embedding.weight_t", np.ascontiguousarray(w["embedding.weight"].T))], "embedded")
         return node("Add", [x, const("token_table", w["token_table"])], "tokens_0")
@@ -190,10 +234,10 @@ class GraphBuilder:
 
 def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str = ""):
     """The ONNX model (opset 17, symbolic batch axis ``batch``) of the trained ``weights``."""
-    g = GraphBuilder(weights)
+    g = GraphBuilder(fold_normalisations(weights))
     w, d, node, const = g.w, g.d, g.node, g.const
     dh = d // heads
-    scale = np.float32(1.0 / np.sqrt(dh))
+    scale = 1.0 / np.sqrt(dh)
 
     tokens = g.embedded_tokens()
     # Key weights: [B, 1, 7].
@@ -251,7 +295,11 @@ def weights_from_onnx(path: str, heads: int) -> dict:
 
 
 def _weights_from_this_graph(init: dict, heads: int) -> dict:
-    w = {name: init[name] for name in ["feature_mean", "feature_inv_std", "output_scale", "token_table", "final_norm.weight", "final_norm.bias"]}
+    w = {name: init[name] for name in ["output_scale", "token_table", "final_norm.weight", "final_norm.bias"]}
+    # A graph with the input normalisation folded into the embedding has no normalisation nodes.
+    features = init["embedding.weight_t"].shape[0]
+    w["feature_mean"] = init.get("feature_mean", np.zeros(features, np.float32))
+    w["feature_inv_std"] = init.get("feature_inv_std", np.ones(features, np.float32))
     w["embedding.weight"] = init["embedding.weight_t"].T
     d = w["token_table"].shape[1]
     dh = d // heads
@@ -265,6 +313,9 @@ def _weights_from_this_graph(init: dict, heads: int) -> dict:
             w[f"{p}.{name}.weight"], w[f"{p}.{name}.bias"] = init[f"{p}.{name}.weight_t"].T, init[f"{p}.{name}.bias_row"]
         stacked = init[f"{p}.attention.query_heads.weight_t"]  # [d, H*d], head h's block keeps its channels
         stacked_b = init[f"{p}.attention.query_heads.bias_row"]
+        # In float64, so that writing the graph again (times the scale, rounded to float32)
+        # gives back the same float32 values.
+        stacked, stacked_b = stacked.astype(np.float64), stacked_b.astype(np.float64)
         w[f"{p}.attention.query.weight"] = (sum(stacked[:, h * d : (h + 1) * d] for h in range(heads)) / scale).T
         w[f"{p}.attention.query.bias"] = sum(stacked_b[h * d : (h + 1) * d] for h in range(heads)) / scale
         stacked_o = init[f"{p}.attention.output.weight_t"]  # [H*d, d]

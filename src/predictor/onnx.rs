@@ -1,7 +1,11 @@
 //! The PR model (paper, Section III-C) executed with tract from its ONNX file.
 //!
-//! [`PrModel`] loads, checks and optimises the model once, with a symbolic batch dimension, and
-//! then runs batches of any size. [`OnnxPredictor`] is a synchronous
+//! [`PrModel`] loads and checks the model with a symbolic batch dimension, then optimises one
+//! plan per batch size of [`PLAN_BATCH_SIZES`] and runs batches of any size through them: full
+//! chunks of the largest size, the rest padded up to the next planned size. tract runs a plan
+//! whose batch is a constant about 30 % faster than the same graph with a symbolic batch (its
+//! shapes, loop bounds and packing are then fixed when the plan is made), more than padding to
+//! the next size costs (`BENCHMARKS.md`). [`OnnxPredictor`] is a synchronous
 //! [`DisplacementPredictor`] on top of it: `submit` runs the batch at once, `collect` hands the
 //! results out. It is deterministic (no clock, no thread), which is what offline tracking and
 //! evaluation want; [`ThreadedPredictor`](super::threaded::ThreadedPredictor) moves it onto an
@@ -94,8 +98,8 @@ pub enum ModelError {
         /// The declared or inferred type and shape.
         found: String,
     },
-    /// tract could not type, optimise or plan the graph for a symbolic batch, or a trial run
-    /// with one sample failed.
+    /// tract could not type the graph for a symbolic batch or optimise and plan it for the sizes
+    /// of [`PLAN_BATCH_SIZES`], or a trial run with one sample failed.
     #[error("PR model {path}: cannot be prepared for inference: {reason}")]
     Preparation {
         /// The model file.
@@ -110,26 +114,44 @@ pub enum ModelError {
 #[error("PR inference failed: {0}")]
 pub struct InferenceError(pub String);
 
-/// The loaded, optimised PR model with its execution state.
-pub struct PrModel {
-    path: PathBuf,
+/// The batch sizes [`PrModel`] plans for, ascending. A batch runs as chunks of the largest size,
+/// and the rest is padded with empty rows up to the next size on this list: at most 7 padded
+/// rows above 8, whose cost (~14 µs each at batch 64) stays below the ~30 % a fixed-size plan
+/// saves.
+pub const PLAN_BATCH_SIZES: [usize; 11] = [1, 2, 4, 8, 16, 24, 32, 40, 48, 56, 64];
+
+/// One optimised plan for a fixed batch size, with its execution state.
+struct BatchPlan {
+    batch: usize,
     plan: Arc<TypedRunnableModel>,
     state: TypedSimpleState,
+}
+
+/// The loaded, optimised PR model: one plan per size of [`PLAN_BATCH_SIZES`].
+pub struct PrModel {
+    path: PathBuf,
+    /// Ascending batch sizes, as [`PLAN_BATCH_SIZES`].
+    plans: Vec<BatchPlan>,
+    /// Inputs of one chunk, padded to its plan's batch size (reused across runs).
+    padded_features: Vec<f32>,
+    padded_valid: Vec<f32>,
 }
 
 impl fmt::Debug for PrModel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("PrModel")
             .field("path", &self.path)
-            .field("nodes", &self.plan.model().nodes().len())
+            .field("batch_sizes", &self.plans.iter().map(|p| p.batch).collect::<Vec<_>>())
+            .field("nodes", &self.plans.last().map(|p| p.plan.model().nodes().len()))
             .finish()
     }
 }
 
 impl PrModel {
     /// Loads `path`, checks its signature against the [model contract](self), binds the batch
-    /// axis to the symbol [`BATCH_SYMBOL`], optimises the graph and plans it, then runs one
-    /// trial sample. All the work of preparing the model happens here, once.
+    /// axis to the symbol [`BATCH_SYMBOL`], then optimises and plans the graph once for each
+    /// size of [`PLAN_BATCH_SIZES`] and runs one trial sample. All the work of preparing the
+    /// model happens here, once.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, ModelError> {
         let path = path.as_ref().to_path_buf();
         match std::fs::metadata(&path) {
@@ -158,9 +180,26 @@ impl PrModel {
         model.set_input_fact(1, f32::fact([batch, MAX_HISTORY.to_dim()]).into()).map_err(prepare)?;
         let typed = model.into_typed().map_err(prepare)?;
         check_output(&path, &typed)?;
-        let plan = typed.into_optimized().map_err(prepare)?.into_runnable().map_err(prepare)?;
-        let state = plan.spawn().map_err(prepare)?;
-        let mut loaded = PrModel { path, plan, state };
+        let symbol = typed.symbols.sym(BATCH_SYMBOL);
+        let mut plans = Vec::with_capacity(PLAN_BATCH_SIZES.len());
+        for batch in PLAN_BATCH_SIZES {
+            let values = std::collections::HashMap::from([(symbol.clone(), (batch as i64).to_dim())]);
+            let plan = typed
+                .clone()
+                .set_symbols(&values)
+                .and_then(|fixed| fixed.into_optimized())
+                .and_then(|optimized| optimized.into_runnable())
+                .map_err(prepare)?;
+            let state = plan.spawn().map_err(prepare)?;
+            plans.push(BatchPlan { batch, plan, state });
+        }
+        let largest = PLAN_BATCH_SIZES[PLAN_BATCH_SIZES.len() - 1];
+        let mut loaded = PrModel {
+            path,
+            plans,
+            padded_features: Vec::with_capacity(largest * MAX_HISTORY * FEATURES),
+            padded_valid: Vec::with_capacity(largest * MAX_HISTORY),
+        };
         // A trial run: a model that loads but cannot run fails here, at start-up.
         let mut out = [0.0f32; 2];
         let mut features = [0.0f32; MAX_HISTORY * FEATURES];
@@ -202,17 +241,48 @@ impl PrModel {
         if batch == 0 {
             return Ok(());
         }
+        let mut done = 0;
+        while done < batch {
+            let rows = self.run_chunk(
+                &features[done * MAX_HISTORY * FEATURES..],
+                &valid[done * MAX_HISTORY..],
+                &mut displacements[done * 2..],
+            )?;
+            done += rows;
+        }
+        Ok(())
+    }
+
+    /// Runs the first rows of `valid` (at most the largest planned batch) through the smallest
+    /// plan that holds them, padded with empty rows; returns how many rows it ran.
+    fn run_chunk(
+        &mut self,
+        features: &[f32],
+        valid: &[f32],
+        displacements: &mut [f32],
+    ) -> Result<usize, InferenceError> {
+        let remaining = valid.len() / MAX_HISTORY;
+        let index = self.plans.iter().position(|p| p.batch >= remaining).unwrap_or(self.plans.len() - 1);
+        let plan = &mut self.plans[index];
+        let (size, rows) = (plan.batch, remaining.min(plan.batch));
+        self.padded_features.clear();
+        self.padded_features.extend_from_slice(&features[..rows * MAX_HISTORY * FEATURES]);
+        self.padded_features.resize(size * MAX_HISTORY * FEATURES, 0.0);
+        self.padded_valid.clear();
+        self.padded_valid.extend_from_slice(&valid[..rows * MAX_HISTORY]);
+        self.padded_valid.resize(size * MAX_HISTORY, 0.0);
         let error = |e: TractError| InferenceError(format!("{e:#}"));
-        let features = Tensor::from_shape(&[batch, MAX_HISTORY, FEATURES], features).map_err(error)?;
-        let valid = Tensor::from_shape(&[batch, MAX_HISTORY], valid).map_err(error)?;
-        let outputs = self.state.run(tvec!(features.into_tvalue(), valid.into_tvalue())).map_err(error)?;
+        let features =
+            Tensor::from_shape(&[size, MAX_HISTORY, FEATURES], &self.padded_features).map_err(error)?;
+        let valid = Tensor::from_shape(&[size, MAX_HISTORY], &self.padded_valid).map_err(error)?;
+        let outputs = plan.state.run(tvec!(features.into_tvalue(), valid.into_tvalue())).map_err(error)?;
         let output = outputs.first().ok_or_else(|| InferenceError("the model returned no output".into()))?;
-        if output.shape() != [batch, 2] {
-            return Err(InferenceError(format!("output shape {:?}, expected [{batch}, 2]", output.shape())));
+        if output.shape() != [size, 2] {
+            return Err(InferenceError(format!("output shape {:?}, expected [{size}, 2]", output.shape())));
         }
         let view = output.try_as_plain_ram().map_err(error)?;
-        displacements.copy_from_slice(view.as_slice::<f32>().map_err(error)?);
-        Ok(())
+        displacements[..rows * 2].copy_from_slice(&view.as_slice::<f32>().map_err(error)?[..rows * 2]);
+        Ok(rows)
     }
 }
 
