@@ -1,7 +1,8 @@
-//! Per-node profile of the PR model in tract: the optimised plan is run through
-//! `run_plan_with_eval`, timing every node's evaluation (the method of the `tract` command
-//! line's `--profile`), summed per operator type and listed per node; then the same model
-//! optimised for a fixed batch size, for comparison.
+//! Per-node profile of the PR model in tract: the plan primm runs for a batch of this size (the
+//! batch fixed when the plan is made, as `PrModel` does) is run through `run_plan_with_eval`,
+//! timing every node's evaluation (the method of the `tract` command line's `--profile`), summed
+//! per operator type and listed per node; then the same plan without the profiler, and the
+//! graph planned for a symbolic batch, for comparison.
 //!
 //! `cargo bench --bench inference_profile [-- MODEL [BATCH]]` (defaults: models/pr.onnx, 64).
 //! Nothing is asserted; the output is for reading (`benches/results/pr_profile.txt`).
@@ -10,7 +11,7 @@ use std::collections::HashMap;
 use std::time::{Duration, Instant};
 use tract_onnx::prelude::*;
 
-/// The plan as primm's runtime builds it (symbolic batch), or with the batch fixed to `batch`.
+/// The plan with the batch fixed to `batch` (as primm's runtime builds it), or symbolic.
 fn load(path: &str, batch: Option<usize>) -> TractResult<std::sync::Arc<TypedSimplePlan>> {
     let mut model = tract_onnx::onnx().model_for_path(path)?;
     let b = model.symbols.sym("batch").to_dim();
@@ -34,7 +35,7 @@ fn main() -> TractResult<()> {
         .cloned()
         .unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/models/pr.onnx").into());
     let batch: usize = positional.get(1).map(|s| s.parse().expect("a batch size")).unwrap_or(64);
-    let plan = load(&path, None)?;
+    let plan = load(&path, Some(batch))?;
     let mut state = plan.spawn()?;
     let f = Tensor::zero::<f32>(&[batch, 5, 5])?;
     let v = Tensor::from_shape(&[batch, 5], &vec![1.0f32; batch * 5])?;
@@ -84,17 +85,17 @@ fn main() -> TractResult<()> {
         plain_time.as_secs_f64() * 1e6,
         plain_time.as_secs_f64() * 1e6 / batch as f64
     );
-    let fixed = load(&path, Some(batch))?;
-    let mut fixed_state = fixed.spawn()?;
+    let symbolic = load(&path, None)?;
+    let mut symbolic_state = symbolic.spawn()?;
     let start = Instant::now();
     for _ in 0..runs {
-        fixed_state.run(inputs.clone())?;
+        symbolic_state.run(inputs.clone())?;
     }
-    let fixed_time = start.elapsed() / runs;
+    let symbolic_time = start.elapsed() / runs;
     println!(
-        "the same model optimised for a fixed batch of {batch}: {:.1} us per run ({:.2} us/sample)",
-        fixed_time.as_secs_f64() * 1e6,
-        fixed_time.as_secs_f64() * 1e6 / batch as f64
+        "the same model planned for a symbolic batch: {:.1} us per run ({:.2} us/sample)",
+        symbolic_time.as_secs_f64() * 1e6,
+        symbolic_time.as_secs_f64() * 1e6 / batch as f64
     );
     println!("top nodes (us per run, op, ONNX name, output shape):");
     for (id, d) in rows.iter().take(20) {

@@ -3,9 +3,9 @@
 //! [`PrModel`] loads and checks the model with a symbolic batch dimension, then optimises one
 //! plan per batch size of [`PLAN_BATCH_SIZES`] and runs batches of any size through them: full
 //! chunks of the largest size, the rest padded up to the next planned size. tract runs a plan
-//! whose batch is a constant about 30 % faster than the same graph with a symbolic batch (its
-//! shapes, loop bounds and packing are then fixed when the plan is made), more than padding to
-//! the next size costs (`BENCHMARKS.md`). [`OnnxPredictor`] is a synchronous
+//! whose batch is a constant in about a quarter less time than the same graph with a symbolic
+//! batch (it then fuses more operations into the matrix products and fixes shapes and packing
+//! when the plan is made), which is more than padding to the next size costs (`BENCHMARKS.md`). [`OnnxPredictor`] is a synchronous
 //! [`DisplacementPredictor`] on top of it: `submit` runs the batch at once, `collect` hands the
 //! results out. It is deterministic (no clock, no thread), which is what offline tracking and
 //! evaluation want; [`ThreadedPredictor`](super::threaded::ThreadedPredictor) moves it onto an
@@ -116,8 +116,8 @@ pub struct InferenceError(pub String);
 
 /// The batch sizes [`PrModel`] plans for, ascending. A batch runs as chunks of the largest size,
 /// and the rest is padded with empty rows up to the next size on this list: at most 7 padded
-/// rows above 8, whose cost (~14 µs each at batch 64) stays below the ~30 % a fixed-size plan
-/// saves.
+/// rows above 8, whose cost (~14 µs each) stays below what a fixed-size plan saves (about a
+/// quarter of the run).
 pub const PLAN_BATCH_SIZES: [usize; 11] = [1, 2, 4, 8, 16, 24, 32, 40, 48, 56, 64];
 
 /// One optimised plan for a fixed batch size, with its execution state.
