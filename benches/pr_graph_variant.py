@@ -1,20 +1,26 @@
 #!/usr/bin/env python3
-"""An alternative PR graph for tract: attention without per-sample matrix products.
+"""Alternative PR graphs for tract, to compare with the shipped form.
 
-The shipped graph (``training/onnx_graph.py``) computes each sample's attention with small
+``batch-folded`` (the default): attention without per-sample matrix products. The shipped graph (``training/onnx_graph.py``) computes each sample's attention with small
 batched products (``[28x32]@[32x7]`` and ``[28x7]@[7x32]`` per sample), which tract packs one by
 one. This variant folds the batch into the products instead: keys and values are laid out key
 first (``[7, B, d]``), repeated over the query rows with ``Expand``, multiplied element-wise with
 the queries, and summed per head by one ``[7*B*Tq, d] @ [d, H]`` product; the softmax runs over the
 leading key axis (``ReduceSum``), and the value mix is an element-wise product summed over that
-axis. Same weights, same function (parity printed against ``models/pr_parity.json``).
+axis.
 
-    python3 benches/pr_graph_variant.py /tmp/pr_batch_folded.onnx
+``transposed-heads``: the textbook layout. Queries, keys and values reshaped to
+``[B, T, H, d/H]`` and transposed to one ``[T, d/H]`` block per head, so the attention products
+do a quarter of the shipped form's arithmetic (no zeroed channels), at the price of four
+transposes per layer.
+
+Same weights and function as the shipped model (parity printed against ``models/pr_parity.json``).
+
+    python3 benches/pr_graph_variant.py /tmp/pr_batch_folded.onnx [batch-folded|transposed-heads]
     cargo bench --bench inference_profile -- /tmp/pr_batch_folded.onnx 64
 
 Needs numpy, onnx and onnxruntime (``training/requirements.txt``). BENCHMARKS.md section 1
-has the result: slower in tract, because its broadcasting element-wise operators cost far more
-per element than the products they replace.
+has the results: both are slower in tract than the shipped form.
 """
 
 import json
@@ -72,10 +78,44 @@ def build(weights, heads):
     return g.model(tokens)
 
 
+def build_transposed_heads(weights, heads):
+    """The textbook multi-head layout: one ``[T, d/H]`` block per head, reached by transposes."""
+    g = og.GraphBuilder(og.fold_normalisations(weights))
+    w, d, node, const = g.w, g.d, g.node, g.const
+    dh = d // heads
+    scale = 1.0 / np.sqrt(dh)
+    tokens = g.embedded_tokens()
+    axes = const("axes_12", np.array([1, 2], np.int64))
+    key_valid = node("Unsqueeze", [g.key_valid_rows(), axes], "key_valid")  # [B, 1, 1, 7]
+    ones = const("ones_7x7", np.ones((TOKENS, TOKENS), np.float32))
+    layers = og.layer_count(weights)
+    for index in range(layers):
+        p = f"layers.{index}"
+        normed = g.layer_norm(tokens, f"{p}.norm_attention", f"{p}.normed")
+        queries, tokens = g.query_rows(normed, tokens, p) if index == layers - 1 else (normed, tokens)
+        q = g.linear(queries, f"{p}.attention.query", f"{p}.q", w[f"{p}.attention.query.weight"].T * scale, w[f"{p}.attention.query.bias"] * scale)
+        head_shape = const(f"{p}.head_shape", np.array([0, -1, heads, dh], np.int64))  # [B, T, H, d/H]
+        q = node("Transpose", [node("Reshape", [q, head_shape], f"{p}.q4")], f"{p}.qh", perm=[0, 2, 1, 3])
+        k = g.linear(normed, f"{p}.attention.key", f"{p}.k")
+        k = node("Transpose", [node("Reshape", [k, head_shape], f"{p}.k4")], f"{p}.kh", perm=[0, 2, 3, 1])
+        v = g.linear(normed, f"{p}.attention.value", f"{p}.v")
+        v = node("Transpose", [node("Reshape", [v, head_shape], f"{p}.v4")], f"{p}.vh", perm=[0, 2, 1, 3])
+        e = node("Mul", [node("Exp", [node("MatMul", [q, k], f"{p}.scores")], f"{p}.exp"), key_valid], f"{p}.exp_masked")
+        attention = node("Div", [e, node("MatMul", [e, ones], f"{p}.row_sums")], f"{p}.weights")
+        mixed = node("Transpose", [node("MatMul", [attention, v], f"{p}.mixed")], f"{p}.mixed_t", perm=[0, 2, 1, 3])
+        mixed = node("Reshape", [mixed, const(f"{p}.mixed_shape", np.array([0, -1, d], np.int64))], f"{p}.mixed_tokens")
+        tokens = g.feed_forward(tokens, g.linear(mixed, f"{p}.attention.output", f"{p}.attended"), p)
+    return g.model(tokens)
+
+
 def main() -> int:
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path("/tmp/pr_batch_folded.onnx")
+    form = sys.argv[2] if len(sys.argv) > 2 else "batch-folded"
+    builders = {"batch-folded": build, "transposed-heads": build_transposed_heads}
+    if form not in builders:
+        raise SystemExit(f"unknown form {form!r}: one of {', '.join(builders)}")
     weights = og.weights_from_onnx(str(ROOT / "models" / "pr.onnx"), 4)
-    model = build(weights, 4)
+    model = builders[form](weights, 4)
     onnx.save(model, out)
     parity = json.loads((ROOT / "models" / "pr_parity.json").read_text())
     import onnxruntime as ort
