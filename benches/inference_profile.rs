@@ -27,6 +27,24 @@ fn load(path: &str, batch: Option<usize>) -> TractResult<std::sync::Arc<TypedSim
     typed.into_optimized()?.into_runnable()
 }
 
+/// Runs `state` `runs` times on `inputs` and prints the mean time per run and per sample.
+fn print_mean_run(
+    label: &str,
+    state: &mut TypedSimpleState,
+    inputs: &TVec<TValue>,
+    runs: u32,
+    batch: usize,
+) -> TractResult<()> {
+    let start = Instant::now();
+    for _ in 0..runs {
+        state.run(inputs.clone())?;
+    }
+    let mean = start.elapsed() / runs;
+    let micros = mean.as_secs_f64() * 1e6;
+    println!("{label}: {micros:.1} us per run ({:.2} us/sample)", micros / batch as f64);
+    Ok(())
+}
+
 fn main() -> TractResult<()> {
     // `cargo bench` passes `--bench`; positional arguments are the model and the batch size.
     let positional: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
@@ -75,28 +93,9 @@ fn main() -> TractResult<()> {
     for (op, (d, n)) in ops.iter().take(15) {
         println!("  {:>8.1}  {:>3}  {}", d.as_secs_f64() * 1e6, n, op);
     }
-    let start = Instant::now();
-    for _ in 0..runs {
-        state.run(inputs.clone())?;
-    }
-    let plain_time = start.elapsed() / runs;
-    println!(
-        "the same plan without the profiler: {:.1} us per run ({:.2} us/sample)",
-        plain_time.as_secs_f64() * 1e6,
-        plain_time.as_secs_f64() * 1e6 / batch as f64
-    );
-    let symbolic = load(&path, None)?;
-    let mut symbolic_state = symbolic.spawn()?;
-    let start = Instant::now();
-    for _ in 0..runs {
-        symbolic_state.run(inputs.clone())?;
-    }
-    let symbolic_time = start.elapsed() / runs;
-    println!(
-        "the same model planned for a symbolic batch: {:.1} us per run ({:.2} us/sample)",
-        symbolic_time.as_secs_f64() * 1e6,
-        symbolic_time.as_secs_f64() * 1e6 / batch as f64
-    );
+    print_mean_run("the same plan without the profiler", &mut state, &inputs, runs, batch)?;
+    let mut symbolic_state = load(&path, None)?.spawn()?;
+    print_mean_run("the same model planned for a symbolic batch", &mut symbolic_state, &inputs, runs, batch)?;
     println!("top nodes (us per run, op, ONNX name, output shape):");
     for (id, d) in rows.iter().take(20) {
         let node = model.node(*id);

@@ -2,7 +2,7 @@
 
 ``build_graph`` takes the trained weights (the ``PRModel`` state dict as NumPy arrays) and writes
 the same function as :class:`model.PRModel` in the operator forms tract executes fastest, measured
-with ``cargo bench --bench inference_profile`` (``benches/results/pr_inference.md``):
+with ``cargo bench --bench inference_profile`` (``benches/results/pr_inference_compare.md``):
 
 * **Heads without transposes.** Head ``h``'s queries are the full-width query vector with the
   other heads' channels zeroed (query weights masked per head and stacked side by side), so one
@@ -29,8 +29,8 @@ with ``cargo bench --bench inference_profile`` (``benches/results/pr_inference.m
 
 ``weights_from_onnx`` reads the weights back from an exported file of either graph form (from
 this one, in their folded but equivalent form), so a model can be re-exported without
-retraining; ``reference_forward`` is the plain NumPy forward
-pass of the trained model (the check for both).
+retraining; ``reference_forward`` is the plain NumPy forward pass of the trained model (the
+check for both).
 """
 
 from __future__ import annotations

@@ -132,9 +132,6 @@ pub struct PrModel {
     path: PathBuf,
     /// Ascending batch sizes, as [`PLAN_BATCH_SIZES`].
     plans: Vec<BatchPlan>,
-    /// Inputs of one chunk, padded to its plan's batch size (reused across runs).
-    padded_features: Vec<f32>,
-    padded_valid: Vec<f32>,
 }
 
 impl fmt::Debug for PrModel {
@@ -193,13 +190,7 @@ impl PrModel {
             let state = plan.spawn().map_err(prepare)?;
             plans.push(BatchPlan { batch, plan, state });
         }
-        let largest = PLAN_BATCH_SIZES[PLAN_BATCH_SIZES.len() - 1];
-        let mut loaded = PrModel {
-            path,
-            plans,
-            padded_features: Vec::with_capacity(largest * MAX_HISTORY * FEATURES),
-            padded_valid: Vec::with_capacity(largest * MAX_HISTORY),
-        };
+        let mut loaded = PrModel { path, plans };
         // A trial run: a model that loads but cannot run fails here, at start-up.
         let mut out = [0.0f32; 2];
         let mut features = [0.0f32; MAX_HISTORY * FEATURES];
@@ -265,16 +256,9 @@ impl PrModel {
         let index = self.plans.iter().position(|p| p.batch >= remaining).unwrap_or(self.plans.len() - 1);
         let plan = &mut self.plans[index];
         let (size, rows) = (plan.batch, remaining.min(plan.batch));
-        self.padded_features.clear();
-        self.padded_features.extend_from_slice(&features[..rows * MAX_HISTORY * FEATURES]);
-        self.padded_features.resize(size * MAX_HISTORY * FEATURES, 0.0);
-        self.padded_valid.clear();
-        self.padded_valid.extend_from_slice(&valid[..rows * MAX_HISTORY]);
-        self.padded_valid.resize(size * MAX_HISTORY, 0.0);
         let error = |e: TractError| InferenceError(format!("{e:#}"));
-        let features =
-            Tensor::from_shape(&[size, MAX_HISTORY, FEATURES], &self.padded_features).map_err(error)?;
-        let valid = Tensor::from_shape(&[size, MAX_HISTORY], &self.padded_valid).map_err(error)?;
+        let features = padded_tensor(&[size, MAX_HISTORY, FEATURES], features).map_err(error)?;
+        let valid = padded_tensor(&[size, MAX_HISTORY], valid).map_err(error)?;
         let outputs = plan.state.run(tvec!(features.into_tvalue(), valid.into_tvalue())).map_err(error)?;
         let output = outputs.first().ok_or_else(|| InferenceError("the model returned no output".into()))?;
         if output.shape() != [size, 2] {
@@ -284,6 +268,17 @@ impl PrModel {
         displacements[..rows * 2].copy_from_slice(&view.as_slice::<f32>().map_err(error)?[..rows * 2]);
         Ok(rows)
     }
+}
+
+/// A zero tensor of `shape` whose leading values are copied from `values` (as many as fit):
+/// the rows of a chunk, followed by empty padding rows.
+fn padded_tensor(shape: &[usize], values: &[f32]) -> TractResult<Tensor> {
+    let mut tensor = Tensor::zero::<f32>(shape)?;
+    let mut view = tensor.try_as_plain_ram_mut()?;
+    let slots = view.as_slice_mut::<f32>()?;
+    let count = slots.len().min(values.len());
+    slots[..count].copy_from_slice(&values[..count]);
+    Ok(tensor)
 }
 
 /// Formats an inference-time shape, `?` for an unknown dimension, `..` for an unknown rank.
