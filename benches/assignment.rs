@@ -7,7 +7,7 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use primm::association::assignment::AssignmentSolver;
+use primm_core::association::assignment::AssignmentSolver;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -62,10 +62,11 @@ fn bench_assignment(c: &mut Criterion) {
 /// measurements, in shuffled measurement order.
 fn association_scene(
     n: usize,
-) -> (Vec<primm::track::Track>, Vec<primm::imm::ImmPrior>, primm::measurement::Frame, Vec<bool>) {
-    use primm::measurement::{Frame, Measurement, ObjectClass};
-    let config = primm::config::Config::default();
-    let imm = primm::imm::Imm::new(&config.imm);
+) -> (Vec<primm_core::track::Track>, Vec<primm_core::imm::ImmPrior>, primm_core::measurement::Frame, Vec<bool>)
+{
+    use primm_core::measurement::{Frame, Measurement, ObjectClass};
+    let config = primm_core::config::Config::default();
+    let imm = primm_core::imm::Imm::new(&config.imm);
     let mut rng = ChaCha8Rng::seed_from_u64(n as u64);
     let mut tracks = Vec::new();
     let mut priors = Vec::new();
@@ -82,12 +83,12 @@ fn association_scene(
             sensor_id: None,
             ground_truth_id: None,
         };
-        let models = primm::motion::ModeModels::from_config(config.classes.get(class));
+        let models = primm_core::motion::ModeModels::from_config(config.classes.get(class));
         let state = imm.initiate(&models, &measurement);
-        let context = primm::motion::PredictContext { dt_s: 0.05, displacement_m: None };
+        let context = primm_core::motion::PredictContext { dt_s: 0.05, displacement_m: None };
         let mut prior = imm.predict(&models, &state, &context);
         prior.fused.mean = glam::DVec2::new(measurement.x_m + 0.3, measurement.y_m - 0.2);
-        tracks.push(primm::track::Track::new(i as u64, &measurement, 0.0, state));
+        tracks.push(primm_core::track::Track::new(i as u64, &measurement, 0.0, state));
         priors.push(prior);
         frame.measurements.push(measurement);
     }
@@ -98,10 +99,10 @@ fn association_scene(
 }
 
 fn bench_association(c: &mut Criterion) {
-    use primm::association::associator::Associator;
-    use primm::association::cost::association_cost;
-    use primm::measurement::ObjectClass;
-    let config = primm::config::Config::default();
+    use primm_core::association::associator::Associator;
+    use primm_core::association::cost::association_cost;
+    use primm_core::measurement::ObjectClass;
+    let config = primm_core::config::Config::default();
     let mut group = c.benchmark_group("association");
     for n in SIZES {
         let (tracks, priors, frame, accepted) = association_scene(n);

@@ -12,8 +12,8 @@
 //! 23.8 and 21.6 µs per sample; `onnx_predictor` 649 µs (16 tracks), 2.19 ms (64 tracks).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use primm::predictor::onnx::{OnnxPredictor, PrModel};
-use primm::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
+use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
+use primm_predictor::onnx::{OnnxPredictor, PrModel};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 

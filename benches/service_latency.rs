@@ -24,8 +24,8 @@ mod common;
 
 use common::service::{spawn_serve, unique_prefix, TestClient};
 use hdrhistogram::Histogram;
-use primm::service::clock::monotonic_ns;
-use primm::service::ServiceNames;
+use primm_service::clock::monotonic_ns;
+use primm_service::ServiceNames;
 use std::fmt::Write as _;
 use std::time::Duration;
 
@@ -64,9 +64,9 @@ fn measure(
         frame.measurements.clone_from(&source.measurements);
         // The scene repeats every 500 frames; each repetition starts a new stream, so the
         // tracker resets instead of seeing every object jump back (a burst of new tracks).
-        let flags = if k % scene.len() == 0 { primm::wire::FRAME_FLAG_STREAM_START } else { 0 };
+        let flags = if k % scene.len() == 0 { primm_wire::FRAME_FLAG_STREAM_START } else { 0 };
         client.send(&frame, k as u64, flags);
-        let read = |answer: &primm::wire::TrackFrame| {
+        let read = |answer: &primm_wire::TrackFrame| {
             (answer.input_publish_time_ns, answer.receive_time_ns, answer.publish_time_ns)
         };
         let answer = if busy {

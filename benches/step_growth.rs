@@ -18,14 +18,14 @@
 
 use hdrhistogram::Histogram;
 use plotters::prelude::*;
-use primm::config::Config;
-use primm::measurement::{Frame, Measurement, ObjectClass};
-use primm::mode::Method;
-use primm::predictor::onnx::OnnxPredictor;
-use primm::predictor::threaded::ThreadedPredictor;
-use primm::predictor::{DisplacementPredictor, NoPredictor};
-use primm::stage_timing::{Stage, StageObserver};
-use primm::tracker::Tracker;
+use primm_core::config::Config;
+use primm_core::measurement::{Frame, Measurement, ObjectClass};
+use primm_core::mode::Method;
+use primm_core::predictor::{DisplacementPredictor, NoPredictor};
+use primm_core::stage_timing::{Stage, StageObserver};
+use primm_core::tracker::Tracker;
+use primm_predictor::onnx::OnnxPredictor;
+use primm_predictor::threaded::ThreadedPredictor;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};

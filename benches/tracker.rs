@@ -4,12 +4,12 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::DVec2;
-use primm::config::Config;
-use primm::imm::Imm;
-use primm::measurement::{Frame, Measurement, ObjectClass};
-use primm::mode::Method;
-use primm::motion::{ModeModels, PredictContext};
-use primm::tracker::Tracker;
+use primm_core::config::Config;
+use primm_core::imm::Imm;
+use primm_core::measurement::{Frame, Measurement, ObjectClass};
+use primm_core::mode::Method;
+use primm_core::motion::{ModeModels, PredictContext};
+use primm_core::tracker::Tracker;
 use std::hint::black_box;
 
 /// `count` objects on parallel lanes 4 m apart (half cars, half pedestrians), `frames` frames

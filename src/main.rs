@@ -1,7 +1,8 @@
 //! `primm`: command-line host of the PR-IMM tracker. Each subcommand lives in `src/cli/`.
 
 use clap::{Parser, Subcommand};
-use primm::cli;
+mod cli;
+
 use std::process::ExitCode;
 
 /// PR-IMM multi-object tracking for automotive radar.
@@ -19,9 +20,9 @@ enum Command {
     /// Run the tracker as a shared-memory service (iceoryx2).
     Serve(cli::serve::Args),
     /// Replay measurement frames onto the service (same as `primm-publisher`).
-    Publish(cli::publish::Args),
+    Publish(primm_publisher::Args),
     /// Show or record the tracks of the service (same as `primm-subscriber`).
-    Subscribe(cli::subscribe::Args),
+    Subscribe(primm_subscriber::Args),
     /// Generate simulated radar sequences as measurement CSV files.
     Generate(cli::generate::Args),
     /// Track a measurement CSV file offline into a track CSV file.
@@ -34,12 +35,12 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    cli::init_logging();
+    primm_service::logging::init_logging();
     let result: Result<(), Box<dyn std::error::Error>> = match cli.command {
         Command::Demo(args) => cli::demo::run(args).map_err(Into::into),
         Command::Serve(args) => cli::serve::run(args).map_err(Into::into),
-        Command::Publish(args) => cli::publish::run(args).map_err(Into::into),
-        Command::Subscribe(args) => cli::subscribe::run(args).map_err(Into::into),
+        Command::Publish(args) => primm_publisher::run(args).map_err(Into::into),
+        Command::Subscribe(args) => primm_subscriber::run(args).map_err(Into::into),
         Command::Generate(args) => cli::generate::run(&args),
         Command::Track(args) => cli::track::run(&args),
         Command::Eval(args) => cli::eval::run(&args),

@@ -2,7 +2,7 @@
 
 use pathfinding::kuhn_munkres::kuhn_munkres;
 use pathfinding::matrix::Matrix;
-use primm::association::assignment::{AssignmentError, AssignmentSolver, AssignmentSummary};
+use primm_core::association::assignment::{AssignmentError, AssignmentSolver, AssignmentSummary};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -4,7 +4,7 @@
 //! thread, so that other test threads cannot interfere.
 
 use crate::common::counting_allocator::count_allocations;
-use primm::association::assignment::{AssignmentError, AssignmentSolver};
+use primm_core::association::assignment::{AssignmentError, AssignmentSolver};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

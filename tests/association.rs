@@ -2,14 +2,14 @@
 //! class.
 
 use glam::DVec2;
-use primm::association::assignment::AssignmentSolver;
-use primm::association::associator::Associator;
-use primm::association::cost::association_cost;
-use primm::config::Config;
-use primm::imm::{Imm, ImmPrior};
-use primm::measurement::{Frame, Measurement, ObjectClass};
-use primm::motion::{ModeModels, PredictContext};
-use primm::track::Track;
+use primm_core::association::assignment::AssignmentSolver;
+use primm_core::association::associator::Associator;
+use primm_core::association::cost::association_cost;
+use primm_core::config::Config;
+use primm_core::imm::{Imm, ImmPrior};
+use primm_core::measurement::{Frame, Measurement, ObjectClass};
+use primm_core::motion::{ModeModels, PredictContext};
+use primm_core::track::Track;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -38,10 +38,10 @@ fn track_writes_one_row_per_measurement_with_consistent_columns() {
         "--method",
         "imm",
     ]);
-    let sequence = primm::io::read_sequence_file(&input).unwrap();
+    let sequence = primm_sim::io::read_sequence_file(&input).unwrap();
     let text = std::fs::read_to_string(&output).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some(primm::io::track_csv::TRACK_CSV_HEADER));
+    assert_eq!(lines.next(), Some(primm_sim::io::track_csv::TRACK_CSV_HEADER));
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     // Every measurement updated or started exactly one track.
     assert_eq!(rows.len(), sequence.measurement_count());
@@ -94,7 +94,7 @@ fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
     let associations = dir.join("associations");
     std::fs::create_dir_all(&associations).unwrap();
     let mut timed_frames = 0;
-    for file in primm::io::dataset_files(&data).unwrap() {
+    for file in primm_sim::io::dataset_files(&data).unwrap() {
         let name = file.file_name().unwrap();
         let output = primm(&[
             "track",
@@ -110,7 +110,7 @@ fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
             dir.join("steps.txt").to_str().unwrap(),
         ]);
         let timing: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-        let sequence = primm::io::read_sequence_file(&file).unwrap();
+        let sequence = primm_sim::io::read_sequence_file(&file).unwrap();
         assert_eq!(timing["frames"].as_u64().unwrap() as usize, sequence.frames.len());
         assert!(timing["frames_per_second"].as_f64().unwrap() > 0.0);
         timed_frames += sequence.frames.len();
@@ -149,8 +149,8 @@ fn score_refuses_an_association_file_that_names_a_missing_measurement() {
     let data = dir.join("evaluation");
     let associations = dir.join("associations");
     std::fs::create_dir_all(&associations).unwrap();
-    for file in primm::io::dataset_files(&data).unwrap() {
-        let text = format!("{}\n0,9999,1,,\n", primm::io::association_csv::ASSOCIATION_CSV_HEADER);
+    for file in primm_sim::io::dataset_files(&data).unwrap() {
+        let text = format!("{}\n0,9999,1,,\n", primm_sim::io::association_csv::ASSOCIATION_CSV_HEADER);
         std::fs::write(associations.join(file.file_name().unwrap()), text).unwrap();
     }
     let output = Command::new(env!("CARGO_BIN_EXE_primm"))

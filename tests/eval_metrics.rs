@@ -3,7 +3,7 @@
 //! `tests/fixtures/identity_fixture.csv` lists (sequence, frame, gt_id, track_id) rows; the
 //! numbers in `tests/fixtures/identity_fixture_motmetrics.json` were computed from it by
 //! `tools/motmetrics_crosscheck.py`, an implementation independent of this crate. This test
-//! recomputes everything with `primm::eval` and requires exact agreement.
+//! recomputes everything with `primm_sim::eval` and requires exact agreement.
 //!
 //! Known difference: motmetrics' optional `max_switch_time` ignores a switch when the object was
 //! last *present* (matched or not) more than that many frames earlier. The paper's IDSW has no
@@ -15,9 +15,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::PathBuf;
 
 use glam::DVec2;
-use primm::eval::identity::id_switch_rows;
-use primm::eval::{identity_counts, AssociationRecord, IdentityCounts};
-use primm::measurement::ObjectClass;
+use primm_core::measurement::ObjectClass;
+use primm_sim::eval::identity::id_switch_rows;
+use primm_sim::eval::{identity_counts, AssociationRecord, IdentityCounts};
 use serde_json::Value;
 
 fn fixture(name: &str) -> PathBuf {

@@ -5,13 +5,13 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use glam::DVec2;
-use primm::eval::plots::{
+use primm_core::measurement::ObjectClass;
+use primm_sim::eval::plots::{
     ground_truth_points, majority_ground_truth, mode_probability_svg, trajectory_svg,
     write_mode_probability_svg, write_trajectory_svg, TrajectoryPanel, TrajectoryPlotOptions,
     TrajectoryPoint,
 };
-use primm::eval::{AssociationRecord, Method};
-use primm::measurement::ObjectClass;
+use primm_sim::eval::{AssociationRecord, Method};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

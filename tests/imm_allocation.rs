@@ -5,9 +5,9 @@ use crate::common::counting_allocator;
 
 use counting_allocator::count_allocations;
 use glam::DVec2;
-use primm::config::Config;
-use primm::imm::Imm;
-use primm::motion::{ModeModels, PredictContext};
+use primm_core::config::Config;
+use primm_core::imm::Imm;
+use primm_core::motion::{ModeModels, PredictContext};
 
 #[test]
 fn ten_thousand_imm_cycles_allocate_nothing() {

@@ -4,12 +4,12 @@ use crate::common;
 
 use glam::DVec2;
 use nalgebra::Vector4;
-use primm::config::Config;
-use primm::gaussian::kalman_update;
-use primm::imm::Imm;
-use primm::mode::{Method, Mode, ModeSet};
-use primm::motion::coordinated_turn::{Matrix5, Vector5};
-use primm::motion::{ConstantVelocity, CoordinatedTurn, ModeModels, MotionModel, PredictContext};
+use primm_core::config::Config;
+use primm_core::gaussian::kalman_update;
+use primm_core::imm::Imm;
+use primm_core::mode::{Method, Mode, ModeSet};
+use primm_core::motion::coordinated_turn::{Matrix5, Vector5};
+use primm_core::motion::{ConstantVelocity, CoordinatedTurn, ModeModels, MotionModel, PredictContext};
 
 /// Wilson–Hilferty approximation of the χ² quantile with `k` degrees of freedom at the standard
 /// normal quantile `z` (accurate to well under 0.1 % for k in the thousands).

@@ -6,11 +6,11 @@ use crate::common;
 
 use glam::{DMat2, DVec2};
 use nalgebra::{Matrix2, SMatrix, SVector};
-use primm::config::Config;
-use primm::gaussian::{replace_position, Gaussian, PositionEstimate};
-use primm::imm::{mix_positions, Imm, ImmState};
-use primm::mode::{Mode, ModeSet};
-use primm::motion::{ModeModels, PredictContext};
+use primm_core::config::Config;
+use primm_core::gaussian::{replace_position, Gaussian, PositionEstimate};
+use primm_core::imm::{mix_positions, Imm, ImmState};
+use primm_core::mode::{Mode, ModeSet};
+use primm_core::motion::{ModeModels, PredictContext};
 use proptest::prelude::*;
 
 /// Positive semi-definite up to rounding: a Cholesky factorisation exists after a shift of
@@ -113,7 +113,7 @@ proptest! {
         let before = g;
         let a = Matrix2::new(new_entries[0], new_entries[1], new_entries[2], new_entries[3]);
         let p_bar = a * a.transpose() + Matrix2::identity() * 0.01;
-        let mixed = PositionEstimate { mean: DVec2::new(new_mean[0], new_mean[1]), covariance: primm::gaussian::to_glam(&p_bar) };
+        let mixed = PositionEstimate { mean: DVec2::new(new_mean[0], new_mean[1]), covariance: primm_core::gaussian::to_glam(&p_bar) };
         replace_position(&mut g, &mixed);
 
         // B = P_hp P_pp⁻¹ and C = P_hh − B P_pp Bᵀ, before and after.

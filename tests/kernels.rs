@@ -1,4 +1,4 @@
-//! The per-track loops of `primm::kernels` (compiled for baseline x86-64 and for AVX2 + FMA,
+//! The per-track loops of `primm_core::kernels` (compiled for baseline x86-64 and for AVX2 + FMA,
 //! chosen at run time) compute exactly what the plain IMM calls compute, bit for bit, on tracks
 //! taken from a running tracker. On a CPU with AVX2 the kernels run their AVX2 version while
 //! the reference loops below are compiled for the baseline, so the comparison covers both.
@@ -7,15 +7,15 @@ use crate::common;
 
 use common::{lanes, measurement, scene_frames};
 use glam::DVec2;
-use primm::config::Config;
-use primm::gaussian::UpdateError;
-use primm::imm::{Imm, ImmPrior};
-use primm::kernels::{self, ClassModels};
-use primm::measurement::{Measurement, ObjectClass};
-use primm::mode::Method;
-use primm::motion::ModeModels;
-use primm::track::Track;
-use primm::tracker::Tracker;
+use primm_core::config::Config;
+use primm_core::gaussian::UpdateError;
+use primm_core::imm::{Imm, ImmPrior};
+use primm_core::kernels::{self, ClassModels};
+use primm_core::measurement::{Measurement, ObjectClass};
+use primm_core::mode::Method;
+use primm_core::motion::ModeModels;
+use primm_core::track::Track;
+use primm_core::tracker::Tracker;
 
 /// The tracks of a tracker running `method` on 24 lanes after `frames` frames.
 fn running_tracks(method: Method, frames: usize) -> (Config, Vec<Track>) {

@@ -5,11 +5,11 @@ use crate::common;
 
 use glam::DVec2;
 use nalgebra::{Matrix2, Matrix4, SMatrix, Vector4};
-use primm::gaussian::{kalman_update, Gaussian};
-use primm::motion::coordinated_turn::{
+use primm_core::gaussian::{kalman_update, Gaussian};
+use primm_core::motion::coordinated_turn::{
     turn_functions_closed_form, turn_functions_series, Vector5, TAYLOR_THRESHOLD,
 };
-use primm::motion::{ConstantVelocity, CoordinatedTurn, ModeModels, MotionModel, PredictContext};
+use primm_core::motion::{ConstantVelocity, CoordinatedTurn, ModeModels, MotionModel, PredictContext};
 
 fn cv_prediction(state: &Vector5, dt: f64) -> Vector4<f64> {
     ConstantVelocity::transition(dt) * Vector4::new(state[0], state[1], state[2], state[3])
@@ -217,7 +217,7 @@ fn spd<const N: usize>(rng: &mut rand_chacha::ChaCha8Rng) -> SMatrix<f64, N, N> 
 
 #[test]
 fn linear_predictions_equal_the_dense_textbook_products() {
-    use primm::motion::ConstantAcceleration;
+    use primm_core::motion::ConstantAcceleration;
     let mut rng = common::rng(77);
     let config = common::config();
     let models = ModeModels::from_config(&config.classes.car);

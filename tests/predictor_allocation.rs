@@ -6,12 +6,12 @@ use crate::common::counting_allocator;
 
 use counting_allocator::{allocations, count_allocations};
 use glam::DVec2;
-use primm::config::Config;
-use primm::measurement::Frame;
-use primm::predictor::onnx::OnnxPredictor;
-use primm::predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
-use primm::predictor::{DisplacementPredictor, PredictionRequest};
-use primm::tracker::Tracker;
+use primm_core::config::Config;
+use primm_core::measurement::Frame;
+use primm_core::predictor::{DisplacementPredictor, PredictionRequest};
+use primm_core::tracker::Tracker;
+use primm_predictor::onnx::OnnxPredictor;
+use primm_predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;

@@ -2,8 +2,8 @@
 //! coasting tracks, and clear start-up errors for unusable model files.
 
 use glam::DVec2;
-use primm::predictor::onnx::{ModelError, OnnxPredictor, PrModel};
-use primm::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
+use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
+use primm_predictor::onnx::{ModelError, OnnxPredictor, PrModel};
 use std::path::{Path, PathBuf};
 
 fn repo_path(relative: &str) -> PathBuf {
@@ -259,11 +259,20 @@ fn a_model_without_the_valid_input_is_rejected() {
 }
 
 #[test]
-fn the_command_line_loads_the_model_for_learned_methods_only() {
-    use primm::cli::predictor::predictor_for;
-    use primm::mode::Method;
+fn the_model_is_loaded_for_learned_methods_only_and_is_built_in_when_no_file_is_given() {
+    use primm_core::mode::Method;
+    use primm_predictor::predictor_for;
     assert!(predictor_for(Method::Imm, Some(Path::new("/nonexistent.onnx"))).is_ok());
     let error = predictor_for(Method::PrImm, Some(Path::new("/nonexistent/pr.onnx"))).err().unwrap();
-    assert!(error.contains("/nonexistent/pr.onnx"), "{error}");
+    assert!(error.to_string().contains("/nonexistent/pr.onnx"), "{error}");
     assert!(predictor_for(Method::Learned, Some(&repo_path("models/pr.onnx"))).is_ok());
+    assert!(predictor_for(Method::Learned, None).is_ok());
+}
+
+#[test]
+fn the_built_in_model_is_the_shipped_file_byte_for_byte() {
+    let shipped = std::fs::read(repo_path("models/pr.onnx")).unwrap();
+    assert_eq!(primm_predictor::DEFAULT_MODEL_ONNX, shipped.as_slice());
+    let model = PrModel::embedded().unwrap();
+    assert_eq!(model.source().to_string(), "models/pr.onnx (built in)");
 }

@@ -1,6 +1,6 @@
 //! The request's step start and its re-timing for the start-of-step prediction.
 
-use primm::predictor::{HistoryEntry, PredictionRequest, MAX_HISTORY};
+use primm_core::predictor::{HistoryEntry, PredictionRequest, MAX_HISTORY};
 
 fn entries(times: &[f64]) -> Vec<HistoryEntry> {
     times

@@ -2,9 +2,9 @@
 //! deadlines that cost one frame only, stale results discarded, panics contained.
 
 use glam::DVec2;
-use primm::predictor::onnx::OnnxPredictor;
-use primm::predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
-use primm::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest};
+use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest};
+use primm_predictor::onnx::OnnxPredictor;
+use primm_predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;

@@ -3,11 +3,11 @@
 //! from the last two measurements, and closer than predicting no motion at all.
 
 use glam::DVec2;
-use primm::io::Sequence;
-use primm::measurement::ObjectClass;
-use primm::predictor::onnx::OnnxPredictor;
-use primm::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, MAX_HISTORY};
-use primm::scenario::{Preset, ScenarioGenerator, Split};
+use primm_core::measurement::ObjectClass;
+use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, MAX_HISTORY};
+use primm_predictor::onnx::OnnxPredictor;
+use primm_sim::io::Sequence;
+use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -5,9 +5,9 @@ use std::collections::{HashMap, HashSet};
 use std::sync::OnceLock;
 
 use glam::DVec2;
-use primm::io::{read_sequence, write_sequence, RecordedFrame, Sequence};
-use primm::measurement::ObjectClass;
-use primm::scenario::{
+use primm_core::measurement::ObjectClass;
+use primm_sim::io::{read_sequence, write_sequence, RecordedFrame, Sequence};
+use primm_sim::scenario::{
     count_events, GeneratedSequence, ObjectState, Preset, RadarMount, ScenarioConfig, ScenarioGenerator,
     Split, SplitSummary, TruthFrame, SPLIT_SEED_STRIDE,
 };
@@ -366,7 +366,7 @@ fn every_class_appears_in_every_split_kind() {
 fn close_proximity_and_crossing_occur_in_the_evaluation_split() {
     let mut close_sequences = 0;
     let mut crossing_sequences = 0;
-    let mut total = primm::scenario::EventCounts::default();
+    let mut total = primm_sim::scenario::EventCounts::default();
     for generated in evaluation_split() {
         let events = count_events(generated);
         close_sequences += usize::from(events.close_proximity_frames > 0);
@@ -565,7 +565,7 @@ fn split_summary_counts_match_the_sequences() {
         (summary.frames, summary.car_object_frames, summary.pedestrian_object_frames),
         (frames, cars, peds)
     );
-    let table = primm::scenario::format_table(&[summary]);
+    let table = primm_sim::scenario::format_table(&[summary]);
     assert!(table.contains("Validation"));
     assert!(table.lines().next().unwrap().contains("Pedestrian object frames"));
 }

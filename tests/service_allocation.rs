@@ -18,14 +18,14 @@ use crate::common::counting_allocator;
 
 use common::service::{unique_prefix, TestClient};
 use counting_allocator::allocations;
-use primm::config::Config;
-use primm::measurement::Frame;
-use primm::mode::Method;
-use primm::predictor::onnx::OnnxPredictor;
-use primm::predictor::threaded::ThreadedPredictor;
-use primm::predictor::{DisplacementPredictor, NoPredictor};
-use primm::service::{ServiceNames, TrackingOptions, TrackingService, WaitMode};
-use primm::tracker::Tracker;
+use primm_core::config::Config;
+use primm_core::measurement::Frame;
+use primm_core::mode::Method;
+use primm_core::predictor::{DisplacementPredictor, NoPredictor};
+use primm_core::tracker::Tracker;
+use primm_predictor::onnx::OnnxPredictor;
+use primm_predictor::threaded::ThreadedPredictor;
+use primm_service::{ServiceNames, TrackingOptions, TrackingService, WaitMode};
 use std::sync::mpsc;
 use std::time::Duration;
 

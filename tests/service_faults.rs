@@ -4,9 +4,9 @@
 use crate::common;
 
 use common::service::{spawn_serve, unique_prefix, ChildGuard, TestClient};
-use primm::measurement::Frame;
-use primm::service::ServiceNames;
-use primm::wire::{FrameStatus, TRACK_FLAG_TRACKER_RESET};
+use primm_core::measurement::Frame;
+use primm_service::ServiceNames;
+use primm_wire::{FrameStatus, TRACK_FLAG_TRACKER_RESET};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 

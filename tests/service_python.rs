@@ -5,7 +5,7 @@
 use crate::common;
 
 use common::service::{spawn_serve, unique_prefix, ChildGuard, TestClient};
-use primm::service::ServiceNames;
+use primm_service::ServiceNames;
 use std::io::BufRead;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

@@ -4,19 +4,19 @@
 use crate::common;
 
 use common::service::{spawn_serve, unique_prefix, wire_frame, TestClient};
-use primm::config::Config;
-use primm::mode::Method;
-use primm::service::ServiceNames;
-use primm::tracker::Tracker;
-use primm::wire::{FrameStatus, WireTrack};
+use primm_core::config::Config;
+use primm_core::mode::Method;
+use primm_core::tracker::Tracker;
+use primm_service::ServiceNames;
+use primm_wire::{FrameStatus, WireTrack};
 use std::time::Duration;
 
 /// Sends `frames` one by one and checks that each answer has the frame's sequence number and
 /// exactly the tracks `offline` computes from the same wire frame. Returns the largest number of
 /// confirmed tracks seen in one answer.
-fn replay_against_offline<P: primm::predictor::DisplacementPredictor>(
+fn replay_against_offline<P: primm_core::predictor::DisplacementPredictor>(
     client: &TestClient,
-    frames: &[primm::measurement::Frame],
+    frames: &[primm_core::measurement::Frame],
     offline: &mut Tracker<P>,
 ) -> usize {
     let mut confirmed_seen = 0;
@@ -73,7 +73,7 @@ fn every_frame_comes_back_in_order_with_the_offline_tracks() {
 /// A configuration file whose learned-predictor deadline is long enough that no frame can miss
 /// it on a loaded machine, so that the served run must equal the synchronous offline run.
 fn generous_deadline_config(prefix: &str) -> std::path::PathBuf {
-    let text = primm::config::DEFAULT_CONFIG_TOML.replace("deadline_ms = 5.0", "deadline_ms = 1000.0");
+    let text = primm_config::DEFAULT_CONFIG_TOML.replace("deadline_ms = 5.0", "deadline_ms = 1000.0");
     assert!(text.contains("deadline_ms = 1000.0"), "the default configuration names predictor.deadline_ms");
     let path = std::env::temp_dir().join(format!("{prefix}.toml"));
     std::fs::write(&path, text).unwrap();
@@ -82,7 +82,7 @@ fn generous_deadline_config(prefix: &str) -> std::path::PathBuf {
 
 #[test]
 fn with_the_learned_predictor_every_frame_comes_back_with_the_tracks_of_a_synchronous_offline_run() {
-    use primm::predictor::onnx::OnnxPredictor;
+    use primm_predictor::onnx::OnnxPredictor;
     let prefix = unique_prefix("replay-pr");
     let config_path = generous_deadline_config(&prefix);
     let client = TestClient::new(&ServiceNames::new(&prefix));

@@ -3,14 +3,14 @@
 use crate::common;
 
 use common::{lanes, scene_frames, SceneObject};
-use primm::config::Config;
-use primm::measurement::{
+use primm_core::config::Config;
+use primm_core::measurement::{
     Frame, FrameView, Measurement, ObjectClass, UnknownClass, MAX_MEASUREMENTS_PER_FRAME,
 };
-use primm::mode::Method;
-use primm::track::{TrackOutput, TrackStatus};
-use primm::tracker::{StepError, Tracker};
-use primm::validation::FrameError;
+use primm_core::mode::Method;
+use primm_core::track::{TrackOutput, TrackStatus};
+use primm_core::tracker::{StepError, Tracker};
+use primm_core::validation::FrameError;
 use std::collections::HashMap;
 
 fn imm_config() -> Config {
@@ -331,7 +331,7 @@ fn a_bad_measurement_is_rejected_alone_and_the_rest_of_the_frame_is_tracked() {
 
 #[test]
 fn a_full_table_refuses_new_tracks_and_keeps_the_old_ones() {
-    use primm::track_table::MAX_TRACKS;
+    use primm_core::track_table::MAX_TRACKS;
     let mut tracker = Tracker::new(imm_config()).unwrap();
     // Frames of 256 far-apart measurements, shifted each frame so nothing associates: the table
     // fills up, then refuses.

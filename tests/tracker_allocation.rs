@@ -4,14 +4,14 @@ use crate::common;
 use crate::common::counting_allocator;
 
 use counting_allocator::count_allocations;
-use primm::config::Config;
-use primm::measurement::Frame;
-use primm::mode::Method;
-use primm::tracker::Tracker;
+use primm_core::config::Config;
+use primm_core::measurement::Frame;
+use primm_core::mode::Method;
+use primm_core::tracker::Tracker;
 
 /// 10 000 frames of 64 objects, built before counting; frames cycle through 500 recorded ones
 /// with timestamps shifted so that time keeps advancing.
-fn run_counted<P: primm::predictor::DisplacementPredictor>(mut tracker: Tracker<P>) -> (u64, u64) {
+fn run_counted<P: primm_core::predictor::DisplacementPredictor>(mut tracker: Tracker<P>) -> (u64, u64) {
     let base = common::scene_frames(&common::lanes(64), 500, 0.04, 0.2, 21);
     let mut frame: Frame = base[0].clone();
     let mut updates = 0u64;

@@ -18,7 +18,8 @@ import sys
 
 import iceoryx2 as iox2
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "crates", "primm-wire", "python"))
 from primm_wire import CLASS_NAMES, QOS, STATUS_NAMES, TRACKS, TrackFrame, service_name  # noqa: E402
 
 

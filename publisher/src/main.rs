@@ -9,13 +9,13 @@ use std::process::ExitCode;
 #[command(name = "primm-publisher", version)]
 struct Cli {
     #[command(flatten)]
-    args: primm::cli::publish::Args,
+    args: primm_publisher::Args,
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    primm::cli::init_logging();
-    match primm::cli::publish::run(cli.args) {
+    primm_service::logging::init_logging();
+    match primm_publisher::run(cli.args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             eprintln!("error: {error}");

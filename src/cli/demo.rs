@@ -6,10 +6,10 @@
 //! otherwise this executable runs the same code as `primm publish` / `primm subscribe`, so
 //! `cargo run --release -- demo` works from a fresh checkout.
 
-use super::publish::DEFAULT_SCENARIO_SEED;
-use crate::mode::Method;
-use crate::service::catalog;
-use crate::service::{ConnectError, ServiceNames};
+use primm_core::mode::Method;
+use primm_publisher::DEFAULT_SCENARIO_SEED;
+use primm_service::catalog;
+use primm_service::{ConnectError, ServiceNames};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};

@@ -1,20 +1,20 @@
 //! `primm eval`: every method on every sequence of a data set, printed as the paper's tables.
 
-use crate::cli::predictor::predictor_for;
-use crate::config::Config;
-use crate::eval::dropout::{sequence_seed, DropoutMask};
-use crate::eval::plots::{
+use clap::Args as ClapArgs;
+use primm_core::config::Config;
+use primm_core::mode::Method;
+use primm_core::predictor::DisplacementPredictor;
+use primm_core::tracker::Tracker;
+use primm_predictor::predictor_for;
+use primm_sim::eval::dropout::{sequence_seed, DropoutMask};
+use primm_sim::eval::plots::{
     ground_truth_points, majority_ground_truth, write_mode_probability_svg, write_trajectory_svg,
     TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint,
 };
-use crate::eval::record::AssociationRecord;
-use crate::eval::report::{EvaluationReport, MethodEvaluator, DEFAULT_MISS_PERCENTS};
-use crate::io::{read_dataset_dir, Sequence};
-use crate::mode::Method;
-use crate::offline::{association_records, track_sequence};
-use crate::predictor::DisplacementPredictor;
-use crate::tracker::Tracker;
-use clap::Args as ClapArgs;
+use primm_sim::eval::record::AssociationRecord;
+use primm_sim::eval::report::{EvaluationReport, MethodEvaluator, DEFAULT_MISS_PERCENTS};
+use primm_sim::io::{read_dataset_dir, Sequence};
+use primm_sim::offline::{association_records, track_sequence};
 use std::path::{Path, PathBuf};
 
 /// Seed of the measurement removal for the missed-detection rows of Table V.
@@ -44,7 +44,8 @@ pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults otherwise.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// ONNX model of the learned predictor.
+    /// ONNX model of the learned predictor (default: the model built into primm,
+    /// models/pr.onnx).
     #[arg(long, value_name = "FILE")]
     pub model: Option<PathBuf>,
     /// Seed of the measurement removal for the missed-detection rows.
@@ -55,7 +56,7 @@ pub struct Args {
 /// Runs `primm eval`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let base_config = match &args.config {
-        Some(path) => Config::from_file(path)?,
+        Some(path) => primm_config::from_file(path)?,
         None => Config::default(),
     };
     let sequences = read_dataset_dir(&args.data)?;
@@ -79,7 +80,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             Ok(predictor) => predictor,
             Err(reason) => {
                 eprintln!("{method}: unavailable: {reason}");
-                report.mark_unavailable(method, reason);
+                report.mark_unavailable(method, reason.to_string());
                 continue;
             }
         };

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
 
-use crate::io::write_sequence_file;
-use crate::scenario::{format_table, Preset, ScenarioGenerator, Split, SplitSummary};
+use primm_sim::io::write_sequence_file;
+use primm_sim::scenario::{format_table, Preset, ScenarioGenerator, Split, SplitSummary};
 
 /// Which splits to generate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -6,11 +6,11 @@
 //! (`MethodEvaluator`), so a tracker outside primm is scored exactly like primm's own methods:
 //! prior RMSE against the true object centre (Table II), ID switches and IDF1 (Table IV).
 
-use crate::eval::{MethodEvaluator, MethodResult};
-use crate::io::association_csv::{association_records_from_rows, read_association_rows};
-use crate::io::{dataset_files, read_sequence_file};
-use crate::mode::Method;
 use clap::Args as ClapArgs;
+use primm_core::mode::Method;
+use primm_sim::eval::{MethodEvaluator, MethodResult};
+use primm_sim::io::association_csv::{association_records_from_rows, read_association_rows};
+use primm_sim::io::{dataset_files, read_sequence_file};
 use std::path::PathBuf;
 
 /// Arguments of `primm score`.

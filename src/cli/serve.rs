@@ -1,16 +1,16 @@
 //! `primm serve`: the tracker as a shared-memory service.
 
-use crate::cli::predictor::DEFAULT_MODEL_PATH;
-use crate::config::{Config, ConfigError};
-use crate::mode::Method;
-use crate::predictor::onnx::{ModelError, OnnxPredictor};
-use crate::predictor::threaded::ThreadedPredictor;
-use crate::predictor::{DisplacementPredictor, NoPredictor};
-use crate::service::catalog::SERVICE_PREFIX_ENV;
-use crate::service::{
+use primm_config::ConfigError;
+use primm_core::config::Config;
+use primm_core::mode::Method;
+use primm_core::predictor::{DisplacementPredictor, NoPredictor};
+use primm_core::tracker::Tracker;
+use primm_predictor::onnx::{ModelError, OnnxPredictor};
+use primm_predictor::threaded::ThreadedPredictor;
+use primm_service::catalog::SERVICE_PREFIX_ENV;
+use primm_service::{
     ConnectError, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService, WaitMode,
 };
-use crate::tracker::Tracker;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -23,8 +23,8 @@ pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults when absent.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Learned displacement predictor (ONNX) for the methods pr and pr-imm; default
-    /// models/pr.onnx. It runs on a dedicated inference thread with the configuration's
+    /// Learned displacement predictor (ONNX) for the methods pr and pr-imm; default: the
+    /// model built into primm (models/pr.onnx). It runs on a dedicated inference thread with the configuration's
     /// `predictor.deadline_ms`.
     #[arg(long, value_name = "FILE")]
     pub model: Option<PathBuf>,
@@ -49,6 +49,9 @@ pub enum ServeError {
     /// The configuration could not be loaded or is invalid.
     #[error(transparent)]
     Config(#[from] ConfigError),
+    /// The configuration is invalid for the tracker.
+    #[error(transparent)]
+    Tracker(#[from] primm_core::config::ConfigError),
     /// `--model` was given for a method that does not use the learned predictor.
     #[error("--model {path}: method '{method}' does not use the learned predictor; use --method pr or pr-imm, or leave out --model")]
     ModelWithoutPredictor {
@@ -82,7 +85,7 @@ pub enum ServeError {
 /// Runs the service until SIGINT or SIGTERM, then prints the counters and the latency table.
 pub fn run(args: Args) -> Result<(), ServeError> {
     let config = match &args.config {
-        Some(path) => Config::from_file(path)?,
+        Some(path) => primm_config::from_file(path)?,
         None => Config::default(),
     };
     if let (Some(path), false) = (&args.model, args.method.needs_predictor()) {
@@ -90,8 +93,7 @@ pub fn run(args: Args) -> Result<(), ServeError> {
     }
     let config = config.with_modes(args.method.modes());
     if args.method.needs_predictor() {
-        let path = args.model.clone().unwrap_or_else(|| PathBuf::from(DEFAULT_MODEL_PATH));
-        let predictor = learned_predictor(&path, &config, args.method)?;
+        let predictor = learned_predictor(args.model.as_deref(), &config, args.method)?;
         serve(Tracker::with_predictor(config, predictor)?, &args)
     } else {
         serve(Tracker::with_predictor(config, NoPredictor)?, &args)
@@ -100,10 +102,18 @@ pub fn run(args: Args) -> Result<(), ServeError> {
 
 /// The PR model on its own inference thread, built on the calling (tracking) thread so that the
 /// hand-over allocates nothing from the first frame on.
-fn learned_predictor(path: &Path, config: &Config, method: Method) -> Result<ThreadedPredictor, ServeError> {
-    let model = OnnxPredictor::load(path).map_err(|source| ServeError::Model { method, source })?;
+fn learned_predictor(
+    path: Option<&Path>,
+    config: &Config,
+    method: Method,
+) -> Result<ThreadedPredictor, ServeError> {
+    let model = match path {
+        Some(path) => OnnxPredictor::load(path),
+        None => OnnxPredictor::embedded(),
+    }
+    .map_err(|source| ServeError::Model { method, source })?;
     let deadline = config.predictor.deadline();
-    tracing::info!(model = %path.display(), deadline_ms = config.predictor.deadline_ms, "learned predictor loaded");
+    tracing::info!(model = %model.model().source(), deadline_ms = config.predictor.deadline_ms, "learned predictor loaded");
     ThreadedPredictor::new(model, deadline).map_err(ServeError::InferenceThread)
 }
 

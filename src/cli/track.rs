@@ -1,13 +1,13 @@
 //! `primm track`: offline tracking of a measurement CSV file into a track CSV file.
 
-use crate::cli::predictor::predictor_for;
-use crate::config::Config;
-use crate::io::association_csv::AssociationCsvWriter;
-use crate::io::read_sequence_file;
-use crate::io::track_csv::TrackCsvWriter;
-use crate::mode::Method;
-use crate::tracker::Tracker;
 use clap::Args as ClapArgs;
+use primm_core::config::Config;
+use primm_core::mode::Method;
+use primm_core::tracker::Tracker;
+use primm_predictor::predictor_for;
+use primm_sim::io::association_csv::AssociationCsvWriter;
+use primm_sim::io::read_sequence_file;
+use primm_sim::io::track_csv::TrackCsvWriter;
 use std::path::PathBuf;
 
 /// Arguments of `primm track`.
@@ -26,7 +26,8 @@ pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults otherwise.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// ONNX model of the learned predictor.
+    /// ONNX model of the learned predictor (default: the model built into primm,
+    /// models/pr.onnx).
     #[arg(long, value_name = "FILE")]
     pub model: Option<PathBuf>,
     /// Also write the association CSV (which track took each measurement; scored by
@@ -43,7 +44,7 @@ pub struct Args {
 /// Runs `primm track`.
 pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let config = match &args.config {
-        Some(path) => Config::from_file(path)?,
+        Some(path) => primm_config::from_file(path)?,
         None => Config::default(),
     }
     .with_modes(args.method.modes());
@@ -105,7 +106,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// Frames per second of the tracker steps alone and their percentiles, as JSON.
-fn timing_json(method: crate::mode::Method, step_ns: &mut [u64]) -> String {
+fn timing_json(method: primm_core::mode::Method, step_ns: &mut [u64]) -> String {
     step_ns.sort_unstable();
     let total_ns: u64 = step_ns.iter().sum();
     let percentile = |q: f64| -> f64 {

@@ -9,13 +9,13 @@ use std::process::ExitCode;
 #[command(name = "primm-subscriber", version)]
 struct Cli {
     #[command(flatten)]
-    args: primm::cli::subscribe::Args,
+    args: primm_subscriber::Args,
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    primm::cli::init_logging();
-    match primm::cli::subscribe::run(cli.args) {
+    primm_service::logging::init_logging();
+    match primm_subscriber::run(cli.args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
             eprintln!("error: {error}");

@@ -2,8 +2,8 @@
 #![allow(dead_code)]
 
 use nalgebra::{SMatrix, SVector};
-use primm::config::Config;
-use primm::measurement::{Measurement, ObjectClass};
+use primm_core::config::Config;
+use primm_core::measurement::{Measurement, ObjectClass};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -81,7 +81,7 @@ pub fn straight_turn_straight(
     out
 }
 
-use primm::measurement::Frame;
+use primm_core::measurement::Frame;
 
 /// A moving object of a hand-built scene: constant velocity from `start`.
 #[derive(Debug, Clone, Copy)]
@@ -155,12 +155,12 @@ pub struct LaneOracle {
     pub objects: Vec<SceneObject>,
 }
 
-impl primm::predictor::DisplacementPredictor for LaneOracle {
-    fn submit(&mut self, _requests: &[primm::predictor::PredictionRequest]) {}
+impl primm_core::predictor::DisplacementPredictor for LaneOracle {
+    fn submit(&mut self, _requests: &[primm_core::predictor::PredictionRequest]) {}
     fn collect(&mut self, _displacements: &mut [Option<glam::DVec2>]) {}
     fn predict(
         &mut self,
-        requests: &[primm::predictor::PredictionRequest],
+        requests: &[primm_core::predictor::PredictionRequest],
         displacements: &mut [Option<glam::DVec2>],
     ) {
         for (request, out) in requests.iter().zip(displacements.iter_mut()) {

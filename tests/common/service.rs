@@ -7,10 +7,10 @@ use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
-use primm::measurement::Frame;
-use primm::service::catalog::{self, Ipc, ServiceNames};
-use primm::service::clock::monotonic_ns;
-use primm::wire::{
+use primm_core::measurement::Frame;
+use primm_service::catalog::{self, Ipc, ServiceNames};
+use primm_service::clock::monotonic_ns;
+use primm_wire::{
     MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, TrackFrame, WireMeasurement,
 };
 use std::process::{Child, Command, Stdio};

@@ -1,0 +1,136 @@
+//! # primm-config: the tracker configuration as a TOML file
+//!
+//! `primm-core` keeps its [`Config`] a plain, validated value so that it needs no parser. This
+//! crate reads the TOML form of it: [`from_toml_str`] and [`from_file`] parse, reject unknown
+//! keys and values of the wrong type, then run [`Config::validate`], whose error names the
+//! offending key. [`DEFAULT_CONFIG_TOML`] is the documented default file,
+//! `config/primm.toml`, embedded; a test checks that it parses to exactly
+//! [`Config::default`].
+//!
+//! ```
+//! let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 6.0", "gate_m = 4.5");
+//! let config = primm_config::from_toml_str(&text)?;
+//! assert_eq!(config.classes.car.gate_m, 4.5);
+//!
+//! let error = primm_config::from_toml_str(&text.replace("gate_m = 4.5", "gate_m = -1.0"));
+//! assert!(error.unwrap_err().to_string().contains("classes.car.gate_m"));
+//! # Ok::<(), primm_config::ConfigError>(())
+//! ```
+
+use primm_core::config::Config;
+use std::path::Path;
+
+/// The default configuration file (`config/primm.toml`), embedded.
+pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../../config/primm.toml");
+
+/// A configuration that could not be read, parsed or validated.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The configuration file could not be read.
+    #[error("cannot read configuration file {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The TOML is malformed, a key is unknown or a value has the wrong type.
+    #[error("configuration is not valid TOML for primm: {0}")]
+    Parse(#[from] toml::de::Error),
+    /// A value is out of its valid range; the error names the key.
+    #[error(transparent)]
+    Invalid(#[from] primm_core::config::ConfigError),
+}
+
+/// Parses and validates a TOML document.
+pub fn from_toml_str(text: &str) -> Result<Config, ConfigError> {
+    let config: Config = toml::from_str(text)?;
+    config.validate()?;
+    Ok(config)
+}
+
+/// Reads, parses and validates a TOML file.
+pub fn from_file(path: &Path) -> Result<Config, ConfigError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| ConfigError::Io { path: path.display().to_string(), source })?;
+    from_toml_str(&text)
+}
+
+/// Writes a configuration as a TOML document that [`from_toml_str`] reads back unchanged.
+pub fn to_toml_string(config: &Config) -> Result<String, toml::ser::Error> {
+    toml::to_string(config)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use primm_core::config::PredictorConfig;
+
+    fn invalid_key(text: &str) -> String {
+        match from_toml_str(text) {
+            Err(ConfigError::Invalid(primm_core::config::ConfigError::Invalid { key, .. })) => key,
+            other => panic!("expected an invalid-key error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn the_embedded_file_parses_to_exactly_the_core_defaults() {
+        assert_eq!(from_toml_str(DEFAULT_CONFIG_TOML).unwrap(), Config::default());
+    }
+
+    #[test]
+    fn a_configuration_survives_a_round_trip_through_toml() {
+        let mut config = Config::default();
+        config.classes.pedestrian.gate_m = 2.25;
+        let text = to_toml_string(&config).unwrap();
+        assert_eq!(from_toml_str(&text).unwrap(), config);
+    }
+
+    #[test]
+    fn a_transition_row_that_does_not_sum_to_one_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replace("[0.01, 0.97, 0.01, 0.01]", "[0.01, 0.96, 0.01, 0.01]");
+        assert_eq!(invalid_key(&text), "imm.transition[1]");
+    }
+
+    #[test]
+    fn an_asymmetric_covariance_is_named() {
+        let text = DEFAULT_CONFIG_TOML.replacen(
+            "measurement_noise_covariance_m2 = [[0.09, 0.0], [0.0, 0.09]]",
+            "measurement_noise_covariance_m2 = [[0.09, 0.01], [0.0, 0.09]]",
+            1,
+        );
+        assert_eq!(invalid_key(&text), "classes.pedestrian.measurement_noise_covariance_m2");
+    }
+
+    #[test]
+    fn an_unknown_key_is_a_parse_error_that_names_it() {
+        let text = DEFAULT_CONFIG_TOML.replace("gate_m = 6.0", "gate_m = 6.0\ngate_meters = 1.0");
+        let error = from_toml_str(&text).unwrap_err();
+        assert!(matches!(error, ConfigError::Parse(_)), "{error:?}");
+        assert!(error.to_string().contains("gate_meters"), "{error}");
+    }
+
+    #[test]
+    fn an_empty_mode_set_is_rejected() {
+        let text = DEFAULT_CONFIG_TOML.replace(r#"modes = ["pr", "cv", "ca", "ct"]"#, "modes = []");
+        assert_eq!(invalid_key(&text), "imm.modes");
+    }
+
+    #[test]
+    fn a_missing_predictor_section_takes_the_default_and_a_bad_deadline_is_named() {
+        let start = DEFAULT_CONFIG_TOML.find("[predictor]").unwrap();
+        let end = DEFAULT_CONFIG_TOML.find("[classes.car]").unwrap();
+        let without = format!("{}{}", &DEFAULT_CONFIG_TOML[..start], &DEFAULT_CONFIG_TOML[end..]);
+        assert_eq!(from_toml_str(&without).unwrap().predictor, PredictorConfig::default());
+        for bad in ["0.0", "-1.0", "nan", "5000.0"] {
+            let text = DEFAULT_CONFIG_TOML.replace("deadline_ms = 5.0", &format!("deadline_ms = {bad}"));
+            assert_eq!(invalid_key(&text), "predictor.deadline_ms", "deadline {bad}");
+        }
+    }
+
+    #[test]
+    fn a_missing_file_names_the_file() {
+        let error = from_file(Path::new("/nonexistent/primm.toml")).unwrap_err();
+        assert!(error.to_string().contains("/nonexistent/primm.toml"), "{error}");
+    }
+}

@@ -1,0 +1,538 @@
+//! All tracker parameters in one validated structure.
+//!
+//! Units are part of every key's name. [`Config::default`] holds the values of the documented
+//! file `config/primm.toml`; `primm-config` reads TOML files into a [`Config`] and a test there
+//! checks that the file and the defaults here are equal. [`Config::validate`] checks every
+//! value and names the offending key.
+
+use crate::measurement::ObjectClass;
+use crate::mode::{ModeSet, MODE_COUNT};
+use alloc::format;
+use alloc::string::String;
+use nalgebra::Matrix2;
+
+/// A 2×2 covariance as written in TOML (`[[xx, xy], [yx, yy]]`), m².
+pub type Covariance2 = [[f64; 2]; 2];
+
+/// Complete tracker configuration.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct Config {
+    /// Mode set, transition matrix and mode-probability settings.
+    pub imm: ImmConfig,
+    /// Association cost settings (`eq:association_cost`).
+    pub association: AssociationConfig,
+    /// Frame validation and track lifecycle.
+    pub tracker: TrackerConfig,
+    /// Per-class parameters.
+    pub classes: ClassTable,
+    /// How the service runs the learned predictor (absent: the defaults).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub predictor: PredictorConfig,
+}
+
+/// Runtime of the learned predictor in the tracking service (`primm serve`): the model runs on
+/// a dedicated inference thread while the tracker predicts the physics modes, and the tracker
+/// waits for its batch at most this long. Offline tracking (`primm track`, `primm eval`) runs
+/// the model synchronously and ignores the deadline, so that its results do not depend on
+/// timing.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct PredictorConfig {
+    /// Longest wait for a frame's learned displacements, measured from the moment the batch is
+    /// handed to the inference thread, ms. A frame whose batch is late is tracked without the
+    /// PR mode (it sits the frame out; see `src/imm.rs`).
+    pub deadline_ms: f64,
+}
+
+impl Default for PredictorConfig {
+    fn default() -> Self {
+        Self { deadline_ms: 5.0 }
+    }
+}
+
+impl PredictorConfig {
+    /// The deadline as a duration.
+    pub fn deadline(&self) -> core::time::Duration {
+        core::time::Duration::from_secs_f64(self.deadline_ms / 1000.0)
+    }
+}
+
+/// IMM settings (paper, Sections III-D and III-F).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct ImmConfig {
+    /// Active modes.
+    pub modes: ModeSet,
+    /// Mode-transition probabilities `π[i][j]`, order PR, CV, CA, CT; rows sum to 1.
+    pub transition: [[f64; MODE_COUNT]; MODE_COUNT],
+    /// Mode probabilities of a new track (renormalised over the active modes).
+    pub initial_mode_probabilities: [f64; MODE_COUNT],
+    /// Exponent `τ` on the likelihoods in `eq:mode_update`; must be > 0.
+    pub likelihood_temperature: f64,
+    /// Lower bound on every active mode's probability; in `[0, 1/modes)`.
+    pub mode_probability_floor: f64,
+}
+
+/// Association cost settings.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct AssociationConfig {
+    /// `λ_v`, metres of cost per m/s of radial-velocity difference (i.e. seconds).
+    pub velocity_weight_s: f64,
+    /// `v_max`, cap on the radial-velocity difference, m/s.
+    pub velocity_cap_mps: f64,
+}
+
+/// Frame validation and track lifecycle settings.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct TrackerConfig {
+    /// Largest accepted time between consecutive frames, s.
+    pub max_frame_interval_s: f64,
+    /// Hits that confirm a tentative track.
+    pub confirmation_hits: u32,
+    /// Consecutive misses after which a tentative track is deleted.
+    pub tentative_max_misses: u32,
+    /// Longest time a tentative track may coast without an update before it is deleted, s.
+    pub tentative_max_coast_s: f64,
+    /// Consecutive misses after which a confirmed track is deleted.
+    pub confirmed_max_misses: u32,
+    /// Longest time a track may coast without an update before it is deleted, s.
+    pub max_coast_s: f64,
+}
+
+/// Per-class parameter sections.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct ClassTable {
+    /// Cars (and large vehicles).
+    pub car: ClassConfig,
+    /// Pedestrians (and groups).
+    pub pedestrian: ClassConfig,
+    /// Two-wheelers.
+    pub two_wheeler: ClassConfig,
+}
+
+impl ClassTable {
+    /// The section of `class`.
+    pub fn get(&self, class: ObjectClass) -> &ClassConfig {
+        match class {
+            ObjectClass::Car => &self.car,
+            ObjectClass::Pedestrian => &self.pedestrian,
+            ObjectClass::TwoWheeler => &self.two_wheeler,
+        }
+    }
+}
+
+/// Parameters of one object class.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct ClassConfig {
+    /// Association gate on the cost of `eq:association_cost`, m.
+    pub gate_m: f64,
+    /// Measurement noise covariance `R` of the CV, CA and CT modes, m².
+    pub measurement_noise_covariance_m2: Covariance2,
+    /// Standard deviation of the measured radial velocity, m/s.
+    pub radial_velocity_std_mps: f64,
+    /// Standard deviation of the velocity across the line of sight at initiation, m/s.
+    pub initial_tangential_speed_std_mps: f64,
+    /// Constant-velocity mode.
+    pub constant_velocity: ConstantVelocityConfig,
+    /// Constant-acceleration mode.
+    pub constant_acceleration: ConstantAccelerationConfig,
+    /// Coordinated-turn mode.
+    pub coordinated_turn: CoordinatedTurnConfig,
+    /// Learned-predictor (PR) mode.
+    pub learned: LearnedConfig,
+}
+
+/// Constant-velocity noise.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct ConstantVelocityConfig {
+    /// Power spectral density of the continuous white-noise acceleration, m²/s³.
+    pub acceleration_psd_m2_per_s3: f64,
+}
+
+/// Constant-acceleration noise and initiation.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct ConstantAccelerationConfig {
+    /// Power spectral density of the continuous white-noise jerk, m²/s⁵.
+    pub jerk_psd_m2_per_s5: f64,
+    /// Standard deviation of the initial acceleration, m/s².
+    pub initial_acceleration_std_mps2: f64,
+}
+
+/// Coordinated-turn noise and initiation.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct CoordinatedTurnConfig {
+    /// Power spectral density of the continuous white-noise acceleration, m²/s³.
+    pub acceleration_psd_m2_per_s3: f64,
+    /// Power spectral density of the turn-rate random walk, rad²/s³.
+    pub turn_rate_psd_rad2_per_s3: f64,
+    /// Standard deviation of the initial turn rate, rad/s.
+    pub initial_turn_rate_std_radps: f64,
+}
+
+/// Learned-predictor (PR) noise (`eq:pr_cov`).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct LearnedConfig {
+    /// `Q_PR`, added to the PR covariance at every prediction, m².
+    pub process_noise_covariance_m2: Covariance2,
+    /// `R_PR`, measurement noise covariance of the PR mode, m².
+    pub measurement_noise_covariance_m2: Covariance2,
+}
+
+/// An invalid configuration value.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ConfigError {
+    /// A value is out of its valid range.
+    #[error("configuration key `{key}` is invalid: {reason}")]
+    Invalid {
+        /// Dotted path of the key, e.g. `classes.car.gate_m`.
+        key: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+}
+
+impl Default for Config {
+    /// The values of `config/primm.toml`.
+    fn default() -> Self {
+        let off = 0.01;
+        let stay = 0.97;
+        Config {
+            imm: ImmConfig {
+                modes: ModeSet::ALL,
+                transition: [
+                    [stay, off, off, off],
+                    [off, stay, off, off],
+                    [off, off, stay, off],
+                    [off, off, off, stay],
+                ],
+                initial_mode_probabilities: [0.25; MODE_COUNT],
+                likelihood_temperature: 0.1,
+                mode_probability_floor: 0.001,
+            },
+            association: AssociationConfig { velocity_weight_s: 0.1, velocity_cap_mps: 5.0 },
+            tracker: TrackerConfig {
+                max_frame_interval_s: 1.0,
+                confirmation_hits: 3,
+                tentative_max_misses: 20,
+                tentative_max_coast_s: 0.3,
+                confirmed_max_misses: 100,
+                max_coast_s: 1.0,
+            },
+            classes: ClassTable {
+                car: ClassConfig {
+                    gate_m: 6.0,
+                    measurement_noise_covariance_m2: diagonal(0.36, 0.36),
+                    radial_velocity_std_mps: 0.5,
+                    initial_tangential_speed_std_mps: 8.0,
+                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 4.0 },
+                    constant_acceleration: ConstantAccelerationConfig {
+                        jerk_psd_m2_per_s5: 20.0,
+                        initial_acceleration_std_mps2: 2.0,
+                    },
+                    coordinated_turn: CoordinatedTurnConfig {
+                        acceleration_psd_m2_per_s3: 2.0,
+                        turn_rate_psd_rad2_per_s3: 0.3,
+                        initial_turn_rate_std_radps: 0.3,
+                    },
+                    learned: LearnedConfig {
+                        process_noise_covariance_m2: diagonal(0.01, 0.017),
+                        measurement_noise_covariance_m2: diagonal(0.36, 0.36),
+                    },
+                },
+                pedestrian: ClassConfig {
+                    gate_m: 3.0,
+                    measurement_noise_covariance_m2: diagonal(0.09, 0.09),
+                    radial_velocity_std_mps: 0.3,
+                    initial_tangential_speed_std_mps: 1.5,
+                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
+                    constant_acceleration: ConstantAccelerationConfig {
+                        jerk_psd_m2_per_s5: 5.0,
+                        initial_acceleration_std_mps2: 1.0,
+                    },
+                    coordinated_turn: CoordinatedTurnConfig {
+                        acceleration_psd_m2_per_s3: 0.5,
+                        turn_rate_psd_rad2_per_s3: 1.0,
+                        initial_turn_rate_std_radps: 0.5,
+                    },
+                    learned: LearnedConfig {
+                        process_noise_covariance_m2: diagonal(0.008, 0.0025),
+                        measurement_noise_covariance_m2: diagonal(0.09, 0.09),
+                    },
+                },
+                two_wheeler: ClassConfig {
+                    gate_m: 4.0,
+                    measurement_noise_covariance_m2: diagonal(0.16, 0.16),
+                    radial_velocity_std_mps: 0.4,
+                    initial_tangential_speed_std_mps: 5.0,
+                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 3.0 },
+                    constant_acceleration: ConstantAccelerationConfig {
+                        jerk_psd_m2_per_s5: 15.0,
+                        initial_acceleration_std_mps2: 1.5,
+                    },
+                    coordinated_turn: CoordinatedTurnConfig {
+                        acceleration_psd_m2_per_s3: 1.5,
+                        turn_rate_psd_rad2_per_s3: 0.5,
+                        initial_turn_rate_std_radps: 0.4,
+                    },
+                    learned: LearnedConfig {
+                        process_noise_covariance_m2: diagonal(0.05, 0.05),
+                        measurement_noise_covariance_m2: diagonal(0.16, 0.16),
+                    },
+                },
+            },
+            predictor: PredictorConfig::default(),
+        }
+    }
+}
+
+/// A diagonal 2×2 covariance.
+fn diagonal(xx: f64, yy: f64) -> Covariance2 {
+    [[xx, 0.0], [0.0, yy]]
+}
+
+fn invalid(key: impl Into<String>, reason: impl Into<String>) -> ConfigError {
+    ConfigError::Invalid { key: key.into(), reason: reason.into() }
+}
+
+fn positive(key: &str, value: f64) -> Result<(), ConfigError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(invalid(key, format!("must be a finite number > 0, got {value}")))
+    }
+}
+
+/// Checks that a 2×2 covariance is finite, symmetric and positive definite.
+fn covariance(key: &str, value: &Covariance2) -> Result<(), ConfigError> {
+    let m = to_matrix(value);
+    if m.iter().any(|v| !v.is_finite()) {
+        return Err(invalid(key, "entries must be finite"));
+    }
+    if (m[(0, 1)] - m[(1, 0)]).abs() > 1e-12 * m.abs().max().max(1.0) {
+        return Err(invalid(key, "must be symmetric"));
+    }
+    if m[(0, 0)] <= 0.0 || m.determinant() <= 0.0 {
+        return Err(invalid(key, "must be positive definite"));
+    }
+    Ok(())
+}
+
+/// A TOML covariance as a nalgebra matrix.
+pub fn to_matrix(value: &Covariance2) -> Matrix2<f64> {
+    Matrix2::new(value[0][0], value[0][1], value[1][0], value[1][1])
+}
+
+impl Config {
+    /// This configuration with another set of active modes.
+    pub fn with_modes(mut self, modes: ModeSet) -> Self {
+        self.imm.modes = modes;
+        self
+    }
+
+    /// Checks every value; the error names the first offending key.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let imm = &self.imm;
+        if imm.modes.is_empty() {
+            return Err(invalid("imm.modes", "at least one mode must be active"));
+        }
+        for (i, row) in imm.transition.iter().enumerate() {
+            for (j, &p) in row.iter().enumerate() {
+                if !(0.0..=1.0).contains(&p) {
+                    return Err(invalid(
+                        format!("imm.transition[{i}][{j}]"),
+                        format!("must be a probability in [0, 1], got {p}"),
+                    ));
+                }
+            }
+            let sum: f64 = row.iter().sum();
+            if (sum - 1.0).abs() > 1e-9 {
+                return Err(invalid(
+                    format!("imm.transition[{i}]"),
+                    format!("row must sum to 1, sums to {sum}"),
+                ));
+            }
+        }
+        for mode in imm.modes.iter() {
+            let i = mode.index();
+            let active_sum: f64 = imm.modes.iter().map(|to| imm.transition[i][to.index()]).sum();
+            if active_sum <= 0.0 {
+                return Err(invalid(
+                    format!("imm.transition[{i}]"),
+                    "row has no probability mass on the active modes",
+                ));
+            }
+        }
+        for (i, &p) in imm.initial_mode_probabilities.iter().enumerate() {
+            if !(0.0..=1.0).contains(&p) {
+                return Err(invalid(
+                    format!("imm.initial_mode_probabilities[{i}]"),
+                    format!("must be a probability in [0, 1], got {p}"),
+                ));
+            }
+        }
+        if imm.modes.iter().map(|m| imm.initial_mode_probabilities[m.index()]).sum::<f64>() <= 0.0 {
+            return Err(invalid("imm.initial_mode_probabilities", "no probability mass on the active modes"));
+        }
+        positive("imm.likelihood_temperature", imm.likelihood_temperature)?;
+        let floor = imm.mode_probability_floor;
+        if !(floor >= 0.0 && floor < 1.0 / imm.modes.len() as f64) {
+            return Err(invalid(
+                "imm.mode_probability_floor",
+                format!("must be in [0, 1/number of active modes), got {floor}"),
+            ));
+        }
+        if !(self.association.velocity_weight_s.is_finite() && self.association.velocity_weight_s >= 0.0) {
+            return Err(invalid("association.velocity_weight_s", "must be a finite number >= 0"));
+        }
+        if !(self.association.velocity_cap_mps.is_finite() && self.association.velocity_cap_mps >= 0.0) {
+            return Err(invalid("association.velocity_cap_mps", "must be a finite number >= 0"));
+        }
+        let tracker = &self.tracker;
+        positive("tracker.max_frame_interval_s", tracker.max_frame_interval_s)?;
+        positive("predictor.deadline_ms", self.predictor.deadline_ms)?;
+        if self.predictor.deadline_ms > 1000.0 {
+            return Err(invalid("predictor.deadline_ms", "must be at most 1000 ms (one second)"));
+        }
+        positive("tracker.max_coast_s", tracker.max_coast_s)?;
+        positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
+        if tracker.confirmation_hits == 0 {
+            return Err(invalid("tracker.confirmation_hits", "must be at least 1"));
+        }
+        for class in ObjectClass::ALL {
+            let section = self.classes.get(class);
+            let key = |name: &str| format!("classes.{}.{}", class.name(), name);
+            positive(&key("gate_m"), section.gate_m)?;
+            covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
+            positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
+            positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
+            positive(
+                &key("constant_velocity.acceleration_psd_m2_per_s3"),
+                section.constant_velocity.acceleration_psd_m2_per_s3,
+            )?;
+            positive(
+                &key("constant_acceleration.jerk_psd_m2_per_s5"),
+                section.constant_acceleration.jerk_psd_m2_per_s5,
+            )?;
+            positive(
+                &key("constant_acceleration.initial_acceleration_std_mps2"),
+                section.constant_acceleration.initial_acceleration_std_mps2,
+            )?;
+            positive(
+                &key("coordinated_turn.acceleration_psd_m2_per_s3"),
+                section.coordinated_turn.acceleration_psd_m2_per_s3,
+            )?;
+            positive(
+                &key("coordinated_turn.turn_rate_psd_rad2_per_s3"),
+                section.coordinated_turn.turn_rate_psd_rad2_per_s3,
+            )?;
+            positive(
+                &key("coordinated_turn.initial_turn_rate_std_radps"),
+                section.coordinated_turn.initial_turn_rate_std_radps,
+            )?;
+            covariance(
+                &key("learned.process_noise_covariance_m2"),
+                &section.learned.process_noise_covariance_m2,
+            )?;
+            covariance(
+                &key("learned.measurement_noise_covariance_m2"),
+                &section.learned.measurement_noise_covariance_m2,
+            )?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn invalid_key(config: &Config) -> String {
+        match config.validate() {
+            Err(ConfigError::Invalid { key, .. }) => key,
+            Ok(()) => panic!("expected an invalid-key error"),
+        }
+    }
+
+    #[test]
+    fn the_default_configuration_is_valid() {
+        Config::default().validate().unwrap();
+    }
+
+    #[test]
+    fn a_transition_row_that_does_not_sum_to_one_is_named() {
+        let mut config = Config::default();
+        config.imm.transition[1][1] = 0.96;
+        assert_eq!(invalid_key(&config), "imm.transition[1]");
+    }
+
+    #[test]
+    fn a_negative_probability_is_named() {
+        let mut config = Config::default();
+        config.imm.transition[0] = [1.01, -0.01, 0.0, 0.0];
+        assert_eq!(invalid_key(&config), "imm.transition[0][0]");
+    }
+
+    #[test]
+    fn a_non_positive_temperature_is_named() {
+        let mut config = Config::default();
+        config.imm.likelihood_temperature = 0.0;
+        assert_eq!(invalid_key(&config), "imm.likelihood_temperature");
+    }
+
+    #[test]
+    fn an_asymmetric_covariance_is_named() {
+        let mut config = Config::default();
+        config.classes.pedestrian.measurement_noise_covariance_m2 = [[0.09, 0.01], [0.0, 0.09]];
+        assert_eq!(invalid_key(&config), "classes.pedestrian.measurement_noise_covariance_m2");
+    }
+
+    #[test]
+    fn an_indefinite_covariance_is_named() {
+        let mut config = Config::default();
+        config.classes.car.learned.process_noise_covariance_m2 = [[0.01, 0.5], [0.5, 0.017]];
+        assert_eq!(invalid_key(&config), "classes.car.learned.process_noise_covariance_m2");
+    }
+
+    #[test]
+    fn a_floor_too_high_for_the_mode_count_is_named() {
+        let mut config = Config::default();
+        config.imm.mode_probability_floor = 0.3;
+        assert_eq!(invalid_key(&config), "imm.mode_probability_floor");
+    }
+
+    #[test]
+    fn an_empty_mode_set_is_rejected() {
+        let config = Config::default().with_modes(ModeSet::EMPTY);
+        assert_eq!(invalid_key(&config), "imm.modes");
+    }
+
+    #[test]
+    fn a_non_positive_or_huge_predictor_deadline_is_rejected() {
+        for bad in [0.0, -1.0, f64::NAN, 5000.0] {
+            let mut config = Config::default();
+            config.predictor.deadline_ms = bad;
+            assert_eq!(invalid_key(&config), "predictor.deadline_ms", "deadline {bad}");
+        }
+        assert_eq!(Config::default().predictor.deadline(), core::time::Duration::from_millis(5));
+    }
+}

@@ -1,0 +1,432 @@
+//! Gaussian mode estimates on the stack and the shared position-space machinery.
+//!
+//! Every mode's state puts the 2-D position first, so the observation matrix is `H = [I₂ 0]`
+//! for all of them (`eq:observation`) and the functions here are written once for every state
+//! size `N`:
+//!
+//! * [`Gaussian::position`] projects a mode onto the shared position space (`Hx`, `HPHᵀ`);
+//! * [`replace_position`] puts a mixed position back into a mode while keeping the mode's own
+//!   non-position states and their conditional distribution (`eq:cov_partition` … `eq:reconstructed_cov`);
+//! * [`kalman_update`] is the measurement update with the Joseph-form covariance and the
+//!   Gaussian log-likelihood (`eq:innovation` … `eq:posterior_cov`, `eq:likelihood`).
+//!
+//! Nothing here allocates: all matrices are `nalgebra` static matrices.
+
+use glam::{DMat2, DVec2};
+use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+
+/// `ln(2π)`, used by the bivariate Gaussian log-density.
+const LN_TWO_PI: f64 = 1.837_877_066_409_345_5;
+
+/// Relative threshold under which singular values of a position covariance are treated as zero
+/// by the pseudo-inverse in [`replace_position`].
+pub const PSEUDO_INVERSE_RELATIVE_TOLERANCE: f64 = 1e-12;
+
+/// A mode's estimate: mean and covariance, position first.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gaussian<const N: usize> {
+    /// State mean; elements 0 and 1 are the x and y position in metres.
+    pub mean: SVector<f64, N>,
+    /// State covariance (units: squares of the state's units).
+    pub covariance: SMatrix<f64, N, N>,
+}
+
+/// The position marginal of an estimate: what the IMM mixes and fuses.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PositionEstimate {
+    /// Position, metres.
+    pub mean: DVec2,
+    /// Position covariance, m².
+    pub covariance: DMat2,
+}
+
+impl<const N: usize> Default for Gaussian<N> {
+    /// Zero mean and zero covariance (a placeholder for preallocated storage).
+    fn default() -> Self {
+        Self { mean: SVector::zeros(), covariance: SMatrix::zeros() }
+    }
+}
+
+impl<const N: usize> Gaussian<N> {
+    /// A Gaussian from its parts.
+    pub fn new(mean: SVector<f64, N>, covariance: SMatrix<f64, N, N>) -> Self {
+        Self { mean, covariance }
+    }
+
+    /// The position marginal `(Hx, HPHᵀ)` with `H = [I₂ 0]`.
+    pub fn position(&self) -> PositionEstimate {
+        PositionEstimate {
+            mean: DVec2::new(self.mean[0], self.mean[1]),
+            covariance: to_glam(&self.position_covariance()),
+        }
+    }
+
+    /// The 2×2 position block `P_pp` of the covariance.
+    pub fn position_covariance(&self) -> Matrix2<f64> {
+        self.covariance.fixed_view::<2, 2>(0, 0).into_owned()
+    }
+}
+
+/// Converts a nalgebra 2×2 matrix to glam.
+pub fn to_glam(m: &Matrix2<f64>) -> DMat2 {
+    DMat2::from_cols(DVec2::new(m[(0, 0)], m[(1, 0)]), DVec2::new(m[(0, 1)], m[(1, 1)]))
+}
+
+/// Converts a glam 2×2 matrix to nalgebra.
+pub fn to_nalgebra(m: &DMat2) -> Matrix2<f64> {
+    Matrix2::new(m.x_axis.x, m.y_axis.x, m.x_axis.y, m.y_axis.y)
+}
+
+/// Moore–Penrose pseudo-inverse of a symmetric positive semi-definite 2×2 matrix, in closed
+/// form. Full rank (the determinant above `PSEUDO_INVERSE_RELATIVE_TOLERANCE` × trace²): the
+/// ordinary inverse. Rank one (`M = λvvᵀ`, `λ` = trace): `M / λ²`. Zero: zero.
+#[inline]
+pub fn symmetric_pseudo_inverse(m: &Matrix2<f64>) -> Matrix2<f64> {
+    let (a, b, d) = (m[(0, 0)], 0.5 * (m[(0, 1)] + m[(1, 0)]), m[(1, 1)]);
+    let trace = a + d;
+    let determinant = a * d - b * b;
+    if determinant > PSEUDO_INVERSE_RELATIVE_TOLERANCE * trace * trace {
+        Matrix2::new(d, -b, -b, a) / determinant
+    } else if trace > 0.0 {
+        Matrix2::new(a, b, b, d) / (trace * trace)
+    } else {
+        Matrix2::zeros()
+    }
+}
+
+/// Replaces a mode's position marginal by a mixed one (`eq:mixed_state`, `eq:B`, `eq:C`,
+/// `eq:reconstructed_cov`).
+///
+/// With the covariance partitioned into position `p` and the mode's other states `h`
+/// (`eq:cov_partition`), `B = P_hp P_pp^†` and `C = P_hh − B P_pp Bᵀ`; the new covariance is
+/// `[[P̄, P̄Bᵀ], [BP̄, C + BP̄Bᵀ]]`. The mean's position becomes `p̄` and the non-position mean
+/// keeps the mode's own value, exactly as the paper writes it. The conditional distribution of
+/// `h` given the position (gain `B`, covariance `C`) is therefore unchanged.
+#[inline(always)]
+pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &PositionEstimate) {
+    let p_pp = gaussian.position_covariance();
+    let p_pp_pinv = symmetric_pseudo_inverse(&p_pp);
+    let p_bar = to_nalgebra(&mixed.covariance);
+    let p = &mut gaussian.covariance;
+    // The blocks of eq:reconstructed_cov, written out so that only O(N²) products remain:
+    // top-left P̄; off-diagonal B P̄; bottom-right C + B P̄ Bᵀ = P_hh + B (P̄ − P_pp) Bᵀ,
+    // with B = P_hp P_pp^† in rows 2.. of `b`.
+    let mut b = SMatrix::<f64, N, 2>::zeros();
+    for r in 2..N {
+        for c in 0..2 {
+            b[(r, c)] = p[(r, 0)] * p_pp_pinv[(0, c)] + p[(r, 1)] * p_pp_pinv[(1, c)];
+        }
+    }
+    let p_bar_01 = 0.5 * (p_bar[(0, 1)] + p_bar[(1, 0)]);
+    let delta = [
+        [p_bar[(0, 0)] - p_pp[(0, 0)], p_bar_01 - 0.5 * (p_pp[(0, 1)] + p_pp[(1, 0)])],
+        [0.0, p_bar[(1, 1)] - p_pp[(1, 1)]],
+    ];
+    // Written in place: row r's pass reads the position columns only through `b` (computed
+    // above) and reads P_hh entries (r, c) and (c, r) with c ≥ r, none of which an earlier
+    // row's pass has written.
+    p[(0, 0)] = p_bar[(0, 0)];
+    p[(1, 1)] = p_bar[(1, 1)];
+    p[(0, 1)] = p_bar_01;
+    p[(1, 0)] = p_bar_01;
+    for r in 2..N {
+        let (b0, b1) = (b[(r, 0)], b[(r, 1)]);
+        // Row r of B P̄ (P̄ symmetric).
+        let cross0 = b0 * p_bar[(0, 0)] + b1 * p_bar_01;
+        let cross1 = b0 * p_bar_01 + b1 * p_bar[(1, 1)];
+        p[(r, 0)] = cross0;
+        p[(0, r)] = cross0;
+        p[(r, 1)] = cross1;
+        p[(1, r)] = cross1;
+        // Row r of B Δ (Δ symmetric).
+        let (d0, d1) = (b0 * delta[0][0] + b1 * delta[0][1], b0 * delta[0][1] + b1 * delta[1][1]);
+        for c in r..N {
+            let value = 0.5 * (p[(r, c)] + p[(c, r)]) + d0 * b[(c, 0)] + d1 * b[(c, 1)];
+            p[(r, c)] = value;
+            p[(c, r)] = value;
+        }
+    }
+    gaussian.mean[0] = mixed.mean.x;
+    gaussian.mean[1] = mixed.mean.y;
+}
+
+/// Makes a covariance exactly symmetric by averaging it with its transpose.
+#[inline]
+pub fn symmetrize<const N: usize>(m: &mut SMatrix<f64, N, N>) {
+    for r in 0..N {
+        for c in (r + 1)..N {
+            let mean = 0.5 * (m[(r, c)] + m[(c, r)]);
+            m[(r, c)] = mean;
+            m[(c, r)] = mean;
+        }
+    }
+}
+
+/// The result of one Kalman measurement update of a mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KalmanUpdate<const N: usize> {
+    /// Posterior estimate (`eq:posterior_state`, `eq:posterior_cov`).
+    pub posterior: Gaussian<N>,
+    /// Innovation `ν = z − Hx⁻` (`eq:innovation`), metres.
+    pub innovation: Vector2<f64>,
+    /// Innovation covariance `S = HP⁻Hᵀ + R` (`eq:innovation_cov`), m².
+    pub innovation_covariance: Matrix2<f64>,
+    /// Natural log of the Gaussian likelihood `Λ` (`eq:likelihood`).
+    pub log_likelihood: f64,
+}
+
+/// A Kalman update failed because the innovation covariance is not positive definite or a
+/// result is not finite; the prior is left untouched.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("innovation covariance is not positive definite or the update is not finite")]
+pub struct UpdateError;
+
+/// Kalman update of a mode with a position measurement `z` and measurement covariance `r`
+/// (`eq:innovation` … `eq:posterior_cov`): gain `K = P⁻Hᵀ S⁻¹`, mean `x⁻ + Kν`, Joseph-form
+/// covariance `(I − KH)P⁻(I − KH)ᵀ + KRKᵀ`, and `ln Λ = −½ νᵀS⁻¹ν − ln 2π − ½ ln|S|`.
+pub fn kalman_update<const N: usize>(
+    prior: &Gaussian<N>,
+    z: DVec2,
+    r: &Matrix2<f64>,
+) -> Result<KalmanUpdate<N>, UpdateError> {
+    let mut posterior = *prior;
+    let terms = kalman_update_into(prior, z, r, &mut posterior)?;
+    Ok(KalmanUpdate {
+        posterior,
+        innovation: terms.innovation,
+        innovation_covariance: terms.innovation_covariance,
+        log_likelihood: terms.log_likelihood,
+    })
+}
+
+/// The by-products of [`kalman_update_into`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UpdateTerms {
+    /// `ν = z − H x⁻`, m.
+    pub innovation: Vector2<f64>,
+    /// `S = H P⁻ Hᵀ + R`, m².
+    pub innovation_covariance: Matrix2<f64>,
+    /// `ln N(ν; 0, S)`.
+    pub log_likelihood: f64,
+}
+
+/// [`kalman_update`] written straight into `posterior` (no temporary copies of the state), for
+/// the hot path. On error `posterior` holds unspecified values and must be discarded.
+#[inline(always)]
+pub fn kalman_update_into<const N: usize>(
+    prior: &Gaussian<N>,
+    z: DVec2,
+    r: &Matrix2<f64>,
+    posterior: &mut Gaussian<N>,
+) -> Result<UpdateTerms, UpdateError> {
+    let p = &prior.covariance;
+    let innovation = Vector2::new(z.x - prior.mean[0], z.y - prior.mean[1]);
+    // S = H P Hᵀ + R is the top-left block plus R, symmetrised.
+    let (s00, s11) = (p[(0, 0)] + r[(0, 0)], p[(1, 1)] + r[(1, 1)]);
+    let s01 = 0.5 * (p[(0, 1)] + p[(1, 0)] + r[(0, 1)] + r[(1, 0)]);
+    let determinant = s00 * s11 - s01 * s01;
+    // Positive definite exactly when both leading minors are positive (Sylvester).
+    if !(s00 > 0.0 && determinant > 0.0) {
+        return Err(UpdateError);
+    }
+    let (i00, i01, i11) = (s11 / determinant, -s01 / determinant, s00 / determinant);
+    let mahalanobis_squared = innovation.x * (i00 * innovation.x + i01 * innovation.y)
+        + innovation.y * (i01 * innovation.x + i11 * innovation.y);
+    let log_likelihood = -0.5 * mahalanobis_squared - LN_TWO_PI - 0.5 * crate::math::ln(determinant);
+    if !log_likelihood.is_finite() {
+        return Err(UpdateError);
+    }
+
+    // K = P Hᵀ S⁻¹ (P Hᵀ is P's first two columns), and the first two columns of
+    // A = (I − KH)P = P − K·P[0..2, :].
+    let mut gain = [[0.0; 2]; N];
+    let mut a_left = [[0.0; 2]; N];
+    for row in 0..N {
+        let (p0, p1) = (p[(row, 0)], p[(row, 1)]);
+        let k = [p0 * i00 + p1 * i01, p0 * i01 + p1 * i11];
+        gain[row] = k;
+        a_left[row] =
+            [p0 - (k[0] * p[(0, 0)] + k[1] * p[(1, 0)]), p1 - (k[0] * p[(0, 1)] + k[1] * p[(1, 1)])];
+    }
+    // Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ with H = [I₂ 0], element by element in O(N²):
+    // A − A[:, 0..2]·Kᵀ + K R Kᵀ, where A = P − K·P[0..2, :]. Upper triangle, mirrored.
+    let (r00, r01, r10, r11) = (r[(0, 0)], r[(0, 1)], r[(1, 0)], r[(1, 1)]);
+    for column in 0..N {
+        let k = gain[column];
+        let (top0, top1) = (p[(0, column)], p[(1, column)]);
+        // Column `column` of R Kᵀ.
+        let (rk0, rk1) = (r00 * k[0] + r01 * k[1], r10 * k[0] + r11 * k[1]);
+        for row in 0..=column {
+            let g = gain[row];
+            let a = p[(row, column)] - (g[0] * top0 + g[1] * top1);
+            let value = a - (a_left[row][0] * k[0] + a_left[row][1] * k[1]) + (g[0] * rk0 + g[1] * rk1);
+            posterior.covariance[(row, column)] = value;
+            posterior.covariance[(column, row)] = value;
+        }
+    }
+    for row in 0..N {
+        let value = prior.mean[row] + gain[row][0] * innovation.x + gain[row][1] * innovation.y;
+        if !value.is_finite() {
+            return Err(UpdateError);
+        }
+        posterior.mean[row] = value;
+    }
+    Ok(UpdateTerms { innovation, innovation_covariance: Matrix2::new(s00, s01, s01, s11), log_likelihood })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Matrix4, Vector4};
+
+    fn spd4() -> Matrix4<f64> {
+        let a = Matrix4::new(1.0, 0.2, 0.1, 0.0, 0.3, 2.0, 0.0, 0.4, 0.0, 0.1, 1.5, 0.2, 0.1, 0.0, 0.3, 0.8);
+        a * a.transpose() + Matrix4::identity() * 0.1
+    }
+
+    #[test]
+    fn pseudo_inverse_equals_inverse_for_invertible_matrices() {
+        let m = Matrix2::new(2.0, 0.3, 0.3, 1.0);
+        let difference = symmetric_pseudo_inverse(&m) - m.try_inverse().unwrap();
+        assert!(difference.abs().max() < 1e-12);
+    }
+
+    #[test]
+    fn pseudo_inverse_of_a_rank_one_matrix_satisfies_the_penrose_conditions() {
+        let v = Vector2::new(1.0, 2.0);
+        let m = v * v.transpose();
+        let pinv = symmetric_pseudo_inverse(&m);
+        assert!((m * pinv * m - m).abs().max() < 1e-12);
+        assert!((pinv * m * pinv - pinv).abs().max() < 1e-12);
+    }
+
+    #[test]
+    fn closed_form_pseudo_inverse_matches_nalgebra_svd_on_full_rank_rank_one_and_zero_matrices() {
+        let mut cases =
+            vec![Matrix2::zeros(), Matrix2::new(4.0, 0.0, 0.0, 0.0), Matrix2::new(0.0, 0.0, 0.0, 2.5)];
+        for i in 0..200 {
+            let angle = f64::from(i) * 0.37;
+            let v = Vector2::new(angle.cos(), angle.sin());
+            let w = Vector2::new(-angle.sin(), angle.cos());
+            let (large, small) = (0.1 + f64::from(i % 7), [0.0, 1e-3, 0.5][i as usize % 3]);
+            cases.push(v * v.transpose() * large + w * w.transpose() * small);
+        }
+        for m in cases {
+            let reference = m.pseudo_inverse(1e-12).unwrap();
+            let ours = symmetric_pseudo_inverse(&m);
+            let scale = reference.abs().max().max(1.0);
+            assert!((ours - reference).abs().max() < 1e-9 * scale, "{m} -> {ours} vs {reference}");
+        }
+    }
+
+    #[test]
+    fn replacing_the_position_by_itself_changes_nothing() {
+        let mut g = Gaussian::new(Vector4::new(1.0, 2.0, 3.0, 4.0), spd4());
+        let before = g;
+        let own = g.position();
+        replace_position(&mut g, &own);
+        assert!((g.covariance - before.covariance).abs().max() < 1e-12);
+        assert_eq!(g.mean, before.mean);
+    }
+
+    #[test]
+    fn kalman_update_likelihood_matches_the_bivariate_normal_density() {
+        let prior = Gaussian::new(Vector4::new(0.0, 0.0, 1.0, 0.0), spd4());
+        let r = Matrix2::new(0.5, 0.1, 0.1, 0.4);
+        let z = DVec2::new(0.7, -0.3);
+        let update = kalman_update(&prior, z, &r).unwrap();
+        let s = prior.position_covariance() + r;
+        let nu = Vector2::new(0.7, -0.3);
+        let density = (-0.5 * (nu.transpose() * s.try_inverse().unwrap() * nu)[(0, 0)]).exp()
+            / (2.0 * core::f64::consts::PI * s.determinant().sqrt());
+        assert!((update.log_likelihood - density.ln()).abs() < 1e-12);
+    }
+
+    /// The textbook update with explicit `H`, `K = P Hᵀ S⁻¹` and the full Joseph product, in
+    /// nalgebra's general matrix arithmetic.
+    fn reference_update(
+        prior: &Gaussian<4>,
+        z: DVec2,
+        r: &Matrix2<f64>,
+    ) -> (Vector4<f64>, Matrix4<f64>, f64) {
+        let h = nalgebra::Matrix2x4::new(1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0);
+        let s = h * prior.covariance * h.transpose() + r;
+        let s_inverse = s.try_inverse().unwrap();
+        let k = prior.covariance * h.transpose() * s_inverse;
+        let nu = Vector2::new(z.x, z.y) - h * prior.mean;
+        let i_kh = Matrix4::identity() - k * h;
+        let covariance = i_kh * prior.covariance * i_kh.transpose() + k * r * k.transpose();
+        let log_likelihood = -0.5 * (nu.transpose() * s_inverse * nu)[(0, 0)]
+            - (2.0 * core::f64::consts::PI).ln()
+            - 0.5 * s.determinant().ln();
+        (prior.mean + k * nu, covariance, log_likelihood)
+    }
+
+    #[test]
+    fn kalman_update_matches_the_textbook_joseph_form_computed_with_full_matrices() {
+        for i in 0..50 {
+            let angle = f64::from(i) * 0.41;
+            let mut covariance = spd4() * (0.5 + f64::from(i % 5));
+            covariance[(0, 1)] += 0.1 * angle.sin();
+            covariance[(1, 0)] = covariance[(0, 1)];
+            let prior = Gaussian::new(Vector4::new(angle.cos(), angle.sin(), 2.0, -1.0), covariance);
+            let r = Matrix2::new(0.3 + 0.1 * f64::from(i % 3), 0.05, 0.05, 0.2);
+            let z = DVec2::new(1.0 + angle.sin(), -0.5 + angle.cos());
+            let ours = kalman_update(&prior, z, &r).unwrap();
+            let (mean, covariance, log_likelihood) = reference_update(&prior, z, &r);
+            assert!((ours.posterior.mean - mean).abs().max() < 1e-12);
+            assert!(
+                (ours.posterior.covariance - covariance).abs().max()
+                    < 1e-12 * covariance.abs().max().max(1.0)
+            );
+            assert!((ours.log_likelihood - log_likelihood).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn kalman_update_refuses_an_innovation_covariance_that_is_not_positive_definite() {
+        let mut prior = Gaussian::new(Vector4::zeros(), spd4());
+        prior.covariance[(0, 0)] = -5.0;
+        assert_eq!(kalman_update(&prior, DVec2::ZERO, &Matrix2::identity()), Err(UpdateError));
+        let prior = Gaussian::new(Vector4::zeros(), Matrix4::zeros());
+        assert_eq!(kalman_update(&prior, DVec2::ZERO, &Matrix2::zeros()), Err(UpdateError));
+    }
+
+    /// eq:reconstructed_cov assembled block by block with general nalgebra products.
+    fn reference_replace(g: &Gaussian<4>, mixed: &PositionEstimate) -> Matrix4<f64> {
+        let p = g.covariance;
+        let p_pp = p.fixed_view::<2, 2>(0, 0).into_owned();
+        let p_hp = p.fixed_view::<2, 2>(2, 0).into_owned();
+        let p_hh = p.fixed_view::<2, 2>(2, 2).into_owned();
+        let b = p_hp * p_pp.pseudo_inverse(1e-12).unwrap();
+        let p_bar = to_nalgebra(&mixed.covariance);
+        let c = p_hh - b * p_pp * b.transpose();
+        let mut out = Matrix4::zeros();
+        out.fixed_view_mut::<2, 2>(0, 0).copy_from(&p_bar);
+        out.fixed_view_mut::<2, 2>(2, 0).copy_from(&(b * p_bar));
+        out.fixed_view_mut::<2, 2>(0, 2).copy_from(&(b * p_bar).transpose());
+        out.fixed_view_mut::<2, 2>(2, 2).copy_from(&(c + b * p_bar * b.transpose()));
+        out
+    }
+
+    #[test]
+    fn replace_position_matches_the_block_formula_computed_with_general_products() {
+        for i in 0..40 {
+            let angle = f64::from(i) * 0.3;
+            let mut g = Gaussian::new(Vector4::new(1.0, 2.0, 3.0, 4.0), spd4() * (1.0 + f64::from(i % 4)));
+            if i % 5 == 0 {
+                // A singular position block (rank one), where B comes from the pseudo-inverse.
+                let v = Vector2::new(angle.cos(), angle.sin());
+                g.covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&(v * v.transpose() * 2.0));
+            }
+            let mixed = PositionEstimate {
+                mean: DVec2::new(angle.sin(), 0.5),
+                covariance: DMat2::from_cols(DVec2::new(1.0 + 0.2 * angle.cos(), 0.1), DVec2::new(0.1, 0.7)),
+            };
+            let reference = reference_replace(&g, &mixed);
+            replace_position(&mut g, &mixed);
+            assert!((g.covariance - reference).abs().max() < 1e-9 * reference.abs().max(), "case {i}");
+            assert_eq!((g.mean[0], g.mean[1], g.mean[2]), (mixed.mean.x, mixed.mean.y, 3.0));
+        }
+    }
+}

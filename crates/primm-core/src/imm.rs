@@ -1,0 +1,571 @@
+//! The position-space Interacting Multiple Model filter of the paper (Sections III-D and III-F).
+//!
+//! One step of a track:
+//! 1. [`Imm::predict`]: prior mode probabilities `c` (`eq:prior_mode_prob`), mixing
+//!    probabilities `β` (`eq:mixing_prob`), mixing of the posterior positions and position
+//!    covariances with the spread-of-means term (`eq:mixed_pos`, `eq:mixed_pos_cov`), the mixed
+//!    position written back into each mode while it keeps its own other states
+//!    (`eq:mixed_state` … `eq:reconstructed_cov`), each mode's prediction, and the fused prior
+//!    position (`eq:prior_fusion`) that association uses.
+//! 2. [`Imm::update`] with the associated measurement: each mode's Kalman update and
+//!    likelihood (`eq:innovation` … `eq:posterior_cov`), the tempered mode-probability update
+//!    `μ ∝ Λ^τ c` (`eq:mode_update`) computed in log space, the probability floor; the fused
+//!    posterior is [`Imm::fuse_posterior`] (`eq:posterior_fusion`).
+//!    Without a measurement, [`Imm::coast`] keeps the priors and `μ = c`.
+//!
+//! The active mode set is configuration; with a single mode every step reduces to that mode's
+//! own Kalman filter. If the learned predictor has no displacement for a step, the PR mode sits
+//! the step out: its prior probability is spread over the other modes for fusion and the mode
+//! update, and afterwards it gets back exactly its prior probability `c_PR` (no evidence either
+//! way), the others sharing `1 − c_PR`.
+
+use crate::config::ImmConfig;
+use crate::gaussian::{kalman_update_into, replace_position, Gaussian, PositionEstimate, UpdateError};
+use crate::measurement::Measurement;
+use crate::mode::{Mode, ModeSet, MODE_COUNT};
+use crate::motion::{ModeModels, MotionModel, PredictContext};
+use glam::{DMat2, DVec2};
+
+/// Mode probabilities in primm's mode order (PR, CV, CA, CT); inactive modes hold 0.
+pub type ModeProbabilities = [f64; MODE_COUNT];
+
+/// A track's estimate in every mode plus the mode probabilities: a small `Copy` value.
+/// Inactive modes are carried but never read.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ImmState {
+    /// PR mode, `[x, y]`.
+    pub learned: Gaussian<2>,
+    /// CV mode, `[x, y, vx, vy]`.
+    pub constant_velocity: Gaussian<4>,
+    /// CA mode, `[x, y, vx, vy, ax, ay]`.
+    pub constant_acceleration: Gaussian<6>,
+    /// CT mode, `[x, y, vx, vy, ω]`.
+    pub coordinated_turn: Gaussian<5>,
+    /// Mode probabilities `μ` (posterior) or `c` (in a prior).
+    pub probabilities: ModeProbabilities,
+    /// Velocity implied by the last learned displacement, m/s (PR's only velocity estimate).
+    pub learned_velocity_mps: DVec2,
+}
+
+impl ImmState {
+    /// The position marginal of one mode.
+    pub fn position(&self, mode: Mode) -> PositionEstimate {
+        match mode {
+            Mode::Learned => self.learned.position(),
+            Mode::ConstantVelocity => self.constant_velocity.position(),
+            Mode::ConstantAcceleration => self.constant_acceleration.position(),
+            Mode::CoordinatedTurn => self.coordinated_turn.position(),
+        }
+    }
+
+    /// The velocity estimate of one mode, m/s (PR: displacement over the last step).
+    pub fn velocity(&self, mode: Mode) -> DVec2 {
+        match mode {
+            Mode::Learned => self.learned_velocity_mps,
+            Mode::ConstantVelocity => {
+                DVec2::new(self.constant_velocity.mean[2], self.constant_velocity.mean[3])
+            }
+            Mode::ConstantAcceleration => {
+                DVec2::new(self.constant_acceleration.mean[2], self.constant_acceleration.mean[3])
+            }
+            Mode::CoordinatedTurn => DVec2::new(self.coordinated_turn.mean[2], self.coordinated_turn.mean[3]),
+        }
+    }
+}
+
+/// The outcome of [`Imm::predict`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ImmPrior {
+    /// Each mode's prior; `probabilities` holds the prior mode probabilities `c`.
+    pub state: ImmState,
+    /// Modes that took part in this step (the active ones, less PR without a displacement).
+    pub available: ModeSet,
+    /// Fused prior position and covariance (`eq:prior_fusion`, covariance with the spread of
+    /// the mode means), weights `c` renormalised over the available modes.
+    pub fused: PositionEstimate,
+}
+
+/// The IMM between [`Imm::predict_physics`] and [`Imm::complete_prior`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PendingPrior {
+    prior: ImmPrior,
+    dt_s: f64,
+}
+
+/// The IMM's configuration, prepared once: stateless and shared by all tracks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Imm {
+    modes: ModeSet,
+    transition: [[f64; MODE_COUNT]; MODE_COUNT],
+    initial_probabilities: ModeProbabilities,
+    temperature: f64,
+    floor: f64,
+}
+
+/// Weighted mean and covariance with the spread-of-means term
+/// (`eq:mixed_pos`, `eq:mixed_pos_cov`); weights must sum to 1 over `modes`.
+#[inline]
+pub fn mix_positions(state: &ImmState, modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
+    mix(&mode_positions(state, modes), modes, weights)
+}
+
+/// Every mode's position estimate (entries of modes outside `modes` are left at zero).
+#[inline]
+fn mode_positions(state: &ImmState, modes: ModeSet) -> [PositionEstimate; MODE_COUNT] {
+    let mut positions = [PositionEstimate::default(); MODE_COUNT];
+    for mode in modes.iter() {
+        positions[mode.index()] = state.position(mode);
+    }
+    positions
+}
+
+/// [`mix_positions`] on positions already extracted.
+#[inline]
+fn mix(
+    positions: &[PositionEstimate; MODE_COUNT],
+    modes: ModeSet,
+    weights: &ModeProbabilities,
+) -> PositionEstimate {
+    let mut mean = DVec2::ZERO;
+    for mode in modes.iter() {
+        mean += weights[mode.index()] * positions[mode.index()].mean;
+    }
+    let mut covariance = DMat2::ZERO;
+    for mode in modes.iter() {
+        let position = &positions[mode.index()];
+        let spread = position.mean - mean;
+        covariance += (position.covariance + outer(spread, spread)) * weights[mode.index()];
+    }
+    PositionEstimate { mean, covariance }
+}
+
+fn outer(a: DVec2, b: DVec2) -> DMat2 {
+    DMat2::from_cols(a * b.x, a * b.y)
+}
+
+/// One mode's Kalman update from `prior` into `posterior` and its log-likelihood; an inactive
+/// mode is copied unchanged.
+#[inline(always)]
+fn update_mode<const N: usize, M: MotionModel<N>>(
+    prior: &Gaussian<N>,
+    posterior: &mut Gaussian<N>,
+    model: &M,
+    z: DVec2,
+    active: bool,
+    log_likelihood: &mut f64,
+) -> Result<(), UpdateError> {
+    if !active {
+        *posterior = *prior;
+        return Ok(());
+    }
+    *log_likelihood = kalman_update_into(prior, z, &model.measurement_noise(), posterior)?.log_likelihood;
+    Ok(())
+}
+
+/// One mode's start (its posterior with the mixed position written in, `eq:mixed_state` …
+/// `eq:reconstructed_cov`) predicted into `prior`.
+#[inline(always)]
+fn mix_and_predict<const N: usize, M: MotionModel<N>>(
+    model: &M,
+    posterior: &Gaussian<N>,
+    mixed: &PositionEstimate,
+    context: &PredictContext,
+    prior: &mut Gaussian<N>,
+) {
+    *prior = *posterior;
+    // With nothing to mix (a single mode, or all weight on itself) the write-back is the
+    // identity; skipping it keeps single-mode filtering bit-identical to a plain filter.
+    if prior.position() != *mixed {
+        replace_position(prior, mixed);
+    }
+    model.predict_in_place(prior, context);
+}
+
+impl Imm {
+    /// Prepares the IMM from validated configuration: the transition matrix is restricted to
+    /// the active modes and each row renormalised; so are the initial probabilities.
+    pub fn new(config: &ImmConfig) -> Self {
+        let modes = config.modes;
+        let mut transition = [[0.0; MODE_COUNT]; MODE_COUNT];
+        for from in modes.iter() {
+            let row_sum: f64 = modes.iter().map(|to| config.transition[from.index()][to.index()]).sum();
+            for to in modes.iter() {
+                transition[from.index()][to.index()] = config.transition[from.index()][to.index()] / row_sum;
+            }
+        }
+        let mut initial_probabilities = [0.0; MODE_COUNT];
+        let initial_sum: f64 = modes.iter().map(|m| config.initial_mode_probabilities[m.index()]).sum();
+        for mode in modes.iter() {
+            initial_probabilities[mode.index()] =
+                config.initial_mode_probabilities[mode.index()] / initial_sum;
+        }
+        let mut imm = Self {
+            modes,
+            transition,
+            initial_probabilities,
+            temperature: config.likelihood_temperature,
+            floor: config.mode_probability_floor,
+        };
+        imm.initial_probabilities = imm.apply_floor(imm.initial_probabilities);
+        imm
+    }
+
+    /// The active modes.
+    pub fn modes(&self) -> ModeSet {
+        self.modes
+    }
+
+    /// The prepared transition matrix over the active modes.
+    pub fn transition(&self) -> &[[f64; MODE_COUNT]; MODE_COUNT] {
+        &self.transition
+    }
+
+    /// A new track's state from its first measurement.
+    pub fn initiate(&self, models: &ModeModels, measurement: &Measurement) -> ImmState {
+        let constant_velocity = models.constant_velocity.initiate(measurement);
+        ImmState {
+            learned: models.learned.initiate(measurement),
+            constant_velocity,
+            constant_acceleration: models.constant_acceleration.initiate(measurement),
+            coordinated_turn: models.coordinated_turn.initiate(measurement),
+            probabilities: self.initial_probabilities,
+            learned_velocity_mps: DVec2::new(constant_velocity.mean[2], constant_velocity.mean[3]),
+        }
+    }
+
+    /// Prior mode probabilities `c_j = Σ_i π_ij μ_i` (`eq:prior_mode_prob`).
+    #[inline]
+    pub fn prior_probabilities(&self, posterior: &ModeProbabilities) -> ModeProbabilities {
+        let mut c = [0.0; MODE_COUNT];
+        for to in self.modes.iter() {
+            c[to.index()] = self
+                .modes
+                .iter()
+                .map(|from| self.transition[from.index()][to.index()] * posterior[from.index()])
+                .sum();
+        }
+        c
+    }
+
+    /// Mixing probabilities `β_ij = π_ij μ_i / c_j` (`eq:mixing_prob`) into mode `to`.
+    #[inline]
+    pub fn mixing_probabilities(
+        &self,
+        posterior: &ModeProbabilities,
+        prior: &ModeProbabilities,
+        to: Mode,
+    ) -> ModeProbabilities {
+        let mut beta = [0.0; MODE_COUNT];
+        let c = prior[to.index()];
+        if c > 0.0 {
+            for from in self.modes.iter() {
+                beta[from.index()] = self.transition[from.index()][to.index()] * posterior[from.index()] / c;
+            }
+        } else {
+            beta[to.index()] = 1.0;
+        }
+        beta
+    }
+
+    /// Mixing, per-mode prediction and prior fusion in one call: [`Imm::predict_physics`]
+    /// followed by [`Imm::complete_prior`].
+    pub fn predict(&self, models: &ModeModels, posterior: &ImmState, context: &PredictContext) -> ImmPrior {
+        let mut prior = ImmPrior::default();
+        self.predict_physics_into(models, posterior, context.dt_s, &mut prior);
+        self.complete_prior_in_place(models, &mut prior, context.dt_s, context.displacement_m);
+        prior
+    }
+
+    /// First half of the prediction, which needs no learned displacement: prior mode
+    /// probabilities, mixing of every mode, and the CV, CA and CT predictions. The PR mode is
+    /// left at its mixed starting point. Lets the caller predict the physics modes while the
+    /// learned predictor is still running.
+    pub fn predict_physics(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64) -> PendingPrior {
+        let mut prior = ImmPrior::default();
+        self.predict_physics_into(models, posterior, dt_s, &mut prior);
+        PendingPrior { prior, dt_s }
+    }
+
+    /// [`predict_physics`](Self::predict_physics) written into `prior` in place (no copy of the
+    /// multi-mode state). `prior.available` and `prior.fused` are only meaningful after
+    /// [`complete_prior_in_place`](Self::complete_prior_in_place).
+    #[inline(always)]
+    pub fn predict_physics_into(
+        &self,
+        models: &ModeModels,
+        posterior: &ImmState,
+        dt_s: f64,
+        prior: &mut ImmPrior,
+    ) {
+        let c = self.prior_probabilities(&posterior.probabilities);
+        let positions = mode_positions(posterior, self.modes);
+        let context = PredictContext { dt_s, displacement_m: None };
+        let state = &mut prior.state;
+        state.probabilities = c;
+        state.learned_velocity_mps = posterior.learned_velocity_mps;
+        for mode in self.modes.iter() {
+            let beta = self.mixing_probabilities(&posterior.probabilities, &c, mode);
+            let start = mix(&positions, self.modes, &beta);
+            match mode {
+                Mode::Learned => {
+                    state.learned = posterior.learned;
+                    if positions[mode.index()] != start {
+                        replace_position(&mut state.learned, &start);
+                    }
+                }
+                Mode::ConstantVelocity => mix_and_predict(
+                    &models.constant_velocity,
+                    &posterior.constant_velocity,
+                    &start,
+                    &context,
+                    &mut state.constant_velocity,
+                ),
+                Mode::ConstantAcceleration => mix_and_predict(
+                    &models.constant_acceleration,
+                    &posterior.constant_acceleration,
+                    &start,
+                    &context,
+                    &mut state.constant_acceleration,
+                ),
+                Mode::CoordinatedTurn => mix_and_predict(
+                    &models.coordinated_turn,
+                    &posterior.coordinated_turn,
+                    &start,
+                    &context,
+                    &mut state.coordinated_turn,
+                ),
+            }
+        }
+        // Inactive modes are carried along unchanged, so that no stale values linger.
+        for mode in ModeSet::ALL.iter().filter(|mode| !self.modes.contains(*mode)) {
+            match mode {
+                Mode::Learned => state.learned = posterior.learned,
+                Mode::ConstantVelocity => state.constant_velocity = posterior.constant_velocity,
+                Mode::ConstantAcceleration => state.constant_acceleration = posterior.constant_acceleration,
+                Mode::CoordinatedTurn => state.coordinated_turn = posterior.coordinated_turn,
+            }
+        }
+        prior.available = self.modes;
+    }
+
+    /// Second half of the prediction: the PR prior from the learned displacement
+    /// (`eq:pr_prior`, `eq:pr_cov`) and the fused prior (`eq:prior_fusion`). Without a
+    /// displacement the PR mode sits the step out (see the module documentation).
+    pub fn complete_prior(
+        &self,
+        models: &ModeModels,
+        pending: &PendingPrior,
+        displacement_m: Option<DVec2>,
+    ) -> ImmPrior {
+        let mut prior = pending.prior;
+        self.complete_prior_in_place(models, &mut prior, pending.dt_s, displacement_m);
+        prior
+    }
+
+    /// [`complete_prior`](Self::complete_prior) on a prior filled by
+    /// [`predict_physics_into`](Self::predict_physics_into) for the same `dt_s`.
+    #[inline(always)]
+    pub fn complete_prior_in_place(
+        &self,
+        models: &ModeModels,
+        prior: &mut ImmPrior,
+        dt_s: f64,
+        displacement_m: Option<DVec2>,
+    ) {
+        let state = &mut prior.state;
+        if self.modes.contains(Mode::Learned) {
+            let context = PredictContext { dt_s, displacement_m };
+            state.learned = models.learned.predict(&state.learned, &context);
+            if let Some(displacement) = displacement_m {
+                state.learned_velocity_mps = displacement / dt_s;
+            }
+        }
+        let mut available = self.modes;
+        if displacement_m.is_none() && self.modes.len() > 1 {
+            available = available.without(Mode::Learned);
+        }
+        prior.available = available;
+        prior.fused = mix_positions(state, available, &renormalised(&state.probabilities, available));
+    }
+
+    /// Kalman update of every active mode with measurement `z`, tempered mode-probability
+    /// update and floor. On a numerical failure of any mode the prior is left as it was.
+    pub fn update(&self, models: &ModeModels, prior: &ImmPrior, z: DVec2) -> Result<ImmState, UpdateError> {
+        let mut state = ImmState::default();
+        self.update_into(models, prior, z, &mut state)?;
+        Ok(state)
+    }
+
+    /// [`update`](Self::update) written into `posterior` in place. On error `posterior` holds
+    /// the prior's state (the track coasts; nothing half-updated is left behind).
+    #[inline(always)]
+    pub fn update_into(
+        &self,
+        models: &ModeModels,
+        prior: &ImmPrior,
+        z: DVec2,
+        posterior: &mut ImmState,
+    ) -> Result<(), UpdateError> {
+        match self.update_modes(models, prior, z, posterior) {
+            Ok(log_likelihood) => {
+                posterior.probabilities =
+                    self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
+                posterior.learned_velocity_mps = prior.state.learned_velocity_mps;
+                Ok(())
+            }
+            Err(error) => {
+                *posterior = prior.state;
+                Err(error)
+            }
+        }
+    }
+
+    /// Each mode's Kalman update from `prior` into `posterior` (inactive modes are copied);
+    /// the log-likelihoods. Stops at the first failing mode.
+    #[inline(always)]
+    fn update_modes(
+        &self,
+        models: &ModeModels,
+        prior: &ImmPrior,
+        z: DVec2,
+        posterior: &mut ImmState,
+    ) -> Result<ModeProbabilities, UpdateError> {
+        let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
+        let (from, to) = (&prior.state, posterior);
+        for mode in ModeSet::ALL.iter() {
+            let active = self.modes.contains(mode);
+            let i = mode.index();
+            match mode {
+                Mode::Learned => update_mode(
+                    &from.learned,
+                    &mut to.learned,
+                    &models.learned,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+                Mode::ConstantVelocity => update_mode(
+                    &from.constant_velocity,
+                    &mut to.constant_velocity,
+                    &models.constant_velocity,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+                Mode::ConstantAcceleration => update_mode(
+                    &from.constant_acceleration,
+                    &mut to.constant_acceleration,
+                    &models.constant_acceleration,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+                Mode::CoordinatedTurn => update_mode(
+                    &from.coordinated_turn,
+                    &mut to.coordinated_turn,
+                    &models.coordinated_turn,
+                    z,
+                    active,
+                    &mut log_likelihood[i],
+                )?,
+            }
+        }
+        Ok(log_likelihood)
+    }
+
+    /// `μ_i ∝ Λ_i^τ c_i` over the available modes (`eq:mode_update`), in log space; a mode that
+    /// sat the step out keeps its prior probability; then the floor.
+    #[inline(always)]
+    pub fn updated_probabilities(
+        &self,
+        prior: &ModeProbabilities,
+        available: ModeSet,
+        log_likelihood: &ModeProbabilities,
+    ) -> ModeProbabilities {
+        let weights = renormalised(prior, available);
+        // μ_i ∝ exp(τ ℓ_i − max_j τ ℓ_j) · c_i: the shift by the largest tempered
+        // log-likelihood keeps the exponentials in range, and the mode attaining it keeps a
+        // positive weight, so the sum cannot vanish.
+        let mut largest = f64::NEG_INFINITY;
+        for mode in available.iter() {
+            let i = mode.index();
+            if weights[i] > 0.0 {
+                largest = largest.max(self.temperature * log_likelihood[i]);
+            }
+        }
+        let mut mu = [0.0; MODE_COUNT];
+        let mut sum = 0.0;
+        for mode in available.iter() {
+            let i = mode.index();
+            if weights[i] > 0.0 {
+                mu[i] = crate::math::exp(self.temperature * log_likelihood[i] - largest) * weights[i];
+                sum += mu[i];
+            }
+        }
+        let sitting_out: f64 =
+            self.modes.iter().filter(|m| !available.contains(*m)).map(|m| prior[m.index()]).sum();
+        for mode in self.modes.iter() {
+            let i = mode.index();
+            mu[i] = if available.contains(mode) { mu[i] / sum * (1.0 - sitting_out) } else { prior[i] };
+        }
+        self.apply_floor(mu)
+    }
+
+    /// A step without measurement: the priors become the posteriors and `μ = c`.
+    pub fn coast(&self, prior: &ImmPrior) -> ImmState {
+        prior.state
+    }
+
+    /// The fused position and covariance of a posterior (`eq:posterior_fusion`, covariance with
+    /// the spread of the mode means) over `modes`, weights `μ` renormalised over them.
+    pub fn fuse_posterior(&self, state: &ImmState, modes: ModeSet) -> PositionEstimate {
+        mix_positions(state, modes, &renormalised(&state.probabilities, modes))
+    }
+
+    /// The fused velocity over `modes`, m/s, weights `μ` renormalised over them; PR's velocity is
+    /// its last displacement divided by the step.
+    pub fn fuse_velocity(&self, state: &ImmState, modes: ModeSet) -> DVec2 {
+        let weights = renormalised(&state.probabilities, modes);
+        modes.iter().map(|mode| weights[mode.index()] * state.velocity(mode)).sum()
+    }
+
+    /// Raises every active mode's probability to at least the floor and renormalises, keeping
+    /// the floored modes at exactly the floor.
+    #[inline]
+    pub fn apply_floor(&self, mut mu: ModeProbabilities) -> ModeProbabilities {
+        if self.floor <= 0.0 || self.modes.iter().all(|mode| mu[mode.index()] >= self.floor) {
+            return mu;
+        }
+        let mut floored = ModeSet::EMPTY;
+        for _ in 0..MODE_COUNT {
+            let mut changed = false;
+            for mode in self.modes.iter() {
+                if !floored.contains(mode) && mu[mode.index()] < self.floor {
+                    floored = floored.with(mode);
+                    changed = true;
+                }
+            }
+            let free: f64 = self.modes.iter().filter(|m| !floored.contains(*m)).map(|m| mu[m.index()]).sum();
+            let target = 1.0 - self.floor * floored.len() as f64;
+            for mode in self.modes.iter() {
+                let i = mode.index();
+                mu[i] = if floored.contains(mode) { self.floor } else { mu[i] * target / free };
+            }
+            if !changed {
+                break;
+            }
+        }
+        mu
+    }
+}
+
+/// `weights` restricted to `modes` and renormalised to sum to 1 (uniform if they sum to 0).
+#[inline]
+pub fn renormalised(weights: &ModeProbabilities, modes: ModeSet) -> ModeProbabilities {
+    let sum: f64 = modes.iter().map(|m| weights[m.index()]).sum();
+    let mut result = [0.0; MODE_COUNT];
+    for mode in modes.iter() {
+        result[mode.index()] = if sum > 0.0 { weights[mode.index()] / sum } else { 1.0 / modes.len() as f64 };
+    }
+    result
+}

@@ -1,0 +1,157 @@
+//! The learned displacement predictor behind a small trait (paper, Section III-C).
+//!
+//! The tracker builds one [`PredictionRequest`] per live track and frame: the track's last
+//! `L ≤ 5` associated measurements laid out as `eq:pr_input` (positions relative to the latest
+//! measurement, radial velocity, RCS, time relative to the prediction time). A
+//! [`DisplacementPredictor`] answers a whole batch at once; `None` for a request means "no
+//! prediction this frame" and the PR mode sits the frame out for that track.
+//!
+//! # Which displacement
+//!
+//! `eq:pr_prior` adds the displacement to the PR estimate of the previous *frame*. A track is
+//! not measured in every frame (the radars scan in turn, and an object is usually seen by only
+//! some of them), so its latest measurement may be older than the previous frame. The
+//! displacement a predictor returns is therefore the one over the tracker step
+//! `[step_start_s, prediction_time_s]`. A model that predicts the displacement from the latest
+//! measurement to a given time, `f(t)`, answers `f(t_k)` when the track was measured in the
+//! previous frame and `f(t_k) − f(t_{k−1})` otherwise, so the PR prior stays
+//! `z_latest + f(t_k)` however many frames the track coasts ([`PredictionRequest::at_time`]
+//! builds the input for `f(t_{k−1})`).
+
+use alloc::boxed::Box;
+use alloc::string::String;
+use glam::DVec2;
+
+pub use crate::limits::MAX_HISTORY;
+/// Features per history step: `[x − x_{k−1}, y − y_{k−1}, v_r, RCS, t − t_k]`.
+pub const FEATURES: usize = 5;
+
+/// One associated measurement in a track's history, absolute values.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HistoryEntry {
+    /// x position, m.
+    pub x_m: f64,
+    /// y position, m.
+    pub y_m: f64,
+    /// Radial velocity, m/s.
+    pub radial_velocity_mps: f64,
+    /// Radar cross section, dBsm.
+    pub rcs_dbsm: f64,
+    /// Measurement time, s.
+    pub timestamp_s: f64,
+}
+
+/// A track's prediction input, laid out as `eq:pr_input`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PredictionRequest {
+    /// Rows `0..len` hold the history oldest first; rows `len..` are zero padding.
+    pub features: [[f32; FEATURES]; MAX_HISTORY],
+    /// Number of valid rows (1..=5).
+    pub len: usize,
+    /// The latest measured position `z_{k−1}` in absolute coordinates, m (not a model input;
+    /// lets an oracle or a diagnostic relate the request to the scene).
+    pub anchor_m: DVec2,
+    /// Time of the latest measurement, s (not a model input).
+    pub anchor_time_s: f64,
+    /// Prediction time `t_k`, s (not a model input).
+    pub prediction_time_s: f64,
+    /// Start of the tracker step, s: the time of the previous frame, where the PR estimate the
+    /// displacement is added to lives (not a model input). Never earlier than the latest
+    /// history measurement; equal to it when the track was measured in the previous frame.
+    pub step_start_s: f64,
+}
+
+impl PredictionRequest {
+    /// Builds the request from a history (oldest first, at least one entry, at most
+    /// [`MAX_HISTORY`] used: the latest ones) and the prediction time.
+    pub fn from_history(history: &[HistoryEntry], prediction_time_s: f64) -> Self {
+        let start = history.len().saturating_sub(MAX_HISTORY);
+        let history = &history[start..];
+        let mut request = PredictionRequest { len: history.len(), prediction_time_s, ..Default::default() };
+        if let Some(latest) = history.last() {
+            request.anchor_m = DVec2::new(latest.x_m, latest.y_m);
+            request.anchor_time_s = latest.timestamp_s;
+            request.step_start_s = latest.timestamp_s;
+            for (row, entry) in request.features.iter_mut().zip(history) {
+                *row = [
+                    (entry.x_m - latest.x_m) as f32,
+                    (entry.y_m - latest.y_m) as f32,
+                    entry.radial_velocity_mps as f32,
+                    entry.rcs_dbsm as f32,
+                    (entry.timestamp_s - prediction_time_s) as f32,
+                ];
+            }
+        }
+        request
+    }
+
+    /// The same request with the step starting at `step_start_s` (the previous frame's time),
+    /// kept between the latest measurement's time and the prediction time.
+    pub fn with_step_start(mut self, step_start_s: f64) -> Self {
+        self.step_start_s = step_start_s.max(self.anchor_time_s).min(self.prediction_time_s);
+        self
+    }
+
+    /// Whether the step starts after the latest measurement, i.e. the track was not measured in
+    /// the previous frame and the displacement is a difference of two predictions.
+    pub fn step_starts_after_latest_measurement(&self) -> bool {
+        self.len > 0 && self.step_start_s > self.anchor_time_s
+    }
+
+    /// The model input for predicting at `time_s` instead of the prediction time: the time
+    /// feature `t_l − t` of every valid row shifted; everything else unchanged.
+    pub fn at_time(&self, time_s: f64) -> Self {
+        let mut request = *self;
+        let shift = (self.prediction_time_s - time_s) as f32;
+        for row in &mut request.features[..self.len] {
+            row[4] += shift;
+        }
+        request.prediction_time_s = time_s;
+        request
+    }
+}
+
+/// Predicts the displacement of many tracks over one tracker step (see the module
+/// documentation), in two steps so that an implementation may run the batch elsewhere (another
+/// thread) while the tracker predicts its physics modes.
+pub trait DisplacementPredictor {
+    /// Starts predicting one batch. May return before the work is done.
+    fn submit(&mut self, requests: &[PredictionRequest]);
+    /// Delivers the batch submitted last: fills `displacements[i]` for the `i`-th request
+    /// (`displacements.len()` equals the batch size); `None` where no prediction is available,
+    /// e.g. after a missed deadline.
+    fn collect(&mut self, displacements: &mut [Option<DVec2>]);
+    /// [`submit`](Self::submit) then [`collect`](Self::collect).
+    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+        self.submit(requests);
+        self.collect(displacements);
+    }
+    /// A one-line summary of the predictor's own counters (batches, deadline misses, errors),
+    /// for a service's shutdown report; `None` when it keeps none.
+    fn report(&self) -> Option<String> {
+        None
+    }
+}
+
+/// A predictor that never predicts: the PR mode sits out every frame.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoPredictor;
+
+impl DisplacementPredictor for NoPredictor {
+    fn submit(&mut self, _requests: &[PredictionRequest]) {}
+    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+        displacements.fill(None);
+    }
+}
+
+impl<P: DisplacementPredictor + ?Sized> DisplacementPredictor for Box<P> {
+    fn submit(&mut self, requests: &[PredictionRequest]) {
+        (**self).submit(requests)
+    }
+    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+        (**self).collect(displacements)
+    }
+    fn report(&self) -> Option<String> {
+        (**self).report()
+    }
+}

@@ -1,0 +1,133 @@
+//! One track: its IMM state, the measurement history the learned predictor reads, lifecycle
+//! counters; and the per-frame output record.
+
+use crate::imm::{ImmState, ModeProbabilities};
+use crate::measurement::{Measurement, ObjectClass};
+use crate::predictor::{HistoryEntry, MAX_HISTORY};
+use glam::{DMat2, DVec2};
+use heapless::HistoryBuf;
+
+/// Lifecycle status of a track.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[repr(u8)]
+pub enum TrackStatus {
+    /// Started by an unassigned measurement, not yet confirmed by enough hits.
+    Tentative = 0,
+    /// Confirmed by `tracker.confirmation_hits` hits.
+    Confirmed = 1,
+}
+
+/// A live track. A small `Copy` value; the table holds them in place.
+#[derive(Debug, Clone)]
+pub struct Track {
+    /// Unique id, never reused within a run.
+    pub id: u64,
+    /// Class of the measurements the track is built from.
+    pub class: ObjectClass,
+    /// Lifecycle status.
+    pub status: TrackStatus,
+    /// IMM posterior.
+    pub estimate: ImmState,
+    /// The last associated measurements, oldest first: the learned predictor's input.
+    pub history: HistoryBuf<HistoryEntry, MAX_HISTORY>,
+    /// Radial velocity of the last associated measurement, m/s (`v_r^last` in `eq:association_cost`).
+    pub last_radial_velocity_mps: f64,
+    /// Time of the last associated measurement, s.
+    pub last_update_s: f64,
+    /// Frames since the track started (0 in its first frame).
+    pub age_frames: u32,
+    /// Associated measurements, including the initiating one.
+    pub hits: u32,
+    /// Consecutive frames without an associated measurement.
+    pub misses: u32,
+    /// Ground-truth id of the last associated measurement (evaluation only).
+    pub ground_truth_id: Option<u64>,
+}
+
+impl Track {
+    /// A new tentative track from its first measurement and timestamp.
+    pub fn new(id: u64, measurement: &Measurement, timestamp_s: f64, estimate: ImmState) -> Self {
+        let mut track = Track {
+            id,
+            class: measurement.class,
+            status: TrackStatus::Tentative,
+            estimate,
+            history: HistoryBuf::new(),
+            last_radial_velocity_mps: measurement.radial_velocity_mps,
+            last_update_s: timestamp_s,
+            age_frames: 0,
+            hits: 1,
+            misses: 0,
+            ground_truth_id: measurement.ground_truth_id,
+        };
+        track.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
+        track
+    }
+
+    /// Records an associated measurement.
+    pub fn record_hit(&mut self, measurement: &Measurement, timestamp_s: f64, confirmation_hits: u32) {
+        self.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
+        self.last_radial_velocity_mps = measurement.radial_velocity_mps;
+        self.last_update_s = timestamp_s;
+        self.hits = self.hits.saturating_add(1);
+        self.misses = 0;
+        self.ground_truth_id = measurement.ground_truth_id;
+        if self.hits >= confirmation_hits {
+            self.status = TrackStatus::Confirmed;
+        }
+    }
+
+    /// Records a frame without associated measurement.
+    pub fn record_miss(&mut self) {
+        self.misses = self.misses.saturating_add(1);
+    }
+}
+
+impl HistoryEntry {
+    /// The history entry of a measurement taken at `timestamp_s`.
+    pub fn from_measurement(measurement: &Measurement, timestamp_s: f64) -> Self {
+        HistoryEntry {
+            x_m: measurement.x_m,
+            y_m: measurement.y_m,
+            radial_velocity_mps: measurement.radial_velocity_mps,
+            rcs_dbsm: measurement.rcs_dbsm,
+            timestamp_s,
+        }
+    }
+}
+
+/// What the tracker reports for every live track after a frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct TrackOutput {
+    /// Track id.
+    pub id: u64,
+    /// Object class.
+    pub class: ObjectClass,
+    /// Lifecycle status.
+    pub status: TrackStatus,
+    /// Fused posterior position (`eq:posterior_fusion`), m.
+    pub position_m: DVec2,
+    /// Covariance of the fused position (with the spread of the mode means), m².
+    pub position_covariance_m2: DMat2,
+    /// Fused velocity estimate, m/s.
+    pub velocity_mps: DVec2,
+    /// Fused one-step prior used for association (`eq:prior_fusion`), m; `None` for a track
+    /// started in this frame.
+    pub prior_position_m: Option<DVec2>,
+    /// Posterior mode probabilities, order PR, CV, CA, CT (inactive modes 0).
+    pub mode_probabilities: ModeProbabilities,
+    /// Frames since the track started.
+    pub age_frames: u32,
+    /// Associated measurements so far.
+    pub hits: u32,
+    /// Consecutive frames without measurement (0 when updated in this frame).
+    pub misses: u32,
+    /// Ground-truth id of the measurement that updated or started the track in this frame.
+    pub ground_truth_id: Option<u64>,
+    /// Index in this frame of the measurement that updated or started the track; `None` when
+    /// the track coasted.
+    pub measurement_index: Option<u16>,
+}

@@ -1,0 +1,482 @@
+//! The multi-object tracker: one [`Tracker::step`] per frame, allocating nothing.
+//!
+//! The step reads like the algorithm of the paper (Section III): validate, predict every
+//! mode of every track (the learned predictor runs on its batch meanwhile), fuse the priors,
+//! associate per class, update, coast, initiate, delete, report. Each role is a method below.
+//! The tracker never reads a clock: time comes from frames, so a replay is bit-for-bit
+//! repeatable.
+
+use crate::association::assignment::AssignmentError;
+use crate::association::associator::Associator;
+use crate::config::{Config, ConfigError};
+use crate::gaussian::UpdateError;
+use crate::imm::{Imm, ImmPrior};
+use crate::kernels;
+use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use crate::mode::{Mode, ModeSet};
+use crate::motion::ModeModels;
+use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
+use crate::stage_timing::{NoObserver, Stage, StageObserver};
+use crate::track::{Track, TrackOutput, TrackStatus};
+use crate::track_table::{TrackTable, MAX_TRACKS};
+use crate::validation::{validate_frame, validate_measurement, FrameError, MeasurementRejection};
+use alloc::boxed::Box;
+use alloc::vec;
+use arrayvec::ArrayVec;
+use glam::DVec2;
+
+/// Why a step failed. The tracker's tracks are exactly as before the frame.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// The frame was rejected by validation.
+    #[error("frame rejected: {0}")]
+    InvalidFrame(#[from] FrameError),
+    /// The assignment solver refused the problem (cannot happen with the tracker's own
+    /// capacities; reported rather than panicking).
+    #[error("association failed: {0}")]
+    Association(#[from] AssignmentError),
+}
+
+/// Counters of everything the tracker did or refused, since it was built.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct TrackerStats {
+    /// Frames tracked.
+    pub frames_tracked: u64,
+    /// Frames rejected because the timestamp was not finite.
+    pub frames_rejected_non_finite_timestamp: u64,
+    /// Frames rejected because time did not advance.
+    pub frames_rejected_timestamp_not_increasing: u64,
+    /// Frames rejected because the interval was too long.
+    pub frames_rejected_interval_too_long: u64,
+    /// Frames rejected because they carried too many measurements.
+    pub frames_rejected_too_many_measurements: u64,
+    /// Measurements tracked (accepted by validation).
+    pub measurements_accepted: u64,
+    /// Measurements rejected for an unknown class code.
+    pub measurements_rejected_unknown_class: u64,
+    /// Measurements rejected for a NaN or infinite value.
+    pub measurements_rejected_non_finite: u64,
+    /// Measurements rejected for an absurd magnitude.
+    pub measurements_rejected_out_of_range: u64,
+    /// Tracks started.
+    pub tracks_initiated: u64,
+    /// Tracks confirmed.
+    pub tracks_confirmed: u64,
+    /// Tracks deleted.
+    pub tracks_deleted: u64,
+    /// Unassigned measurements that could not start a track because the table was full.
+    pub initiations_refused_table_full: u64,
+    /// Track-frames in which the learned predictor gave no displacement (PR sat out).
+    pub learned_predictions_missing: u64,
+    /// Frames in which at least one track had no learned displacement.
+    pub frames_with_learned_predictions_missing: u64,
+    /// Kalman updates refused for numerical reasons (the track coasted instead).
+    pub update_failures: u64,
+    /// Calls to [`Tracker::reset`].
+    pub resets: u64,
+}
+
+/// What happened to each measurement of the current frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum MeasurementFate {
+    Rejected,
+    Unassigned,
+    Assigned,
+}
+
+/// What one live track did in the current frame, aligned with the track table's rows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct RowRecord {
+    prior_position_m: Option<DVec2>,
+    available: ModeSet,
+    measurement_index: Option<u16>,
+}
+
+const EMPTY_ROW: RowRecord =
+    RowRecord { prior_position_m: None, available: ModeSet::EMPTY, measurement_index: None };
+
+/// The PR-IMM multi-object tracker with a learned-displacement predictor `P`.
+#[derive(Debug)]
+pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
+    config: Config,
+    imm: Imm,
+    models: [ModeModels; ObjectClass::COUNT],
+    predictor: P,
+    table: TrackTable,
+    associator: Associator,
+    last_timestamp_s: Option<f64>,
+    stats: TrackerStats,
+    // Per-frame workspaces, allocated once.
+    requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
+    displacements: Box<[Option<DVec2>; MAX_TRACKS]>,
+    /// Each track's prior of the current frame (the first `table.len()` entries).
+    priors: Box<[ImmPrior]>,
+    /// Interval of the current frame, s.
+    dt_s: f64,
+    track_to_measurement: Box<[Option<u16>; MAX_TRACKS]>,
+    /// Each track's assigned measurement of the current frame (`None`: none).
+    assigned_measurements: Box<[Option<Measurement>; MAX_TRACKS]>,
+    /// Each track's update outcome of the current frame.
+    update_outcomes: Box<[Result<(), UpdateError>; MAX_TRACKS]>,
+    rows: Box<[RowRecord; MAX_TRACKS]>,
+    fates: Box<[MeasurementFate; MAX_MEASUREMENTS_PER_FRAME]>,
+    accepted: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
+    outputs: Box<ArrayVec<TrackOutput, MAX_TRACKS>>,
+}
+
+impl Tracker<NoPredictor> {
+    /// A tracker without learned predictor (for methods without the PR mode).
+    pub fn new(config: Config) -> Result<Self, ConfigError> {
+        Self::with_predictor(config, NoPredictor)
+    }
+}
+
+impl<P: DisplacementPredictor> Tracker<P> {
+    /// A tracker using `predictor` for the PR mode. Validates `config`.
+    pub fn with_predictor(config: Config, predictor: P) -> Result<Self, ConfigError> {
+        config.validate()?;
+        Ok(Self {
+            imm: Imm::new(&config.imm),
+            models: ObjectClass::ALL.map(|class| ModeModels::from_config(config.classes.get(class))),
+            config,
+            predictor,
+            table: TrackTable::new(),
+            associator: Associator::new(),
+            last_timestamp_s: None,
+            stats: TrackerStats::default(),
+            requests: Box::new(ArrayVec::new()),
+            displacements: Box::new([None; MAX_TRACKS]),
+            priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
+            dt_s: 0.0,
+            track_to_measurement: Box::new([None; MAX_TRACKS]),
+            assigned_measurements: Box::new([None; MAX_TRACKS]),
+            update_outcomes: Box::new([Ok(()); MAX_TRACKS]),
+            rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
+            fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
+            accepted: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
+            outputs: Box::new(ArrayVec::new()),
+        })
+    }
+
+    /// Tracks one frame and returns the state of every live track.
+    pub fn step<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<&[TrackOutput], StepError> {
+        self.advance(frame, &mut NoObserver)?;
+        self.outputs.clear();
+        let outputs = &mut self.outputs;
+        report(&self.table, &self.rows[..], &self.imm, |output| outputs.push(*output));
+        Ok(&self.outputs)
+    }
+
+    /// Tracks one frame and hands every live track's output to `sink`, in table order, instead
+    /// of collecting them: lets a caller write them straight into their destination (e.g. a
+    /// loaned shared-memory sample). Returns the number of outputs.
+    pub fn step_into<F: FrameView + ?Sized>(
+        &mut self,
+        frame: &F,
+        sink: impl FnMut(&TrackOutput),
+    ) -> Result<usize, StepError> {
+        self.step_observed(frame, &mut NoObserver, sink)
+    }
+
+    /// [`step_into`](Self::step_into), telling `observer` when each [`Stage`] finishes, so
+    /// that a caller can time the stages with its own clock.
+    pub fn step_observed<F: FrameView + ?Sized, O: StageObserver>(
+        &mut self,
+        frame: &F,
+        observer: &mut O,
+        sink: impl FnMut(&TrackOutput),
+    ) -> Result<usize, StepError> {
+        self.advance(frame, observer)?;
+        let count = report(&self.table, &self.rows[..], &self.imm, sink);
+        observer.stage_finished(Stage::Report);
+        Ok(count)
+    }
+
+    /// Everything but the report.
+    fn advance<F: FrameView + ?Sized, O: StageObserver>(
+        &mut self,
+        frame: &F,
+        observer: &mut O,
+    ) -> Result<(), StepError> {
+        let dt_s = self.validate(frame)?;
+        observer.stage_finished(Stage::Validate);
+        let t = frame.timestamp_s();
+        self.request_learned_predictions(t);
+        self.predict_physics(dt_s);
+        observer.stage_finished(Stage::Predict);
+        self.fuse_priors();
+        observer.stage_finished(Stage::LearnedWait);
+        self.associate(frame)?;
+        observer.stage_finished(Stage::Associate);
+        self.update(frame, t);
+        self.coast();
+        self.initiate(frame, t);
+        self.delete(t);
+        observer.stage_finished(Stage::Update);
+        self.last_timestamp_s = Some(t);
+        self.stats.frames_tracked += 1;
+        Ok(())
+    }
+
+    /// Frame checks, then per-measurement checks; counts every rejection.
+    fn validate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<f64, StepError> {
+        let dt_s =
+            validate_frame(frame, self.last_timestamp_s, &self.config.tracker).inspect_err(|error| {
+                let counter = match error {
+                    FrameError::NonFiniteTimestamp { .. } => {
+                        &mut self.stats.frames_rejected_non_finite_timestamp
+                    }
+                    FrameError::TimestampNotIncreasing { .. } => {
+                        &mut self.stats.frames_rejected_timestamp_not_increasing
+                    }
+                    FrameError::IntervalTooLong { .. } => &mut self.stats.frames_rejected_interval_too_long,
+                    FrameError::TooManyMeasurements { .. } => {
+                        &mut self.stats.frames_rejected_too_many_measurements
+                    }
+                };
+                *counter += 1;
+            })?;
+        for index in 0..frame.len() {
+            let verdict = validate_measurement(frame, index);
+            self.accepted[index] = verdict.is_ok();
+            self.fates[index] =
+                if verdict.is_ok() { MeasurementFate::Unassigned } else { MeasurementFate::Rejected };
+            match verdict {
+                Ok(_) => self.stats.measurements_accepted += 1,
+                Err(MeasurementRejection::UnknownClass) => {
+                    self.stats.measurements_rejected_unknown_class += 1
+                }
+                Err(MeasurementRejection::NonFinite) => self.stats.measurements_rejected_non_finite += 1,
+                Err(MeasurementRejection::OutOfRange) => self.stats.measurements_rejected_out_of_range += 1,
+            }
+        }
+        Ok(dt_s)
+    }
+
+    /// Hands every track's history (`eq:pr_input`) to the learned predictor.
+    fn request_learned_predictions(&mut self, t: f64) {
+        self.requests.clear();
+        if !self.imm.modes().contains(Mode::Learned) {
+            return;
+        }
+        for track in self.table.tracks() {
+            let (older, newer) = track.history.as_slices();
+            let mut window = [Default::default(); crate::predictor::MAX_HISTORY];
+            let len = older.len() + newer.len();
+            window[..older.len()].copy_from_slice(older);
+            window[older.len()..len].copy_from_slice(newer);
+            let step_start = self.last_timestamp_s.unwrap_or(t);
+            self.requests
+                .push(PredictionRequest::from_history(&window[..len], t).with_step_start(step_start));
+        }
+        self.predictor.submit(&self.requests);
+    }
+
+    /// Mixing and the CV, CA and CT predictions, while the predictor works.
+    fn predict_physics(&mut self, dt_s: f64) {
+        self.dt_s = dt_s;
+        kernels::predict_physics(&self.imm, &self.models, self.table.tracks(), dt_s, &mut self.priors[..]);
+    }
+
+    /// Collects the displacements; the PR priors and the fused priors (`eq:prior_fusion`).
+    fn fuse_priors(&mut self) {
+        let count = self.table.len();
+        let displacements = &mut self.displacements[..count];
+        if self.requests.is_empty() {
+            displacements.fill(None);
+        } else {
+            self.predictor.collect(displacements);
+            let missing = displacements.iter().filter(|d| d.is_none()).count() as u64;
+            self.stats.learned_predictions_missing += missing;
+            self.stats.frames_with_learned_predictions_missing += u64::from(missing > 0);
+        }
+        kernels::complete_priors(
+            &self.imm,
+            &self.models,
+            self.table.tracks(),
+            self.dt_s,
+            displacements,
+            &mut self.priors[..],
+        );
+    }
+
+    /// Per-class gated optimal assignment (`eq:association_cost`).
+    fn associate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<(), StepError> {
+        self.associator.associate(
+            self.table.tracks(),
+            &self.priors[..self.table.len()],
+            frame,
+            &self.accepted[..frame.len()],
+            &self.config,
+            &mut self.track_to_measurement[..],
+        )?;
+        Ok(())
+    }
+
+    /// Kalman and mode-probability update of every assigned track.
+    fn update<F: FrameView + ?Sized>(&mut self, frame: &F, t: f64) {
+        let count = self.table.len();
+        for i in 0..count {
+            // An accepted measurement always reads back; if one did not, the track coasts rather
+            // than keep a stale state.
+            self.assigned_measurements[i] =
+                self.track_to_measurement[i].and_then(|index| frame.measurement(usize::from(index)).ok());
+            if self.assigned_measurements[i].is_none() {
+                self.track_to_measurement[i] = None;
+            }
+        }
+        kernels::update(
+            &self.imm,
+            &self.models,
+            self.table.tracks_mut(),
+            &self.priors[..count],
+            &self.assigned_measurements[..count],
+            &mut self.update_outcomes[..count],
+        );
+        let confirmation_hits = self.config.tracker.confirmation_hits;
+        for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
+            let (Some(index), Some(measurement)) =
+                (self.track_to_measurement[i], self.assigned_measurements[i])
+            else {
+                continue;
+            };
+            if self.update_outcomes[i].is_ok() {
+                let was_confirmed = track.status == TrackStatus::Confirmed;
+                track.record_hit(&measurement, t, confirmation_hits);
+                self.stats.tracks_confirmed +=
+                    u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);
+                self.fates[usize::from(index)] = MeasurementFate::Assigned;
+            } else {
+                // Numerically unusable: the track coasts and the measurement is free to start a
+                // track of its own.
+                self.stats.update_failures += 1;
+                self.track_to_measurement[i] = None;
+            }
+        }
+    }
+
+    /// Tracks without a measurement keep their priors; every existing track's frame record.
+    fn coast(&mut self) {
+        for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
+            let measurement_index = self.track_to_measurement[i];
+            if measurement_index.is_none() {
+                track.estimate = self.imm.coast(&self.priors[i]);
+                track.record_miss();
+            }
+            track.age_frames = track.age_frames.saturating_add(1);
+            self.rows[i] = RowRecord {
+                prior_position_m: Some(self.priors[i].fused.mean),
+                available: self.priors[i].available,
+                measurement_index,
+            };
+        }
+    }
+
+    /// Every accepted, unassigned measurement starts a tentative track.
+    fn initiate<F: FrameView + ?Sized>(&mut self, frame: &F, t: f64) {
+        let confirmation_hits = self.config.tracker.confirmation_hits;
+        for index in 0..frame.len() {
+            if self.fates[index] != MeasurementFate::Unassigned {
+                continue;
+            }
+            let Ok(measurement) = frame.measurement(index) else { continue };
+            let estimate = self.imm.initiate(&self.models[measurement.class.index()], &measurement);
+            match self.table.insert(|id| Track::new(id, &measurement, t, estimate)) {
+                Ok(track) => {
+                    self.stats.tracks_initiated += 1;
+                    // A confirmation threshold of one hit confirms at once.
+                    if track.hits >= confirmation_hits {
+                        track.status = TrackStatus::Confirmed;
+                        self.stats.tracks_confirmed += 1;
+                    }
+                    self.rows[self.table.len() - 1] = RowRecord {
+                        prior_position_m: None,
+                        available: self.imm.modes(),
+                        measurement_index: Some(index as u16),
+                    };
+                    self.fates[index] = MeasurementFate::Assigned;
+                }
+                Err(_) => self.stats.initiations_refused_table_full += 1,
+            }
+        }
+    }
+
+    /// Removes tentative tracks after `tentative_max_misses` misses or `tentative_max_coast_s`
+    /// without update, confirmed ones after `confirmed_max_misses` or `max_coast_s`.
+    fn delete(&mut self, t: f64) {
+        let lifecycle = &self.config.tracker;
+        let rows = &mut self.rows;
+        let (mut read, mut write) = (0, 0);
+        let deleted = self.table.retain(|track| {
+            let (max_misses, max_coast_s) = match track.status {
+                TrackStatus::Tentative => (lifecycle.tentative_max_misses, lifecycle.tentative_max_coast_s),
+                TrackStatus::Confirmed => (lifecycle.confirmed_max_misses, lifecycle.max_coast_s),
+            };
+            let keep = track.misses <= max_misses && t - track.last_update_s <= max_coast_s;
+            if keep {
+                rows[write] = rows[read];
+                write += 1;
+            }
+            read += 1;
+            keep
+        });
+        self.stats.tracks_deleted += deleted as u64;
+    }
+
+    /// Removes every track and forgets the last timestamp, e.g. after a gap in the stream that
+    /// [`FrameError::IntervalTooLong`] reported. Ids keep counting; statistics are kept.
+    pub fn reset(&mut self) {
+        self.table.clear();
+        self.last_timestamp_s = None;
+        self.stats.resets += 1;
+    }
+
+    /// The counters.
+    pub fn stats(&self) -> &TrackerStats {
+        &self.stats
+    }
+
+    /// The live tracks.
+    pub fn tracks(&self) -> &[Track] {
+        self.table.tracks()
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The predictor.
+    pub fn predictor(&self) -> &P {
+        &self.predictor
+    }
+
+    /// The predictor, mutable.
+    pub fn predictor_mut(&mut self) -> &mut P {
+        &mut self.predictor
+    }
+}
+
+/// The output record of every live track, handed to `sink`; returns the count.
+fn report(table: &TrackTable, rows: &[RowRecord], imm: &Imm, mut sink: impl FnMut(&TrackOutput)) -> usize {
+    for (track, row) in table.tracks().iter().zip(rows.iter()) {
+        let fused = imm.fuse_posterior(&track.estimate, row.available);
+        sink(&TrackOutput {
+            id: track.id,
+            class: track.class,
+            status: track.status,
+            position_m: fused.mean,
+            position_covariance_m2: fused.covariance,
+            velocity_mps: imm.fuse_velocity(&track.estimate, row.available),
+            prior_position_m: row.prior_position_m,
+            mode_probabilities: track.estimate.probabilities,
+            age_frames: track.age_frames,
+            hits: track.hits,
+            misses: track.misses,
+            ground_truth_id: row.measurement_index.and(track.ground_truth_id),
+            measurement_index: row.measurement_index,
+        });
+    }
+    table.len()
+}

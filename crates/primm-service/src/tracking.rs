@@ -1,0 +1,492 @@
+//! The tracking loop: take a measurement sample, track it in place, write the tracks straight
+//! into a loaned track sample, send, notify; record latencies; report them every few frames.
+//!
+//! primm's code on this path allocates nothing per frame (`tests/service_allocation.rs` counts
+//! it). What remains: iceoryx2 0.10's `Publisher::loan_uninit` allocates one 48-byte
+//! reference-counted handle per loaned sample (every loan path of 0.10 does; see
+//! `docs/service.md`), and, off the normal path, a logged warning (bounded by [`LogLimiter`])
+//! and the setup of a connection when a port joins.
+//!
+//! The loop waits on the measurement stream's iceoryx2 listener (event-driven, the default) or
+//! spins on the subscriber ([`WaitMode::BusyPoll`]). It does not use a `WaitSet` because
+//! iceoryx2 0.10's `WaitSet` collects the ready attachments into a fresh `Vec` on every
+//! wake-up; with a single source the listener's own timed wait does the same job without it.
+//!
+//! Rejected frames are answered, not dropped: the service publishes a [`TrackFrame`] with no
+//! tracks and a [`FrameStatus`] naming the reason, so a subscriber can tell a rejected frame from
+//! a lost one and every input sequence number gets exactly one answer.
+
+use super::catalog::{self, ConnectError, Ipc, ServiceNames};
+use super::clock::monotonic_ns;
+use super::latency::{LatencyHistograms, StageTimer};
+use super::log_limit::LogLimiter;
+use super::shutdown::ShutdownFlag;
+use iceoryx2::identifiers::UniquePublisherId;
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::ConnectionFailure;
+use iceoryx2::port::ReceiveError;
+use iceoryx2::sample::Sample;
+use primm_core::predictor::DisplacementPredictor;
+use primm_core::tracker::{StepError, Tracker};
+use primm_core::validation::FrameError;
+use primm_wire::{
+    FrameStatus, LatencyReport, LatencyStage, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
+    TrackFrameWriter, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, STAGE_CAPACITY,
+    TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
+};
+use std::time::{Duration, Instant};
+
+/// How the tracking loop waits for measurement frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum WaitMode {
+    /// Sleep on the measurement stream's event service until a publisher notifies (default;
+    /// costs a wake-up, ~10-30 µs, but no CPU while idle).
+    #[default]
+    Event,
+    /// Spin on the subscriber: lowest latency, one core busy all the time.
+    BusyPoll,
+}
+
+/// Settings of the tracking loop.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TrackingOptions {
+    /// Service-name prefix.
+    pub names: ServiceNames,
+    /// How to wait for input.
+    pub wait: WaitMode,
+    /// A latency report is published after every this many received frames (0: never, only at
+    /// shutdown).
+    pub latency_report_interval_frames: u64,
+    /// Longest single wait, after which the loop checks for shutdown.
+    pub poll_timeout: Duration,
+}
+
+impl Default for TrackingOptions {
+    fn default() -> Self {
+        Self {
+            names: ServiceNames::new(""),
+            wait: WaitMode::Event,
+            latency_report_interval_frames: 100,
+            poll_timeout: Duration::from_millis(50),
+        }
+    }
+}
+
+/// Counters of the service (the tracker keeps its own, [`Tracker::stats`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct ServiceCounters {
+    /// Measurement frames taken from the input buffer.
+    pub frames_received: u64,
+    /// Frames tracked.
+    pub frames_tracked: u64,
+    /// Frames rejected (answered with a rejection status).
+    pub frames_rejected: u64,
+    /// Input sequence numbers skipped (frames lost before the tracker saw them).
+    pub frames_lost: u64,
+    /// Resets because a frame started a new stream.
+    pub resets_stream_start: u64,
+    /// Resets because frames came from a new publisher.
+    pub resets_new_publisher: u64,
+    /// Resets because the interval since the previous frame was too long (the frame was then
+    /// tracked as the first of a new stream).
+    pub resets_interval_too_long: u64,
+    /// Track frames that could not be loaned or sent.
+    pub publish_failures: u64,
+    /// Latency reports that could not be loaned or sent.
+    pub latency_report_failures: u64,
+    /// Latency reports sent.
+    pub latency_reports: u64,
+}
+
+impl ServiceCounters {
+    /// All resets.
+    pub fn resets(&self) -> u64 {
+        self.resets_stream_start + self.resets_new_publisher + self.resets_interval_too_long
+    }
+}
+
+/// Why the tracking loop stopped with an error.
+#[derive(Debug, thiserror::Error)]
+pub enum TrackingLoopError {
+    /// Receiving from the measurement stream failed.
+    #[error("cannot receive measurement frames: {0}")]
+    Receive(ReceiveError),
+    /// Checking the measurement stream for samples failed (busy-poll mode).
+    #[error("cannot poll the measurement stream: {0}")]
+    Poll(ConnectionFailure),
+    /// Waiting on the measurement stream's event service failed.
+    #[error("cannot wait for measurement frames: {0}")]
+    Wait(ListenerWaitError),
+}
+
+/// Which rejections and failures have been logged how often.
+#[derive(Debug, Default)]
+struct LogLimits {
+    rejected: LogLimiter,
+    lost: LogLimiter,
+    publish: LogLimiter,
+    latency: LogLimiter,
+    notify: LogLimiter,
+}
+
+/// Where the current input stream stands.
+#[derive(Debug, Default)]
+struct StreamState {
+    origin: Option<UniquePublisherId>,
+    last_sequence: Option<u64>,
+    /// Whether the tracker has tracked a frame since it was built or last reset.
+    tracker_dirty: bool,
+}
+
+/// The tracker behind its iceoryx2 ports.
+#[derive(Debug)]
+pub struct TrackingService<P: DisplacementPredictor> {
+    input: Subscriber<Ipc, MeasurementFrame, ()>,
+    input_listener: Option<Listener<Ipc>>,
+    output: Publisher<Ipc, TrackFrame, ()>,
+    output_notifier: Notifier<Ipc>,
+    latency_output: Publisher<Ipc, LatencyReport, ()>,
+    latency_notifier: Notifier<Ipc>,
+    tracker: Tracker<P>,
+    histograms: LatencyHistograms,
+    counters: ServiceCounters,
+    stream: StreamState,
+    logs: LogLimits,
+    options: TrackingOptions,
+    node: Node<Ipc>,
+}
+
+impl<P: DisplacementPredictor> TrackingService<P> {
+    /// Opens the three streams (creating them if needed) and their ports.
+    pub fn new(tracker: Tracker<P>, options: TrackingOptions) -> Result<Self, ConnectError> {
+        let node = catalog::create_node("primm-serve")?;
+        let measurements = catalog::measurements(&node, &options.names)?;
+        let tracks = catalog::tracks(&node, &options.names)?;
+        let latency = catalog::latency(&node, &options.names)?;
+        let input = measurements.subscriber()?;
+        let input_listener = match options.wait {
+            WaitMode::Event => Some(measurements.listener()?),
+            WaitMode::BusyPoll => None,
+        };
+        Ok(Self {
+            input,
+            input_listener,
+            output: tracks.publisher()?,
+            output_notifier: tracks.notifier()?,
+            latency_output: latency.publisher()?,
+            latency_notifier: latency.notifier()?,
+            tracker,
+            histograms: LatencyHistograms::new(),
+            counters: ServiceCounters::default(),
+            stream: StreamState::default(),
+            logs: LogLimits::default(),
+            options,
+            node,
+        })
+    }
+
+    /// Runs until `shutdown` is raised, then publishes a last latency report.
+    pub fn run(&mut self, shutdown: &ShutdownFlag) -> Result<(), TrackingLoopError> {
+        while !shutdown.is_requested() {
+            self.poll(self.options.poll_timeout)?;
+        }
+        self.publish_latency_report();
+        Ok(())
+    }
+
+    /// Waits up to `timeout` for input, then tracks every frame in the buffer. Returns the
+    /// number of frames processed.
+    pub fn poll(&mut self, timeout: Duration) -> Result<usize, TrackingLoopError> {
+        match &self.input_listener {
+            Some(listener) => match listener.timed_wait(|_| {}, timeout) {
+                Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
+                Err(error) => return Err(TrackingLoopError::Wait(error)),
+            },
+            None => {
+                let deadline = Instant::now() + timeout;
+                while !self.input.has_samples().map_err(TrackingLoopError::Poll)? && Instant::now() < deadline
+                {
+                    std::hint::spin_loop();
+                }
+            }
+        }
+        self.drain()
+    }
+
+    /// Tracks every frame in the input buffer without waiting.
+    pub fn drain(&mut self) -> Result<usize, TrackingLoopError> {
+        let mut processed = 0;
+        while let Some(sample) = self.input.receive().map_err(TrackingLoopError::Receive)? {
+            self.process(sample);
+            processed += 1;
+        }
+        Ok(processed)
+    }
+
+    /// Tracks one frame and publishes the answer.
+    fn process(&mut self, sample: Sample<Ipc, MeasurementFrame, ()>) {
+        let receive_ns = monotonic_ns();
+        self.counters.frames_received += 1;
+        let origin = sample.header().publisher_id();
+        let frame: &MeasurementFrame = &sample;
+        let mut flags = self.follow_stream(origin, frame);
+
+        let stats_before = *self.tracker.stats();
+        let mut loan = match self.output.loan_uninit() {
+            Ok(loan) => Some(loan),
+            Err(error) => {
+                self.counters.publish_failures += 1;
+                if self.logs.publish.occur() {
+                    tracing::warn!(%error, occurrences = self.logs.publish.occurrences(), "cannot loan a track sample; frame tracked but not published");
+                }
+                None
+            }
+        };
+        let mut writer = loan.as_mut().map(|loan| TrackFrameWriter::new(loan.payload_mut()));
+        let mut timer = StageTimer::new(&mut self.histograms, receive_ns);
+        let mut result = self.tracker.step_observed(frame, &mut timer, |output| {
+            if let Some(writer) = writer.as_mut() {
+                writer.push(output);
+            }
+        });
+        if let Err(StepError::InvalidFrame(FrameError::IntervalTooLong { .. })) = result {
+            // Tracks cannot be bridged over the gap: start afresh with this frame.
+            self.tracker.reset();
+            self.counters.resets_interval_too_long += 1;
+            flags |= TRACK_FLAG_TRACKER_RESET;
+            if let Some(writer) = writer.as_mut() {
+                writer.clear();
+            }
+            result = self.tracker.step_observed(frame, &mut timer, |output| {
+                if let Some(writer) = writer.as_mut() {
+                    writer.push(output);
+                }
+            });
+        }
+        let status = match &result {
+            Ok(_) => {
+                self.counters.frames_tracked += 1;
+                self.stream.tracker_dirty = true;
+                FrameStatus::Tracked
+            }
+            Err(error) => {
+                self.counters.frames_rejected += 1;
+                if self.logs.rejected.occur() {
+                    tracing::warn!(
+                        sequence = frame.sequence,
+                        %error,
+                        occurrences = self.logs.rejected.occurrences(),
+                        "measurement frame rejected"
+                    );
+                }
+                FrameStatus::of_error(error)
+            }
+        };
+        let stats = self.tracker.stats();
+        let accepted = stats.measurements_accepted - stats_before.measurements_accepted;
+        let rejected = (stats.measurements_rejected_unknown_class
+            + stats.measurements_rejected_non_finite
+            + stats.measurements_rejected_out_of_range)
+            - (stats_before.measurements_rejected_unknown_class
+                + stats_before.measurements_rejected_non_finite
+                + stats_before.measurements_rejected_out_of_range);
+        if frame.flags & FRAME_FLAG_STREAM_END != 0 {
+            flags |= TRACK_FLAG_STREAM_END;
+        }
+        let mut header = TrackFrameHeader {
+            input_sequence: frame.sequence,
+            source_frame: frame.source_frame,
+            sensor_timestamp_s: frame.sensor_timestamp_s,
+            input_publish_time_ns: frame.publish_time_ns,
+            receive_time_ns: receive_ns,
+            publish_time_ns: 0,
+            status,
+            flags,
+            measurements_accepted: accepted.min(u64::from(u16::MAX)) as u16,
+            measurements_rejected: rejected.min(u64::from(u16::MAX)) as u16,
+        };
+        // The input sample goes back to its publisher before the answer is sent.
+        drop(sample);
+
+        let publish_start = monotonic_ns();
+        header.publish_time_ns = publish_start;
+        let written = writer.map(|writer| writer.finish(&header));
+        if let (Some(loan), Some(_)) = (loan, written) {
+            // SAFETY: the writer initialised the header and the first `count` tracks; the
+            // remaining slots hold bytes left in the shared-memory chunk by earlier samples (or
+            // the zeroes the OS mapped), and every field of `WireTrack` is a plain integer or
+            // float for which any bit pattern is a valid value.
+            let sample = unsafe { loan.assume_init() };
+            match sample.send() {
+                Ok(_) => {
+                    if let Err(error) = self.output_notifier.notify() {
+                        if self.logs.notify.occur() {
+                            tracing::warn!(%error, "cannot notify track listeners");
+                        }
+                    }
+                }
+                Err(error) => {
+                    self.counters.publish_failures += 1;
+                    if self.logs.publish.occur() {
+                        tracing::warn!(%error, occurrences = self.logs.publish.occurrences(), "cannot send a track frame");
+                    }
+                }
+            }
+            let done_ns = monotonic_ns();
+            self.histograms.record(LatencyStage::Publish, done_ns.saturating_sub(publish_start));
+            self.histograms.record(LatencyStage::ReceiveToPublish, done_ns.saturating_sub(receive_ns));
+            if header.input_publish_time_ns != 0 && header.input_publish_time_ns <= publish_start {
+                self.histograms.record(LatencyStage::EndToEnd, publish_start - header.input_publish_time_ns);
+            }
+        }
+
+        let interval = self.options.latency_report_interval_frames;
+        if interval > 0 && self.counters.frames_received % interval == 0 {
+            self.publish_latency_report();
+        }
+    }
+
+    /// Resets the tracker when a new stream or publisher starts; counts sequence gaps. Returns
+    /// the track-frame flags this implies.
+    fn follow_stream(&mut self, origin: UniquePublisherId, frame: &MeasurementFrame) -> u8 {
+        let mut flags = 0;
+        let new_publisher = self.stream.origin.is_some_and(|previous| previous != origin);
+        let stream_start = frame.flags & FRAME_FLAG_STREAM_START != 0;
+        if stream_start || new_publisher {
+            if self.stream.tracker_dirty {
+                self.tracker.reset();
+                self.stream.tracker_dirty = false;
+                flags |= TRACK_FLAG_TRACKER_RESET;
+                if new_publisher {
+                    self.counters.resets_new_publisher += 1;
+                    tracing::info!(sequence = frame.sequence, "frames from a new publisher: tracker reset");
+                } else {
+                    self.counters.resets_stream_start += 1;
+                    tracing::info!(sequence = frame.sequence, "new stream: tracker reset");
+                }
+            }
+            self.stream.last_sequence = None;
+        }
+        self.stream.origin = Some(origin);
+        if let Some(last) = self.stream.last_sequence {
+            if frame.sequence > last.saturating_add(1) {
+                let lost = frame.sequence - last - 1;
+                self.counters.frames_lost += lost;
+                flags |= TRACK_FLAG_SEQUENCE_GAP;
+                if self.logs.lost.occur() {
+                    tracing::warn!(
+                        lost,
+                        after = last,
+                        occurrences = self.logs.lost.occurrences(),
+                        "measurement frames lost"
+                    );
+                }
+            }
+        }
+        self.stream.last_sequence = Some(frame.sequence);
+        flags
+    }
+
+    /// Sends a latency report (cumulative since start) and notifies its listeners.
+    pub fn publish_latency_report(&mut self) {
+        let loan = match self.latency_output.loan_uninit() {
+            Ok(loan) => loan,
+            Err(error) => {
+                self.counters.latency_report_failures += 1;
+                if self.logs.latency.occur() {
+                    tracing::warn!(%error, "cannot loan a latency report");
+                }
+                return;
+            }
+        };
+        let report = self.latency_report();
+        match loan.write_payload(report).send() {
+            Ok(_) => {
+                self.counters.latency_reports += 1;
+                let _ = self.latency_notifier.notify();
+            }
+            Err(error) => {
+                self.counters.latency_report_failures += 1;
+                if self.logs.latency.occur() {
+                    tracing::warn!(%error, "cannot send a latency report");
+                }
+            }
+        }
+    }
+
+    /// The current latency report.
+    pub fn latency_report(&self) -> LatencyReport {
+        let stats = self.tracker.stats();
+        let mut report = LatencyReport {
+            sequence: self.counters.latency_reports,
+            publish_time_ns: monotonic_ns(),
+            frames_received: self.counters.frames_received,
+            frames_tracked: self.counters.frames_tracked,
+            frames_rejected: self.counters.frames_rejected,
+            frames_lost: self.counters.frames_lost,
+            measurements_rejected: stats.measurements_rejected_unknown_class
+                + stats.measurements_rejected_non_finite
+                + stats.measurements_rejected_out_of_range,
+            resets: self.counters.resets(),
+            stage_count: 0,
+            _pad0: [0; 4],
+            stages: [StageLatency::named(""); STAGE_CAPACITY],
+        };
+        self.histograms.fill_report(&mut report);
+        report
+    }
+
+    /// The service's counters.
+    pub fn counters(&self) -> &ServiceCounters {
+        &self.counters
+    }
+
+    /// The tracker.
+    pub fn tracker(&self) -> &Tracker<P> {
+        &self.tracker
+    }
+
+    /// The latency histograms.
+    pub fn histograms(&self) -> &LatencyHistograms {
+        &self.histograms
+    }
+
+    /// The options.
+    pub fn options(&self) -> &TrackingOptions {
+        &self.options
+    }
+
+    /// The iceoryx2 node.
+    pub fn node(&self) -> &Node<Ipc> {
+        &self.node
+    }
+
+    /// A plain-text summary for the end of a run: counters and the latency table.
+    pub fn summary(&self) -> String {
+        let c = &self.counters;
+        let s = self.tracker.stats();
+        format!(
+            "frames: {} received, {} tracked, {} rejected, {} lost; resets: {} (stream start {}, new publisher {}, interval too long {}); \
+             measurements: {} accepted, {} rejected; tracks: {} started, {} confirmed, {} deleted; publish failures: {}\n{}",
+            c.frames_received,
+            c.frames_tracked,
+            c.frames_rejected,
+            c.frames_lost,
+            c.resets(),
+            c.resets_stream_start,
+            c.resets_new_publisher,
+            c.resets_interval_too_long,
+            s.measurements_accepted,
+            s.measurements_rejected_unknown_class + s.measurements_rejected_non_finite + s.measurements_rejected_out_of_range,
+            s.tracks_initiated,
+            s.tracks_confirmed,
+            s.tracks_deleted,
+            c.publish_failures,
+            self.histograms.table()
+        ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
+    }
+}

@@ -1,0 +1,165 @@
+//! Per-measurement evaluation rows and the identifiers of the compared methods.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use primm_core::measurement::ObjectClass;
+
+pub use primm_core::mode::Method;
+
+/// One evaluation row: a single measurement, which the paper counts as one ground-truth object
+/// frame, together with what one method did with it.
+///
+/// Rows of one sequence are passed together as a slice; rows of different sequences must never be
+/// mixed, because ground-truth and track identifiers are only unique within a sequence.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AssociationRecord {
+    /// Frame index within the sequence; defines the time order of rows.
+    pub frame: u64,
+    /// Frame time, seconds.
+    pub timestamp_s: f64,
+    /// Ground-truth object identity; `None` for a measurement without an annotated object, which
+    /// is neither a ground-truth object frame nor part of any scenario subset.
+    pub ground_truth_id: Option<u64>,
+    /// Object class of the measurement.
+    pub class: ObjectClass,
+    /// Measured position (vehicle frame, metres).
+    pub measured: DVec2,
+    /// True object position when the data source knows it (simulation); otherwise the measurement
+    /// is the reference position.
+    pub true_position: Option<DVec2>,
+    /// Track that this measurement updated or started; `None` when no track took it.
+    pub track_id: Option<u64>,
+    /// The track's fused one-step prior position before this update (`eq:prior_fusion` for the
+    /// IMM variants); `None` when the measurement started a track or was not used.
+    pub prior: Option<DVec2>,
+    /// Posterior mode probabilities after the update, in PR, CV, CA, CT order
+    /// (`eq:mode_update`); `None` for single-model methods and rows without an update. A mode the
+    /// method does not have carries probability 0.
+    pub mode_probabilities: Option<[f64; 4]>,
+}
+
+impl AssociationRecord {
+    /// The position the prior is scored against and scenario rules are computed from: the true
+    /// position when known, else the measurement.
+    pub fn reference_position(&self) -> DVec2 {
+        self.true_position.unwrap_or(self.measured)
+    }
+
+    /// Whether this row is a ground-truth object frame.
+    pub fn is_ground_truth_frame(&self) -> bool {
+        self.ground_truth_id.is_some()
+    }
+
+    /// Whether this row is an estimated object frame (a track consumed the measurement).
+    pub fn is_estimated_frame(&self) -> bool {
+        self.track_id.is_some()
+    }
+}
+
+/// Errors of the evaluation library.
+#[derive(Debug, thiserror::Error)]
+pub enum EvalError {
+    /// A drop fraction outside `[0, 1]` (or not finite).
+    #[error("drop fraction {0} is not within [0, 1]")]
+    InvalidDropFraction(f64),
+    /// Scenario or interaction rules that cannot be applied.
+    #[error("invalid rule parameters: {0}")]
+    InvalidRules(String),
+    /// A list whose length does not match the one a mask or flag set was built for.
+    #[error("expected {expected} items, got {actual}")]
+    LengthMismatch {
+        /// Length the mask was built for.
+        expected: usize,
+        /// Length of the list it was applied to.
+        actual: usize,
+    },
+    /// Drawing a figure failed.
+    #[error("plot failed: {0}")]
+    Plot(String),
+    /// Reading or writing a file failed.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// Encoding JSON failed.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
+/// Row indices of one sequence in time order: sorted by frame, ties kept in input order.
+pub(crate) fn time_order(records: &[AssociationRecord]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..records.len()).collect();
+    order.sort_by_key(|&index| records[index].frame);
+    order
+}
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    use super::*;
+
+    /// A row with a ground-truth id, an optional track and nothing else of interest.
+    pub fn identity_row(frame: u64, gt: Option<u64>, track: Option<u64>) -> AssociationRecord {
+        AssociationRecord {
+            frame,
+            timestamp_s: frame as f64 * 0.1,
+            ground_truth_id: gt,
+            class: ObjectClass::Car,
+            measured: DVec2::ZERO,
+            true_position: None,
+            track_id: track,
+            prior: None,
+            mode_probabilities: None,
+        }
+    }
+
+    /// A row of ground-truth object `gt` at a given time and reference position.
+    pub fn position_row(frame: u64, time_s: f64, gt: u64, position: DVec2) -> AssociationRecord {
+        AssociationRecord {
+            frame,
+            timestamp_s: time_s,
+            ground_truth_id: Some(gt),
+            class: ObjectClass::Car,
+            measured: position,
+            true_position: Some(position),
+            track_id: Some(gt),
+            prior: None,
+            mode_probabilities: None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn method_keys_and_labels_round_trip() {
+        for method in Method::ALL {
+            assert_eq!(Method::parse(method.key()), Some(method));
+            assert_eq!(Method::parse(method.label()), Some(method));
+            let json = serde_json::to_string(&method).unwrap();
+            assert_eq!(json, format!("\"{}\"", method.id()));
+        }
+        assert_eq!(Method::parse("pr-imm"), Some(Method::PrImm));
+        assert_eq!(Method::parse("kalman"), None);
+    }
+
+    #[test]
+    fn reference_position_prefers_truth() {
+        let mut row = test_support::identity_row(0, Some(1), Some(1));
+        row.measured = DVec2::new(1.0, 2.0);
+        assert_eq!(row.reference_position(), DVec2::new(1.0, 2.0));
+        row.true_position = Some(DVec2::new(3.0, 4.0));
+        assert_eq!(row.reference_position(), DVec2::new(3.0, 4.0));
+    }
+
+    #[test]
+    fn time_order_is_stable_by_frame() {
+        let rows = [
+            test_support::identity_row(3, Some(1), None),
+            test_support::identity_row(1, Some(2), None),
+            test_support::identity_row(3, Some(3), None),
+            test_support::identity_row(0, Some(4), None),
+        ];
+        assert_eq!(time_order(&rows), vec![3, 1, 0, 2]);
+    }
+}

@@ -1,0 +1,136 @@
+//! Recorded sequences: the in-memory form of a measurement file and of generated scenarios.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use primm_core::measurement::{Frame, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+
+/// Pose of the ego vehicle's reference point (centre of the rear axle, as in RadarScenes) in a
+/// fixed world frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EgoPose {
+    /// World x of the reference point, metres.
+    pub x_m: f64,
+    /// World y of the reference point, metres.
+    pub y_m: f64,
+    /// Heading of the vehicle's x axis, radians, counter-clockwise from the world x axis.
+    pub yaw_rad: f64,
+}
+
+impl EgoPose {
+    /// The reference point as a vector, metres.
+    pub fn position(&self) -> DVec2 {
+        DVec2::new(self.x_m, self.y_m)
+    }
+
+    /// Maps a point from the car frame (x forward, y left) into the world frame.
+    pub fn car_to_world(&self, point_car: DVec2) -> DVec2 {
+        self.position() + DVec2::from_angle(self.yaw_rad).rotate(point_car)
+    }
+
+    /// Maps a point from the world frame into the car frame.
+    pub fn world_to_car(&self, point_world: DVec2) -> DVec2 {
+        DVec2::from_angle(-self.yaw_rad).rotate(point_world - self.position())
+    }
+
+    /// Rotates a world-frame direction or velocity into the car frame (no translation).
+    pub fn rotate_to_car(&self, vector_world: DVec2) -> DVec2 {
+        DVec2::from_angle(-self.yaw_rad).rotate(vector_world)
+    }
+}
+
+/// One object-level measurement of a recorded frame, with its true position where known.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RecordedMeasurement {
+    /// The measurement as the tracker receives it.
+    pub measurement: Measurement,
+    /// True centre of the object in the car frame, metres (simulated data only).
+    pub true_position: Option<DVec2>,
+}
+
+/// One radar scan: its index in the sequence, time, sensor, ego pose and measurements.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecordedFrame {
+    /// 0-based frame index within its sequence; strictly increasing along a sequence.
+    pub index: u64,
+    /// Scan time, seconds since the start of the sequence.
+    pub timestamp_s: f64,
+    /// Radar sensor that produced the scan, if known.
+    pub sensor_id: Option<u16>,
+    /// Ego pose at scan time, if known.
+    pub ego_pose: Option<EgoPose>,
+    /// Object measurements of this scan (possibly none).
+    pub measurements: Vec<RecordedMeasurement>,
+}
+
+/// A recorded frame holds more measurements than [`MAX_MEASUREMENTS_PER_FRAME`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("frame {frame} holds {count} measurements, more than the limit of {max}", max = MAX_MEASUREMENTS_PER_FRAME)]
+pub struct TooManyMeasurements {
+    /// Index of the offending frame.
+    pub frame: u64,
+    /// Number of measurements it holds.
+    pub count: usize,
+}
+
+impl RecordedFrame {
+    /// An empty frame.
+    pub fn new(index: u64, timestamp_s: f64) -> Self {
+        Self { index, timestamp_s, sensor_id: None, ego_pose: None, measurements: Vec::new() }
+    }
+
+    /// Converts into the library's fixed-capacity [`Frame`]. Ground-truth ids, classes and
+    /// sensor ids are carried through unchanged; true positions are dropped.
+    pub fn to_frame(&self) -> Result<Frame, TooManyMeasurements> {
+        if self.measurements.len() > MAX_MEASUREMENTS_PER_FRAME {
+            return Err(TooManyMeasurements { frame: self.index, count: self.measurements.len() });
+        }
+        let mut frame = Frame::new(self.timestamp_s);
+        frame.measurements.extend(self.measurements.iter().map(|m| m.measurement));
+        Ok(frame)
+    }
+
+    /// Number of measurements of class `class`.
+    pub fn count_class(&self, class: ObjectClass) -> usize {
+        self.measurements.iter().filter(|m| m.measurement.class == class).count()
+    }
+}
+
+/// A named sequence of recorded frames (one measurement file).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Sequence {
+    /// Name of the sequence, e.g. the file stem of its CSV file.
+    pub name: String,
+    /// Frames in time order.
+    pub frames: Vec<RecordedFrame>,
+}
+
+impl Sequence {
+    /// An empty sequence called `name`.
+    pub fn new(name: impl Into<String>) -> Self {
+        Self { name: name.into(), frames: Vec::new() }
+    }
+
+    /// Total number of object measurements over all frames.
+    pub fn measurement_count(&self) -> usize {
+        self.frames.iter().map(|f| f.measurements.len()).sum()
+    }
+
+    /// Number of object measurements of class `class` over all frames.
+    pub fn class_count(&self, class: ObjectClass) -> usize {
+        self.frames.iter().map(|f| f.count_class(class)).sum()
+    }
+
+    /// Time between the first and the last frame, seconds (0 for fewer than two frames).
+    pub fn duration_s(&self) -> f64 {
+        match (self.frames.first(), self.frames.last()) {
+            (Some(first), Some(last)) => last.timestamp_s - first.timestamp_s,
+            _ => 0.0,
+        }
+    }
+
+    /// The frames converted into library [`Frame`]s, in order.
+    pub fn to_frames(&self) -> Result<Vec<Frame>, TooManyMeasurements> {
+        self.frames.iter().map(RecordedFrame::to_frame).collect()
+    }
+}

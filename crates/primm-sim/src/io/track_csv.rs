@@ -1,0 +1,110 @@
+//! The track file format written by `primm track` and `primm-subscriber --csv`.
+//!
+//! Header `frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct`; one row
+//! per track updated by a measurement in that frame: `x`,`y` the fused posterior position (m),
+//! `prior_*` the fused one-step prior before the update (m; empty for a track started in that
+//! frame), `gt_id` the ground-truth id of the measurement (-1 when unknown), `mu_*` the posterior
+//! mode probabilities (0 for modes the method does not use).
+
+use primm_core::track::TrackOutput;
+use std::io::Write;
+
+/// The header line.
+pub const TRACK_CSV_HEADER: &str = "frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct";
+
+/// One row of the track file.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackRow<'a> {
+    /// Frame index in its recording.
+    pub frame: u64,
+    /// Frame time, s.
+    pub timestamp_s: f64,
+    /// Track id.
+    pub track_id: u64,
+    /// Class name (`car`, `pedestrian`, ...).
+    pub class: &'a str,
+    /// Fused posterior position, m.
+    pub position_m: [f64; 2],
+    /// Fused prior position, m; `None` for a track started in this frame.
+    pub prior_position_m: Option<[f64; 2]>,
+    /// Ground-truth id of the measurement.
+    pub ground_truth_id: Option<u64>,
+    /// Mode probabilities, order PR, CV, CA, CT.
+    pub mode_probabilities: [f64; 4],
+}
+
+/// Writes track rows. Floats are written in the shortest form that reads back exactly.
+#[derive(Debug)]
+pub struct TrackCsvWriter<W: Write> {
+    out: W,
+    rows: u64,
+}
+
+impl<W: Write> TrackCsvWriter<W> {
+    /// A writer that starts with the header.
+    pub fn new(mut out: W) -> std::io::Result<Self> {
+        writeln!(out, "{TRACK_CSV_HEADER}")?;
+        Ok(Self { out, rows: 0 })
+    }
+
+    /// Writes the rows of one frame (tracks updated by a measurement only).
+    pub fn write_frame(
+        &mut self,
+        frame: u64,
+        timestamp_s: f64,
+        outputs: &[TrackOutput],
+    ) -> std::io::Result<()> {
+        for output in outputs.iter().filter(|o| o.measurement_index.is_some()) {
+            self.write_row(frame, timestamp_s, output)?;
+        }
+        Ok(())
+    }
+
+    /// Writes one row from a tracker output.
+    pub fn write_row(&mut self, frame: u64, timestamp_s: f64, output: &TrackOutput) -> std::io::Result<()> {
+        self.write(&TrackRow {
+            frame,
+            timestamp_s,
+            track_id: output.id,
+            class: output.class.name(),
+            position_m: [output.position_m.x, output.position_m.y],
+            prior_position_m: output.prior_position_m.map(|p| [p.x, p.y]),
+            ground_truth_id: output.ground_truth_id,
+            mode_probabilities: output.mode_probabilities,
+        })
+    }
+
+    /// Writes one row.
+    pub fn write(&mut self, row: &TrackRow<'_>) -> std::io::Result<()> {
+        let (prior_x, prior_y) = match row.prior_position_m {
+            Some([x, y]) => (x.to_string(), y.to_string()),
+            None => (String::new(), String::new()),
+        };
+        let gt = row.ground_truth_id.map_or(-1, |id| id as i64);
+        let [mu_pr, mu_cv, mu_ca, mu_ct] = row.mode_probabilities;
+        let [x, y] = row.position_m;
+        writeln!(
+            self.out,
+            "{},{},{},{},{x},{y},{prior_x},{prior_y},{gt},{mu_pr},{mu_cv},{mu_ca},{mu_ct}",
+            row.frame, row.timestamp_s, row.track_id, row.class
+        )?;
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
+    /// Flushes the output.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
+
+    /// Flushes and returns the inner writer.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        self.out.flush()?;
+        Ok(self.out)
+    }
+}
