@@ -2,7 +2,7 @@
 //! [`Sequence`], with every measurement's fate turned into evaluation rows.
 
 use crate::eval::record::AssociationRecord;
-use crate::io::{RecordedFrame, RecordedMeasurement, Sequence, TooManyMeasurements};
+use crate::io::{RecordedFrame, Sequence, TooManyMeasurements};
 use primm_core::measurement::Frame;
 use primm_core::mode::Method;
 use primm_core::predictor::DisplacementPredictor;
@@ -70,7 +70,7 @@ pub fn association_records(
     records: &mut Vec<AssociationRecord>,
 ) {
     let start = records.len();
-    records.extend(recorded.measurements.iter().map(|m| unassigned_record(recorded, m)));
+    records.extend(recorded.measurements.iter().map(|m| recorded.unassigned_record(m)));
     let with_modes = method.modes().len() > 1;
     for output in outputs {
         let Some(index) = output.measurement_index else { continue };
@@ -81,22 +81,6 @@ pub fn association_records(
                 record.mode_probabilities = Some(output.mode_probabilities);
             }
         }
-    }
-}
-
-/// The evaluation row of measurement `m` of `recorded` before any track is known to have taken
-/// it.
-pub fn unassigned_record(recorded: &RecordedFrame, m: &RecordedMeasurement) -> AssociationRecord {
-    AssociationRecord {
-        frame: recorded.index,
-        timestamp_s: recorded.timestamp_s,
-        ground_truth_id: m.measurement.ground_truth_id,
-        class: m.measurement.class,
-        measured: m.measurement.position(),
-        true_position: m.true_position,
-        track_id: None,
-        prior: None,
-        mode_probabilities: None,
     }
 }
 

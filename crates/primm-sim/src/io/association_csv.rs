@@ -208,7 +208,7 @@ pub fn association_records_from_rows(
     for recorded in &sequence.frames {
         for (position, m) in recorded.measurements.iter().enumerate() {
             index.insert((recorded.index, position as u16), records.len());
-            records.push(crate::offline::unassigned_record(recorded, m));
+            records.push(recorded.unassigned_record(m));
         }
     }
     let mut seen = vec![false; records.len()];

@@ -3,6 +3,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use crate::eval::record::AssociationRecord;
 use primm_core::measurement::{Frame, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 
 /// Pose of the ego vehicle's reference point (centre of the rear axle, as in RadarScenes) in a
@@ -61,6 +62,24 @@ pub struct RecordedFrame {
     pub ego_pose: Option<EgoPose>,
     /// Object measurements of this scan (possibly none).
     pub measurements: Vec<RecordedMeasurement>,
+}
+
+impl RecordedFrame {
+    /// The evaluation row of measurement `m` of this frame before any track is known to have
+    /// taken it.
+    pub fn unassigned_record(&self, m: &RecordedMeasurement) -> AssociationRecord {
+        AssociationRecord {
+            frame: self.index,
+            timestamp_s: self.timestamp_s,
+            ground_truth_id: m.measurement.ground_truth_id,
+            class: m.measurement.class,
+            measured: m.measurement.position(),
+            true_position: m.true_position,
+            track_id: None,
+            prior: None,
+            mode_probabilities: None,
+        }
+    }
 }
 
 /// A recorded frame holds more measurements than [`MAX_MEASUREMENTS_PER_FRAME`].
