@@ -16,6 +16,24 @@
 //!
 //! The publisher's replay loop and the subscriber's loop live in the `primm-publisher` and
 //! `primm-subscriber` packages; both use [`catalog`] to open the same services.
+//!
+//! Hosting a tracker (any `DisplacementPredictor`; here the physics-only IMM) under a private
+//! prefix, so that it does not meet another setup on the same machine:
+//!
+//! ```no_run
+//! use primm_core::config::Config;
+//! use primm_core::mode::Method;
+//! use primm_core::tracker::Tracker;
+//! use primm_service::{ServiceNames, ShutdownFlag, TrackingOptions, TrackingService};
+//!
+//! let tracker = Tracker::new(Config::default().with_modes(Method::Imm.modes()))?;
+//! let options = TrackingOptions { names: ServiceNames::new("example"), ..TrackingOptions::default() };
+//! let mut service = TrackingService::new(tracker, options)?;
+//! let shutdown = ShutdownFlag::on_signals()?;
+//! service.run(&shutdown)?; // until SIGINT or SIGTERM
+//! println!("{}", service.summary());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod catalog;
 pub mod clock;

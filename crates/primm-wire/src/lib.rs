@@ -1,3 +1,5 @@
+//! # primm-wire: the shared-memory payloads
+//!
 //! Payload types exchanged over shared memory between the tracker service, publishers,
 //! subscribers and clients written in other languages.
 //!
@@ -15,6 +17,41 @@
 //! Units are part of every field name. Times are either sensor time in seconds (`_s`, from the
 //! recording, the only time the tracker reads) or `CLOCK_MONOTONIC` nanoseconds (`_ns`, for
 //! latency measurements between processes on the same host).
+//!
+//! A [`MeasurementFrame`] is written in place (here into a zeroed heap buffer; in the service,
+//! into a sample loaned from shared memory) and read in place by the tracker, which takes any
+//! `FrameView`:
+//!
+//! ```
+//! use primm_core::config::Config;
+//! use primm_core::measurement::{Measurement, ObjectClass};
+//! use primm_core::tracker::Tracker;
+//! use primm_wire::{MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, WireMeasurement};
+//! use std::mem::MaybeUninit;
+//!
+//! let mut sample: Box<MaybeUninit<MeasurementFrame>> = Box::new_zeroed();
+//! let mut writer = MeasurementFrameWriter::new(&mut sample);
+//! let measurement = Measurement {
+//!     x_m: 12.0,
+//!     y_m: -3.0,
+//!     radial_velocity_mps: 2.5,
+//!     rcs_dbsm: 4.0,
+//!     class: ObjectClass::TwoWheeler,
+//!     sensor_id: Some(1),
+//!     ground_truth_id: None,
+//! };
+//! writer.push(WireMeasurement::new(&measurement, None))?;
+//! let header = MeasurementFrameHeader { sensor_timestamp_s: 0.25, ..Default::default() };
+//! writer.finish(&header);
+//! // Sound: the buffer started zeroed (every field is plain data) and `finish` wrote the
+//! // header and the measurement.
+//! let frame = unsafe { sample.assume_init() };
+//! assert_eq!(frame.count, 1);
+//!
+//! let mut tracker = Tracker::new(Config::default())?;
+//! assert_eq!(tracker.step(&*frame)?.len(), 1);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 mod latency_report;
 mod measurement_frame;
