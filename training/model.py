@@ -3,7 +3,7 @@
 Inputs (batch axis ``batch`` is the only dynamic one):
 
 * ``features`` ``[batch, 5, 5]`` float32: ``eq:pr_input`` rows, oldest first; rows ``0..len``
-  valid, rows ``len..`` zero (right padding), as ``primm::predictor::PredictionRequest``.
+  valid, rows ``len..`` zero (right padding), as ``primm_core::predictor::PredictionRequest``.
 * ``valid`` ``[batch, 5]`` float32: 1 for rows ``0..len``, 0 for padding.
 
 Output ``displacement`` ``[batch, 2]`` float32: ``[dx, dy]`` in metres, the displacement of the

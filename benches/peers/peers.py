@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Python trackers that a team would otherwise pick, run on primm's measurement CSV files.
 
-Two peers share one tracking loop that mirrors primm's (``src/tracker.rs``): per class, the
+Two peers share one tracking loop that mirrors primm's (``crates/primm-core/src/tracker.rs``): per class, the
 association cost of ``eq:association_cost`` (distance to the predicted position plus
 ``velocity_weight_s * min(|dv_r|, velocity_cap_mps)``), the class gate, an optimal assignment
 that first maximises the number of pairs and then minimises the cost, and primm's track
@@ -21,7 +21,7 @@ comes from ``config/primm.toml``. What differs is the filter and assignment code
   at the class gate). Stone Soup's hypothesiser has no radial-velocity term, so this peer's
   cost is the distance alone.
 
-Output: one association CSV per sequence (``src/io/association_csv.rs``), scored by
+Output: one association CSV per sequence (``crates/primm-sim/src/io/association_csv.rs``), scored by
 ``primm score``; and one JSON line with the time spent in the per-frame tracking loop
 (prediction, association, update, lifecycle; file reading and writing excluded).
 
@@ -84,7 +84,7 @@ def white_jerk(dt: float) -> np.ndarray:
 
 
 def initial_velocity(cls: dict, x: float, y: float, vr: float):
-    """primm's line-of-sight initial velocity (src/motion/mod.rs, InitialVelocity)."""
+    """primm's line-of-sight initial velocity (crates/primm-core/src/motion/mod.rs, InitialVelocity)."""
     rng = math.hypot(x, y)
     along = np.array([x / rng, y / rng]) if rng > 1e-6 else np.array([1.0, 0.0])
     across = np.array([-along[1], along[0]])
