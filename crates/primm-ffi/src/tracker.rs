@@ -1,0 +1,403 @@
+//! The tracker handle and its entry points.
+
+use crate::status::{guard, guard_value, record_thread_error, ErrorText, Failure, PanicMessage, PrimmStatus};
+use crate::text::copy_to_c_buffer;
+use crate::types::{
+    method_from_code, PrimmMeasurement, PrimmStats, PrimmStepSummary, PrimmTrack, PrimmTrackerOptions,
+    PRIMM_MAX_TRACKS, PRIMM_METHOD_CONFIG,
+};
+use core::ffi::{c_char, CStr};
+use core::fmt;
+use primm_core::config::Config;
+use primm_core::measurement::{FrameView, Measurement, UnknownClass};
+use primm_core::mode::Mode;
+use primm_core::predictor::{DisplacementPredictor, NoPredictor};
+use primm_core::tracker::Tracker;
+use primm_predictor::onnx::{ModelSource, OnnxPredictor, PrModel};
+use primm_predictor::threaded::ThreadedPredictor;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+/// Name under which model bytes given to [`primm_tracker_create`] appear in model errors.
+const CALLER_MODEL_NAME: &str = "(model bytes given to primm_tracker_create)";
+
+/// An opaque tracker: the core tracker with its predictor, the output buffer of the last step
+/// and the message of its last failure. Created by `primm_tracker_create`, released by
+/// `primm_tracker_destroy`. One thread at a time may use a tracker.
+pub struct PrimmTracker {
+    tracker: Tracker<Box<dyn DisplacementPredictor + Send>>,
+    /// [`PRIMM_MAX_TRACKS`] entries; the first `track_count` are the last step's tracks.
+    tracks: Box<[PrimmTrack]>,
+    track_count: usize,
+    last_error: ErrorText,
+    /// Set when a call panicked: the tracker's state may be inconsistent.
+    poisoned: bool,
+}
+
+impl fmt::Debug for PrimmTracker {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("PrimmTracker")
+            .field("stats", self.tracker.stats())
+            .field("track_count", &self.track_count)
+            .field("last_error", &self.last_error)
+            .field("poisoned", &self.poisoned)
+            .finish_non_exhaustive()
+    }
+}
+
+impl PrimmTracker {
+    /// Builds a tracker from `options`.
+    ///
+    /// # Safety
+    /// The pointers in `options` are NULL or valid as documented on [`PrimmTrackerOptions`].
+    unsafe fn new(options: &PrimmTrackerOptions) -> Result<Box<Self>, Failure> {
+        let config = if options.config_toml.is_null() {
+            Config::default()
+        } else {
+            // SAFETY: the caller passes a NUL-terminated string.
+            let text = unsafe { CStr::from_ptr(options.config_toml) };
+            primm_config::from_toml_str(text.to_str().map_err(Failure::ConfigNotUtf8)?)
+                .map_err(Failure::Config)?
+        };
+        let config = match method_from_code(options.method).map_err(Failure::UnknownMethod)? {
+            Some(method) => config.with_modes(method.modes()),
+            None => config,
+        };
+        let model_bytes = match (options.model_onnx.is_null(), options.model_onnx_len) {
+            (true, 0) => None,
+            (true, _) => return Err(Failure::NullArgument("model_onnx")),
+            // SAFETY: the caller passes `model_onnx_len` readable bytes.
+            (false, len) => Some(unsafe { core::slice::from_raw_parts(options.model_onnx, len) }),
+        };
+        let model = match model_bytes {
+            Some(bytes) => Some(
+                PrModel::from_bytes(bytes, ModelSource::File(PathBuf::from(CALLER_MODEL_NAME)))
+                    .map_err(Failure::Model)?,
+            ),
+            None => None,
+        };
+        let predictor: Box<dyn DisplacementPredictor + Send> = if config.imm.modes.contains(Mode::Learned) {
+            let onnx = match model {
+                Some(model) => OnnxPredictor::from_model(model),
+                None if options.use_builtin_model => OnnxPredictor::embedded().map_err(Failure::Model)?,
+                None => return Err(Failure::ModelRequired),
+            };
+            if options.inference_thread {
+                Box::new(
+                    ThreadedPredictor::new(onnx, config.predictor.deadline())
+                        .map_err(Failure::InferenceThread)?,
+                )
+            } else {
+                Box::new(onnx)
+            }
+        } else {
+            Box::new(NoPredictor)
+        };
+        let tracker = Tracker::with_predictor(config, predictor).map_err(Failure::ConfigRejected)?;
+        Ok(Box::new(PrimmTracker {
+            tracker,
+            tracks: vec![PrimmTrack::EMPTY; PRIMM_MAX_TRACKS].into_boxed_slice(),
+            track_count: 0,
+            last_error: ErrorText::new(),
+            poisoned: false,
+        }))
+    }
+
+    /// Tracks one frame and keeps its tracks.
+    fn step(&mut self, frame: &CallerFrame) -> Result<PrimmStepSummary, Failure> {
+        let before = *self.tracker.stats();
+        let tracks = &mut self.tracks;
+        let mut count = 0;
+        self.tracker
+            .step_into(frame, |output| {
+                if let Some(slot) = tracks.get_mut(count) {
+                    *slot = PrimmTrack::from(output);
+                    count += 1;
+                }
+            })
+            .map_err(Failure::Step)?;
+        self.track_count = count;
+        Ok(PrimmStepSummary::from_stats(&before, self.tracker.stats(), &self.tracks[..count]))
+    }
+}
+
+/// A frame in caller memory, read in place: the tracker decodes each measurement when it needs
+/// it, so stepping copies no frame.
+struct CallerFrame {
+    timestamp_s: f64,
+    measurements: *const PrimmMeasurement,
+    count: usize,
+}
+
+impl FrameView for CallerFrame {
+    fn timestamp_s(&self) -> f64 {
+        self.timestamp_s
+    }
+
+    fn len(&self) -> usize {
+        self.count
+    }
+
+    fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
+        assert!(index < self.count, "measurement {index} of a frame of {}", self.count);
+        // SAFETY: the caller of `primm_tracker_step` passes `count` readable measurements, and
+        // `index < count`.
+        let measurement = unsafe { self.measurements.add(index).read() };
+        measurement.to_measurement()
+    }
+}
+
+/// Runs an entry point on the tracker behind `tracker`: NULL and poisoned trackers are refused,
+/// a failure's message is recorded for the tracker and the calling thread, and a panic poisons
+/// the tracker.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle from [`primm_tracker_create`], used by no other thread.
+unsafe fn with_tracker(
+    tracker: *mut PrimmTracker,
+    body: impl FnOnce(&mut PrimmTracker) -> Result<(), Failure>,
+) -> PrimmStatus {
+    if tracker.is_null() {
+        return guard(|| Err(Failure::NullArgument("tracker")));
+    }
+    // SAFETY: a live, exclusively used handle (caller contract).
+    if unsafe { (*tracker).poisoned } {
+        record_thread_error(&PrimmStatus::Poisoned.message().to_string_lossy());
+        return PrimmStatus::Poisoned;
+    }
+    // SAFETY: as above; the reference ends with the closure.
+    let result = catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *tracker })));
+    // SAFETY: as above; the closure's reference is gone.
+    let handle = unsafe { &mut *tracker };
+    match result {
+        Ok(Ok(())) => PrimmStatus::Ok,
+        Ok(Err(failure)) => {
+            handle.last_error.set(&failure);
+            record_thread_error(&failure);
+            failure.status()
+        }
+        Err(payload) => {
+            handle.poisoned = true;
+            let message = PanicMessage(payload.as_ref());
+            handle.last_error.set(&message);
+            record_thread_error(&message);
+            PrimmStatus::Panic
+        }
+    }
+}
+
+/// The default options: the built-in configuration (`config/primm.toml`) with its modes
+/// (PR-IMM), the built-in PR model, inference inside `primm_tracker_step`.
+#[no_mangle]
+pub extern "C" fn primm_tracker_options_default() -> PrimmTrackerOptions {
+    PrimmTrackerOptions {
+        config_toml: core::ptr::null(),
+        method: PRIMM_METHOD_CONFIG,
+        model_onnx: core::ptr::null(),
+        model_onnx_len: 0,
+        use_builtin_model: true,
+        inference_thread: false,
+    }
+}
+
+/// Creates a tracker and writes its handle to `*out_tracker` (NULL on failure).
+///
+/// `options` may be NULL for `primm_tracker_options_default()`. The configuration text and
+/// model bytes are only read during the call. Loading a PR model takes a while (the model is
+/// optimised for several batch sizes); create trackers ahead of time.
+///
+/// Errors: `PRIMM_STATUS_NULL_ARGUMENT` (`out_tracker`, or `model_onnx` NULL with a non-zero
+/// length), `PRIMM_STATUS_INVALID_ARGUMENT` (unknown method), `PRIMM_STATUS_INVALID_CONFIG`,
+/// `PRIMM_STATUS_INVALID_MODEL`, `PRIMM_STATUS_INFERENCE_THREAD_FAILED`; the message
+/// (`primm_last_error_message`) gives the details.
+///
+/// # Safety
+/// `options` is NULL or points to a valid `PrimmTrackerOptions` whose pointers are NULL or
+/// valid as documented there; `out_tracker` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_create(
+    options: *const PrimmTrackerOptions,
+    out_tracker: *mut *mut PrimmTracker,
+) -> PrimmStatus {
+    guard(|| {
+        if out_tracker.is_null() {
+            return Err(Failure::NullArgument("out_tracker"));
+        }
+        // SAFETY: writable (caller contract).
+        unsafe { out_tracker.write(core::ptr::null_mut()) };
+        let options = if options.is_null() {
+            primm_tracker_options_default()
+        } else {
+            // SAFETY: a valid options struct (caller contract).
+            unsafe { options.read() }
+        };
+        // SAFETY: the options' pointers are valid (caller contract).
+        let tracker = unsafe { PrimmTracker::new(&options) }?;
+        // SAFETY: writable (caller contract).
+        unsafe { out_tracker.write(Box::into_raw(tracker)) };
+        Ok(())
+    })
+}
+
+/// Tracks one frame: `count` measurements at `measurements` (NULL allowed when `count` is 0),
+/// taken at `timestamp_s` (seconds, strictly increasing from frame to frame). The measurements
+/// are read in place during the call. Writes what the step did to `*out_summary` unless it is
+/// NULL (zeroed on failure).
+///
+/// Allocates nothing, unless the PR model runs inside the step (`inference_thread` false),
+/// where tract allocates during inference.
+///
+/// A rejected frame (`PRIMM_STATUS_INVALID_FRAME`: timestamp not finite or not advancing,
+/// interval too long, more than `PRIMM_MAX_MEASUREMENTS_PER_FRAME` measurements) leaves the
+/// tracks and the output of the previous step unchanged. Single measurements with an unknown
+/// class or NaN, infinite or absurd values are left out and counted; the rest of the frame is
+/// tracked.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread; `measurements` is NULL or points
+/// to `count` readable, aligned `PrimmMeasurement`s; `out_summary` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_step(
+    tracker: *mut PrimmTracker,
+    timestamp_s: f64,
+    measurements: *const PrimmMeasurement,
+    count: usize,
+    out_summary: *mut PrimmStepSummary,
+) -> PrimmStatus {
+    if !out_summary.is_null() {
+        // SAFETY: writable (caller contract).
+        unsafe { out_summary.write(PrimmStepSummary::default()) };
+    }
+    let body = |handle: &mut PrimmTracker| {
+        if measurements.is_null() && count > 0 {
+            return Err(Failure::NullArgument("measurements"));
+        }
+        let summary = handle.step(&CallerFrame { timestamp_s, measurements, count })?;
+        if !out_summary.is_null() {
+            // SAFETY: writable (caller contract).
+            unsafe { out_summary.write(summary) };
+        }
+        Ok(())
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { with_tracker(tracker, body) }
+}
+
+/// Copies the tracks of the last successful step (every live track, in table order) to `out`,
+/// which holds `capacity` entries, and writes their number to `*out_count`.
+///
+/// When `capacity` is smaller than the number of tracks, returns `PRIMM_STATUS_BUFFER_TOO_SMALL`
+/// with `*out_count` set to the number needed and nothing copied; `out` may be NULL when
+/// `capacity` is 0 (a query of the count). A buffer of `PRIMM_MAX_TRACKS` entries always fits.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread; `out` is NULL or points to
+/// `capacity` writable `PrimmTrack`s; `out_count` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_tracks(
+    tracker: *mut PrimmTracker,
+    out: *mut PrimmTrack,
+    capacity: usize,
+    out_count: *mut usize,
+) -> PrimmStatus {
+    let body = |handle: &mut PrimmTracker| {
+        if out_count.is_null() {
+            return Err(Failure::NullArgument("out_count"));
+        }
+        if out.is_null() && capacity > 0 {
+            return Err(Failure::NullArgument("out"));
+        }
+        let needed = handle.track_count;
+        // SAFETY: writable (caller contract).
+        unsafe { out_count.write(needed) };
+        if needed > capacity {
+            return Err(Failure::BufferTooSmall { needed, capacity });
+        }
+        if needed > 0 {
+            // SAFETY: `out` holds `capacity >= needed` entries (caller contract) and does not
+            // overlap the handle's buffer.
+            unsafe { core::ptr::copy_nonoverlapping(handle.tracks.as_ptr(), out, needed) };
+        }
+        Ok(())
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { with_tracker(tracker, body) }
+}
+
+/// Writes the tracker's counters since it was built to `*out`.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread; `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_stats(
+    tracker: *mut PrimmTracker,
+    out: *mut PrimmStats,
+) -> PrimmStatus {
+    let body = |handle: &mut PrimmTracker| {
+        if out.is_null() {
+            return Err(Failure::NullArgument("out"));
+        }
+        // SAFETY: writable (caller contract).
+        unsafe { out.write(PrimmStats::from(handle.tracker.stats())) };
+        Ok(())
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { with_tracker(tracker, body) }
+}
+
+/// Drops every track and forgets the last timestamp, e.g. before replaying another recording
+/// or after `PRIMM_STATUS_INVALID_FRAME` for a too long interval. Counters are kept; `resets`
+/// counts the call.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_reset(tracker: *mut PrimmTracker) -> PrimmStatus {
+    let body = |handle: &mut PrimmTracker| {
+        handle.tracker.reset();
+        handle.track_count = 0;
+        Ok(())
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { with_tracker(tracker, body) }
+}
+
+/// Destroys a tracker (stops its inference thread, if any). NULL is ignored.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle from `primm_tracker_create`, not used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_destroy(tracker: *mut PrimmTracker) {
+    if tracker.is_null() {
+        return;
+    }
+    guard_value((), || {
+        // SAFETY: a live handle made by `Box::into_raw` (caller contract).
+        drop(unsafe { Box::from_raw(tracker) });
+    });
+}
+
+/// Copies the message of the last failed call on this tracker into `buf` (`len` bytes,
+/// NUL-terminated, cut if too short; nothing written when `buf` is NULL or `len` is 0) and
+/// returns the message's full length in bytes without the NUL, like `snprintf`. An empty
+/// message when no call on the tracker has failed, or when `tracker` is NULL.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread; `buf` is NULL or points to `len`
+/// writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_last_error(
+    tracker: *const PrimmTracker,
+    buf: *mut c_char,
+    len: usize,
+) -> usize {
+    guard_value(0, || {
+        // SAFETY: a live handle or NULL (caller contract).
+        let text = unsafe { tracker.as_ref() }.map_or("", |handle| handle.last_error.as_str());
+        // SAFETY: `buf` holds `len` bytes (caller contract).
+        unsafe { copy_to_c_buffer(text, buf, len) }
+    })
+}
+
+#[cfg(test)]
+mod tests;

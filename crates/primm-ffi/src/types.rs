@@ -1,0 +1,376 @@
+//! The `#[repr(C)]` types and the constants of the C API.
+//!
+//! Codes that C passes in (method, class) are plain integers with named constants rather than
+//! Rust enums, so that an out-of-range value from C is an error and never undefined behaviour.
+
+use core::ffi::c_char;
+use primm_core::limits::{MAX_MEASUREMENTS_PER_FRAME, MAX_TRACKS};
+use primm_core::measurement::{Measurement, ObjectClass, UnknownClass};
+use primm_core::mode::{Method, MODE_COUNT};
+use primm_core::track::{TrackOutput, TrackStatus};
+use primm_core::tracker::TrackerStats;
+
+/// Most live tracks a tracker holds (the size of a buffer that always fits
+/// `primm_tracker_tracks`).
+pub const PRIMM_MAX_TRACKS: usize = 512;
+/// Most measurements one frame may carry; a larger frame is rejected with
+/// `PRIMM_STATUS_INVALID_FRAME`.
+pub const PRIMM_MAX_MEASUREMENTS_PER_FRAME: usize = 256;
+/// Number of IMM modes; mode probabilities are ordered PR, CV, CA, CT.
+pub const PRIMM_MODE_COUNT: usize = 4;
+
+/// A method code, one of the `PRIMM_METHOD_*` constants: which IMM modes the tracker runs.
+pub type PrimmMethod = u32;
+/// The modes the configuration names (`imm.modes`; PR, CV, CA and CT in the defaults).
+pub const PRIMM_METHOD_CONFIG: PrimmMethod = 0;
+/// Constant-velocity Kalman filter.
+pub const PRIMM_METHOD_CV: PrimmMethod = 1;
+/// Constant-acceleration Kalman filter.
+pub const PRIMM_METHOD_CA: PrimmMethod = 2;
+/// Coordinated-turn extended Kalman filter.
+pub const PRIMM_METHOD_CT: PrimmMethod = 3;
+/// The learned predictor (PR) alone; needs a model.
+pub const PRIMM_METHOD_PR: PrimmMethod = 4;
+/// IMM of CV, CA and CT (what `primm track --method imm` runs).
+pub const PRIMM_METHOD_IMM: PrimmMethod = 5;
+/// IMM of PR, CV, CA and CT; needs a model.
+pub const PRIMM_METHOD_PR_IMM: PrimmMethod = 6;
+
+/// An object class code, one of the `PRIMM_OBJECT_CLASS_*` constants.
+pub type PrimmObjectClass = u8;
+/// Passenger cars and large vehicles.
+pub const PRIMM_OBJECT_CLASS_CAR: PrimmObjectClass = 0;
+/// Pedestrians and pedestrian groups.
+pub const PRIMM_OBJECT_CLASS_PEDESTRIAN: PrimmObjectClass = 1;
+/// Bicycles and motorcycles; reserved, not tracked by the default configuration.
+pub const PRIMM_OBJECT_CLASS_TWO_WHEELER: PrimmObjectClass = 2;
+
+/// A track status code, one of the `PRIMM_TRACK_STATUS_*` constants.
+pub type PrimmTrackStatus = u8;
+/// Started by an unassigned measurement, not yet confirmed.
+pub const PRIMM_TRACK_STATUS_TENTATIVE: PrimmTrackStatus = 0;
+/// Confirmed by `tracker.confirmation_hits` hits.
+pub const PRIMM_TRACK_STATUS_CONFIRMED: PrimmTrackStatus = 1;
+
+/// `ground_truth_id` value meaning "unknown".
+pub const PRIMM_NO_GROUND_TRUTH_ID: i64 = -1;
+/// `sensor_id` value meaning "unknown".
+pub const PRIMM_NO_SENSOR_ID: i32 = -1;
+/// `measurement_index` value of a track that coasted (no measurement in this frame).
+pub const PRIMM_NO_MEASUREMENT_INDEX: i32 = -1;
+
+// The C constants are literals (cbindgen writes them into the header); they must agree with
+// the core's values.
+const _: () = {
+    assert!(PRIMM_MAX_TRACKS == MAX_TRACKS);
+    assert!(PRIMM_MAX_MEASUREMENTS_PER_FRAME == MAX_MEASUREMENTS_PER_FRAME);
+    assert!(PRIMM_MODE_COUNT == MODE_COUNT);
+    assert!(PRIMM_OBJECT_CLASS_CAR == ObjectClass::Car as u8);
+    assert!(PRIMM_OBJECT_CLASS_PEDESTRIAN == ObjectClass::Pedestrian as u8);
+    assert!(PRIMM_OBJECT_CLASS_TWO_WHEELER == ObjectClass::TwoWheeler as u8);
+    assert!(PRIMM_TRACK_STATUS_TENTATIVE == TrackStatus::Tentative as u8);
+    assert!(PRIMM_TRACK_STATUS_CONFIRMED == TrackStatus::Confirmed as u8);
+};
+
+/// The method of a code: `Ok(None)` for [`PRIMM_METHOD_CONFIG`], `Err(code)` for an unknown code.
+pub(crate) fn method_from_code(code: PrimmMethod) -> Result<Option<Method>, PrimmMethod> {
+    Ok(Some(match code {
+        PRIMM_METHOD_CONFIG => return Ok(None),
+        PRIMM_METHOD_CV => Method::ConstantVelocity,
+        PRIMM_METHOD_CA => Method::ConstantAcceleration,
+        PRIMM_METHOD_CT => Method::CoordinatedTurn,
+        PRIMM_METHOD_PR => Method::Learned,
+        PRIMM_METHOD_IMM => Method::Imm,
+        PRIMM_METHOD_PR_IMM => Method::PrImm,
+        other => return Err(other),
+    }))
+}
+
+/// How to build a tracker; `primm_tracker_options_default` gives the defaults.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct PrimmTrackerOptions {
+    /// Tracker configuration as TOML text (UTF-8, NUL-terminated; the format of
+    /// `config/primm.toml`); NULL for the built-in defaults. Only read during the call.
+    pub config_toml: *const c_char,
+    /// Which modes to run: a `PRIMM_METHOD_*` code; `PRIMM_METHOD_CONFIG` keeps the
+    /// configuration's `imm.modes`.
+    pub method: PrimmMethod,
+    /// ONNX bytes of a PR model (the contract of `models/pr.json`), or NULL for none. Checked
+    /// whenever given; used when the modes include PR. Only read during the call.
+    pub model_onnx: *const u8,
+    /// Length of `model_onnx` in bytes; 0 when `model_onnx` is NULL.
+    pub model_onnx_len: usize,
+    /// When the modes include PR and `model_onnx` is NULL: use the model built into the library
+    /// (`models/pr.onnx`) if true, fail with `PRIMM_STATUS_INVALID_MODEL` if false.
+    pub use_builtin_model: bool,
+    /// Run the PR model on a dedicated inference thread with the configuration's
+    /// `predictor.deadline_ms`: `primm_tracker_step` then allocates nothing with any method, but
+    /// whether a frame gets its learned predictions depends on timing. If false, the model runs
+    /// inside `primm_tracker_step` (deterministic; tract allocates during the run).
+    pub inference_thread: bool,
+}
+
+/// One object-level radar measurement, read from caller memory by `primm_tracker_step`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrimmMeasurement {
+    /// Longitudinal position in the vehicle frame, m.
+    pub x_m: f64,
+    /// Lateral position in the vehicle frame, m.
+    pub y_m: f64,
+    /// Ego-motion compensated radial velocity, m/s, positive moving away.
+    pub radial_velocity_mps: f64,
+    /// Radar cross section, dBsm.
+    pub rcs_dbsm: f64,
+    /// Ground-truth object id carried through to the track (evaluation only; the tracker never
+    /// reads it), or `PRIMM_NO_GROUND_TRUTH_ID`. Ids are 64-bit patterns: ids of 2^63 and above
+    /// appear negative.
+    pub ground_truth_id: i64,
+    /// Radar that produced the measurement, 0 to 65535, or `PRIMM_NO_SENSOR_ID` (any value
+    /// outside 0 to 65535 means unknown).
+    pub sensor_id: i32,
+    /// Object class, a `PRIMM_OBJECT_CLASS_*` code; a measurement with an unknown code is
+    /// rejected and counted in `measurements_rejected_unknown_class`.
+    pub class_code: PrimmObjectClass,
+}
+
+impl PrimmMeasurement {
+    /// The core measurement, or the unknown class code.
+    pub(crate) fn to_measurement(self) -> Result<Measurement, UnknownClass> {
+        let class = ObjectClass::from_code(self.class_code).ok_or(UnknownClass { code: self.class_code })?;
+        Ok(Measurement {
+            x_m: self.x_m,
+            y_m: self.y_m,
+            radial_velocity_mps: self.radial_velocity_mps,
+            rcs_dbsm: self.rcs_dbsm,
+            class,
+            sensor_id: u16::try_from(self.sensor_id).ok(),
+            ground_truth_id: (self.ground_truth_id != PRIMM_NO_GROUND_TRUTH_ID)
+                .then_some(self.ground_truth_id as u64),
+        })
+    }
+}
+
+/// The state of one live track after a step, as copied out by `primm_tracker_tracks`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrimmTrack {
+    /// Track id, unique within the tracker's life.
+    pub id: u64,
+    /// Fused posterior position, x, m.
+    pub x_m: f64,
+    /// Fused posterior position, y, m.
+    pub y_m: f64,
+    /// Fused velocity estimate, x, m/s.
+    pub velocity_x_mps: f64,
+    /// Fused velocity estimate, y, m/s.
+    pub velocity_y_mps: f64,
+    /// Covariance of the fused position (with the spread of the mode means), xx entry, m².
+    pub position_covariance_xx_m2: f64,
+    /// Covariance of the fused position, xy (= yx) entry, m².
+    pub position_covariance_xy_m2: f64,
+    /// Covariance of the fused position, yy entry, m².
+    pub position_covariance_yy_m2: f64,
+    /// Fused one-step prior used for association, x, m; NaN when `has_prior_position` is false.
+    pub prior_x_m: f64,
+    /// Fused one-step prior used for association, y, m; NaN when `has_prior_position` is false.
+    pub prior_y_m: f64,
+    /// Posterior mode probabilities, order PR, CV, CA, CT (0 for modes not run).
+    pub mode_probabilities: [f64; PRIMM_MODE_COUNT],
+    /// Ground-truth id of the measurement that updated or started the track in this step, or
+    /// `PRIMM_NO_GROUND_TRUTH_ID`.
+    pub ground_truth_id: i64,
+    /// Frames since the track started.
+    pub age_frames: u32,
+    /// Associated measurements so far.
+    pub hits: u32,
+    /// Consecutive frames without measurement (0 when updated in this step).
+    pub misses: u32,
+    /// Index, in this step's measurement array, of the measurement that updated or started the
+    /// track, or `PRIMM_NO_MEASUREMENT_INDEX` when the track coasted.
+    pub measurement_index: i32,
+    /// Object class, a `PRIMM_OBJECT_CLASS_*` code.
+    pub class_code: PrimmObjectClass,
+    /// Lifecycle status, a `PRIMM_TRACK_STATUS_*` code.
+    pub status: PrimmTrackStatus,
+    /// Whether the track has a prior (false for a track started in this step).
+    pub has_prior_position: bool,
+}
+
+impl PrimmTrack {
+    /// A zeroed entry (buffer filler).
+    pub(crate) const EMPTY: PrimmTrack = PrimmTrack {
+        id: 0,
+        x_m: 0.0,
+        y_m: 0.0,
+        velocity_x_mps: 0.0,
+        velocity_y_mps: 0.0,
+        position_covariance_xx_m2: 0.0,
+        position_covariance_xy_m2: 0.0,
+        position_covariance_yy_m2: 0.0,
+        prior_x_m: f64::NAN,
+        prior_y_m: f64::NAN,
+        mode_probabilities: [0.0; PRIMM_MODE_COUNT],
+        ground_truth_id: PRIMM_NO_GROUND_TRUTH_ID,
+        age_frames: 0,
+        hits: 0,
+        misses: 0,
+        measurement_index: PRIMM_NO_MEASUREMENT_INDEX,
+        class_code: PRIMM_OBJECT_CLASS_CAR,
+        status: PRIMM_TRACK_STATUS_TENTATIVE,
+        has_prior_position: false,
+    };
+}
+
+impl From<&TrackOutput> for PrimmTrack {
+    fn from(output: &TrackOutput) -> Self {
+        let covariance = output.position_covariance_m2;
+        let prior = output.prior_position_m;
+        PrimmTrack {
+            id: output.id,
+            x_m: output.position_m.x,
+            y_m: output.position_m.y,
+            velocity_x_mps: output.velocity_mps.x,
+            velocity_y_mps: output.velocity_mps.y,
+            position_covariance_xx_m2: covariance.x_axis.x,
+            position_covariance_xy_m2: covariance.y_axis.x,
+            position_covariance_yy_m2: covariance.y_axis.y,
+            prior_x_m: prior.map_or(f64::NAN, |p| p.x),
+            prior_y_m: prior.map_or(f64::NAN, |p| p.y),
+            mode_probabilities: output.mode_probabilities,
+            ground_truth_id: output.ground_truth_id.map_or(PRIMM_NO_GROUND_TRUTH_ID, |id| id as i64),
+            age_frames: output.age_frames,
+            hits: output.hits,
+            misses: output.misses,
+            measurement_index: output.measurement_index.map_or(PRIMM_NO_MEASUREMENT_INDEX, i32::from),
+            class_code: output.class.code(),
+            status: output.status as u8,
+            has_prior_position: prior.is_some(),
+        }
+    }
+}
+
+/// What one successful `primm_tracker_step` did.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PrimmStepSummary {
+    /// Live tracks after the step: the count `primm_tracker_tracks` copies.
+    pub track_count: usize,
+    /// Tracks updated or started by a measurement of this frame.
+    pub updated_track_count: usize,
+    /// Measurements of this frame accepted by validation.
+    pub measurements_accepted: usize,
+    /// Measurements of this frame rejected (unknown class, non-finite or absurd values).
+    pub measurements_rejected: usize,
+    /// Tracks started in this step.
+    pub tracks_initiated: usize,
+    /// Tracks deleted in this step.
+    pub tracks_deleted: usize,
+}
+
+impl PrimmStepSummary {
+    /// The summary of a step from the counters before and after it.
+    pub(crate) fn from_stats(before: &TrackerStats, after: &TrackerStats, tracks: &[PrimmTrack]) -> Self {
+        let delta = |f: fn(&TrackerStats) -> u64| (f(after) - f(before)) as usize;
+        PrimmStepSummary {
+            track_count: tracks.len(),
+            updated_track_count: tracks
+                .iter()
+                .filter(|t| t.measurement_index != PRIMM_NO_MEASUREMENT_INDEX)
+                .count(),
+            measurements_accepted: delta(|s| s.measurements_accepted),
+            measurements_rejected: delta(|s| {
+                s.measurements_rejected_unknown_class
+                    + s.measurements_rejected_non_finite
+                    + s.measurements_rejected_out_of_range
+            }),
+            tracks_initiated: delta(|s| s.tracks_initiated),
+            tracks_deleted: delta(|s| s.tracks_deleted),
+        }
+    }
+}
+
+/// The tracker's counters since it was built (`TrackerStats` of primm-core).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PrimmStats {
+    /// Frames tracked.
+    pub frames_tracked: u64,
+    /// Frames rejected because the timestamp was not finite.
+    pub frames_rejected_non_finite_timestamp: u64,
+    /// Frames rejected because time did not advance.
+    pub frames_rejected_timestamp_not_increasing: u64,
+    /// Frames rejected because the interval was too long.
+    pub frames_rejected_interval_too_long: u64,
+    /// Frames rejected because they carried too many measurements.
+    pub frames_rejected_too_many_measurements: u64,
+    /// Measurements tracked (accepted by validation).
+    pub measurements_accepted: u64,
+    /// Measurements rejected for an unknown class code.
+    pub measurements_rejected_unknown_class: u64,
+    /// Measurements rejected for a NaN or infinite value.
+    pub measurements_rejected_non_finite: u64,
+    /// Measurements rejected for an absurd magnitude.
+    pub measurements_rejected_out_of_range: u64,
+    /// Tracks started.
+    pub tracks_initiated: u64,
+    /// Tracks confirmed.
+    pub tracks_confirmed: u64,
+    /// Tracks deleted.
+    pub tracks_deleted: u64,
+    /// Unassigned measurements that could not start a track because the table was full.
+    pub initiations_refused_table_full: u64,
+    /// Track-frames in which the learned predictor gave no displacement (PR sat out).
+    pub learned_predictions_missing: u64,
+    /// Frames in which at least one track had no learned displacement.
+    pub frames_with_learned_predictions_missing: u64,
+    /// Kalman updates refused for numerical reasons (the track coasted instead).
+    pub update_failures: u64,
+    /// Calls to `primm_tracker_reset`.
+    pub resets: u64,
+}
+
+impl From<&TrackerStats> for PrimmStats {
+    fn from(stats: &TrackerStats) -> Self {
+        // Destructured field by field: a counter added to the core breaks the build here.
+        let TrackerStats {
+            frames_tracked,
+            frames_rejected_non_finite_timestamp,
+            frames_rejected_timestamp_not_increasing,
+            frames_rejected_interval_too_long,
+            frames_rejected_too_many_measurements,
+            measurements_accepted,
+            measurements_rejected_unknown_class,
+            measurements_rejected_non_finite,
+            measurements_rejected_out_of_range,
+            tracks_initiated,
+            tracks_confirmed,
+            tracks_deleted,
+            initiations_refused_table_full,
+            learned_predictions_missing,
+            frames_with_learned_predictions_missing,
+            update_failures,
+            resets,
+        } = *stats;
+        PrimmStats {
+            frames_tracked,
+            frames_rejected_non_finite_timestamp,
+            frames_rejected_timestamp_not_increasing,
+            frames_rejected_interval_too_long,
+            frames_rejected_too_many_measurements,
+            measurements_accepted,
+            measurements_rejected_unknown_class,
+            measurements_rejected_non_finite,
+            measurements_rejected_out_of_range,
+            tracks_initiated,
+            tracks_confirmed,
+            tracks_deleted,
+            initiations_refused_table_full,
+            learned_predictions_missing,
+            frames_with_learned_predictions_missing,
+            update_failures,
+            resets,
+        }
+    }
+}

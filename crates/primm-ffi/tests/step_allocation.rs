@@ -1,0 +1,175 @@
+//! Stepping a tracker through the C API allocates nothing: not for good frames, not for
+//! rejected ones, not when copying tracks and counters out. A global allocator counts the
+//! allocations of the calling thread.
+
+use primm_ffi::*;
+use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::ptr::{null, null_mut};
+
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+/// Counts `alloc`, `alloc_zeroed` and `realloc` calls per thread and forwards them to the system
+/// allocator.
+struct CountingAllocator;
+
+fn record_allocation() {
+    // `try_with`: the allocator may run while the thread's locals are being torn down.
+    let _ = ALLOCATIONS.try_with(|count| count.set(count.get() + 1));
+}
+
+// SAFETY: every method forwards to `System` with the caller's arguments unchanged; the counter is
+// a const-initialised thread-local `Cell`, which never allocates.
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        record_allocation();
+        // SAFETY: forwarded.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        record_allocation();
+        // SAFETY: forwarded.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        record_allocation();
+        // SAFETY: forwarded.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: forwarded.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+fn count_allocations(work: impl FnOnce()) -> u64 {
+    let before = ALLOCATIONS.with(Cell::get);
+    work();
+    ALLOCATIONS.with(Cell::get) - before
+}
+
+/// The frames of a generated 5 s scenario as C measurement arrays, with their timestamps.
+fn scenario_frames() -> Vec<(f64, Vec<PrimmMeasurement>)> {
+    let mut config = Preset::Default.config();
+    config.sequence.duration_s = 5.0;
+    let generated = ScenarioGenerator::new(config).unwrap().generate(Split::Evaluation, 1);
+    generated
+        .sequence
+        .frames
+        .iter()
+        .map(|frame| {
+            let measurements = frame
+                .measurements
+                .iter()
+                .map(|recorded| {
+                    let m = recorded.measurement;
+                    PrimmMeasurement {
+                        x_m: m.x_m,
+                        y_m: m.y_m,
+                        radial_velocity_mps: m.radial_velocity_mps,
+                        rcs_dbsm: m.rcs_dbsm,
+                        ground_truth_id: m.ground_truth_id.map_or(PRIMM_NO_GROUND_TRUTH_ID, |id| id as i64),
+                        sensor_id: m.sensor_id.map_or(PRIMM_NO_SENSOR_ID, i32::from),
+                        class_code: m.class.code(),
+                    }
+                })
+                .collect();
+            (frame.timestamp_s, measurements)
+        })
+        .collect()
+}
+
+/// Steps every frame (each good frame followed by a rejected repeat of it) and copies tracks and
+/// counters out after each; returns the allocations and the track rows updated.
+fn run_counted(options: &PrimmTrackerOptions) -> (u64, usize) {
+    let frames = scenario_frames();
+    assert!(frames.len() > 300, "{} frames", frames.len());
+    let mut tracker = null_mut();
+    // SAFETY: valid options and out-pointer.
+    assert_eq!(unsafe { primm_tracker_create(options, &mut tracker) }, PrimmStatus::Ok);
+    let mut tracks = vec![
+        // SAFETY: `PrimmTrack` is plain data (integers, doubles, a bool); all zeroes is valid.
+        unsafe { std::mem::zeroed::<PrimmTrack>() };
+        PRIMM_MAX_TRACKS
+    ];
+    let mut message = [0 as std::ffi::c_char; 256];
+    let mut updated = 0;
+    let allocations = count_allocations(|| {
+        for (timestamp_s, measurements) in &frames {
+            let mut summary = PrimmStepSummary::default();
+            let mut stats = PrimmStats::default();
+            let mut count = 0;
+            // SAFETY: a live tracker, valid buffers of the lengths given.
+            unsafe {
+                let status = primm_tracker_step(
+                    tracker,
+                    *timestamp_s,
+                    measurements.as_ptr(),
+                    measurements.len(),
+                    &mut summary,
+                );
+                assert_eq!(status, PrimmStatus::Ok);
+                updated += summary.updated_track_count;
+                let status = primm_tracker_step(
+                    tracker,
+                    *timestamp_s,
+                    measurements.as_ptr(),
+                    measurements.len(),
+                    null_mut(),
+                );
+                assert_eq!(status, PrimmStatus::InvalidFrame);
+                primm_tracker_last_error(tracker, message.as_mut_ptr(), message.len());
+                let status = primm_tracker_tracks(tracker, tracks.as_mut_ptr(), tracks.len(), &mut count);
+                assert_eq!(status, PrimmStatus::Ok);
+                assert_eq!(count, summary.track_count);
+                assert_eq!(primm_tracker_stats(tracker, &mut stats), PrimmStatus::Ok);
+            }
+        }
+    });
+    // SAFETY: a live tracker, not used afterwards.
+    unsafe { primm_tracker_destroy(tracker) };
+    (allocations, updated)
+}
+
+#[test]
+fn stepping_with_imm_allocates_nothing() {
+    let options = PrimmTrackerOptions { method: PRIMM_METHOD_IMM, ..primm_tracker_options_default() };
+    let (allocations, updated) = run_counted(&options);
+    assert_eq!(allocations, 0);
+    assert!(updated > 300, "{updated} track updates");
+}
+
+#[test]
+fn stepping_with_pr_imm_on_the_inference_thread_allocates_nothing_on_the_calling_thread() {
+    let options = PrimmTrackerOptions {
+        method: PRIMM_METHOD_PR_IMM,
+        use_builtin_model: true,
+        inference_thread: true,
+        ..primm_tracker_options_default()
+    };
+    let (allocations, updated) = run_counted(&options);
+    assert_eq!(allocations, 0);
+    assert!(updated > 300, "{updated} track updates");
+}
+
+#[test]
+fn failed_calls_without_a_tracker_allocate_nothing() {
+    let mut count = 0;
+    let allocations = count_allocations(|| {
+        // SAFETY: NULL trackers are refused; other pointers are valid.
+        unsafe {
+            assert_eq!(primm_tracker_step(null_mut(), 0.0, null(), 0, null_mut()), PrimmStatus::NullArgument);
+            assert_eq!(
+                primm_tracker_tracks(null_mut(), null_mut(), 0, &mut count),
+                PrimmStatus::NullArgument
+            );
+        }
+    });
+    assert_eq!(allocations, 0);
+}

@@ -1,0 +1,331 @@
+/*
+ * track_csv: tracks a measurement CSV file through the primm C API and writes the track CSV
+ * file, exactly as `primm track --method imm --input INPUT.csv --output OUTPUT.csv` does.
+ *
+ *   cargo build --release -p primm-ffi
+ *   cc -O2 -Iinclude examples/c/track_csv.c target/release/libprimm_ffi.a -lpthread -ldl -lm -o track_csv
+ *   ./track_csv INPUT.csv OUTPUT.csv
+ *
+ * (GNU ld warns that tract's assembly objects lack a .note.GNU-stack section; add
+ * -Wl,-z,noexecstack to the link line to keep the stack non-executable and the warning away.)
+ *
+ * Input: the measurement CSV format of docs/scenario.md. Columns are found by their header
+ * names (frame, t, gt_id, class, x, y, vr, rcs required; sensor_id optional; others ignored),
+ * fields are trimmed, lines starting with '#' are comments, and a row with an empty class is
+ * the one row of a frame without measurements. Rows of one frame are consecutive.
+ *
+ * Output: header frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct and
+ * one row per track updated by a measurement in that frame. Numbers are written with
+ * primm_format_f64, the shortest form that reads back exactly (as primm writes them).
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "primm.h"
+
+#include <errno.h>
+#include <inttypes.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_FIELDS 64
+
+enum column { COL_FRAME, COL_T, COL_GT_ID, COL_CLASS, COL_X, COL_Y, COL_VR, COL_RCS, COL_SENSOR_ID, COL_COUNT };
+
+static const char *const COLUMN_NAMES[COL_COUNT] = {"frame", "t", "gt_id", "class", "x", "y",
+                                                    "vr", "rcs", "sensor_id"};
+
+/* Required columns: all but sensor_id. */
+#define REQUIRED_COLUMNS COL_SENSOR_ID
+
+struct input {
+    FILE *file;
+    const char *path;
+    char *line;
+    size_t line_capacity;
+    unsigned long line_number;
+    char *fields[MAX_FIELDS];
+    size_t field_count;
+    int columns[COL_COUNT];
+};
+
+static void fail(const char *format, const char *path, unsigned long line, const char *detail) {
+    fprintf(stderr, "track_csv: %s:%lu: ", path, line);
+    fprintf(stderr, format, detail);
+    fputc('\n', stderr);
+    exit(EXIT_FAILURE);
+}
+
+static char *trim(char *text) {
+    while (*text == ' ' || *text == '\t') {
+        text++;
+    }
+    size_t len = strlen(text);
+    while (len > 0 && (text[len - 1] == ' ' || text[len - 1] == '\t' || text[len - 1] == '\r' ||
+                       text[len - 1] == '\n')) {
+        text[--len] = '\0';
+    }
+    return text;
+}
+
+/* Splits the current line into fields in place; handles double-quoted fields with "" escapes. */
+static void split_fields(struct input *in) {
+    char *read = in->line;
+    in->field_count = 0;
+    for (;;) {
+        if (in->field_count == MAX_FIELDS) {
+            fail("%s", in->path, in->line_number, "too many fields");
+        }
+        while (*read == ' ' || *read == '\t') {
+            read++;
+        }
+        char *start = read;
+        char *write = read;
+        if (*read == '"') {
+            read++;
+            for (;;) {
+                if (*read == '\0') {
+                    fail("%s", in->path, in->line_number, "unterminated quoted field");
+                }
+                if (*read == '"') {
+                    if (read[1] == '"') {
+                        *write++ = '"';
+                        read += 2;
+                        continue;
+                    }
+                    read++;
+                    break;
+                }
+                *write++ = *read++;
+            }
+            while (*read != ',' && *read != '\0') {
+                read++;
+            }
+        } else {
+            while (*read != ',' && *read != '\0') {
+                *write++ = *read++;
+            }
+        }
+        char separator = *read;
+        *write = '\0';
+        in->fields[in->field_count++] = trim(start);
+        if (separator != ',') {
+            break;
+        }
+        read++;
+    }
+}
+
+/* Reads the next non-comment, non-empty line into fields; returns 0 at the end of the file. */
+static int next_record(struct input *in) {
+    for (;;) {
+        errno = 0;
+        if (getline(&in->line, &in->line_capacity, in->file) < 0) {
+            if (errno != 0) {
+                fail("cannot read: %s", in->path, in->line_number + 1, strerror(errno));
+            }
+            return 0;
+        }
+        in->line_number++;
+        if (in->line[0] == '#') {
+            continue;
+        }
+        char *content = trim(in->line);
+        if (*content == '\0') {
+            continue;
+        }
+        memmove(in->line, content, strlen(content) + 1);
+        split_fields(in);
+        return 1;
+    }
+}
+
+static const char *field(const struct input *in, enum column column) {
+    int index = in->columns[column];
+    if (index < 0 || (size_t)index >= in->field_count) {
+        return "";
+    }
+    return in->fields[index];
+}
+
+static double parse_double(const struct input *in, enum column column) {
+    const char *text = field(in, column);
+    char *end = NULL;
+    errno = 0;
+    double value = strtod(text, &end);
+    if (*text == '\0' || *end != '\0' || value != value || value - value != 0.0) {
+        fail("invalid number `%s`", in->path, in->line_number, text);
+    }
+    return value;
+}
+
+static uint64_t parse_u64(const struct input *in, enum column column) {
+    const char *text = field(in, column);
+    char *end = NULL;
+    errno = 0;
+    unsigned long long value = strtoull(text, &end, 10);
+    if (*text < '0' || *text > '9' || *end != '\0' || errno == ERANGE) {
+        fail("invalid integer `%s`", in->path, in->line_number, text);
+    }
+    return (uint64_t)value;
+}
+
+static void print_double(FILE *out, double value) {
+    char text[512];
+    primm_format_f64(value, text, sizeof text);
+    fputs(text, out);
+}
+
+static void check(PrimmStatus status, const char *what) {
+    if (status != PRIMM_STATUS_OK) {
+        char message[1024];
+        primm_last_error_message(message, sizeof message);
+        fprintf(stderr, "track_csv: %s: %s: %s\n", what, primm_status_message(status), message);
+        exit(EXIT_FAILURE);
+    }
+}
+
+/* Tracks one frame and writes the rows of the tracks a measurement updated. */
+static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double timestamp_s,
+                        const PrimmMeasurement *measurements, size_t count, PrimmTrack *tracks) {
+    PrimmStatus status = primm_tracker_step(tracker, timestamp_s, measurements, count, NULL);
+    if (status != PRIMM_STATUS_OK) {
+        char message[1024];
+        primm_tracker_last_error(tracker, message, sizeof message);
+        fprintf(stderr, "track_csv: frame %" PRIu64 ": %s\n", frame, message);
+        exit(EXIT_FAILURE);
+    }
+    size_t track_count = 0;
+    check(primm_tracker_tracks(tracker, tracks, PRIMM_MAX_TRACKS, &track_count), "copying tracks");
+    for (size_t i = 0; i < track_count; i++) {
+        const PrimmTrack *track = &tracks[i];
+        if (track->measurement_index == PRIMM_NO_MEASUREMENT_INDEX) {
+            continue;
+        }
+        fprintf(out, "%" PRIu64 ",", frame);
+        print_double(out, timestamp_s);
+        fprintf(out, ",%" PRIu64 ",%s,", track->id, primm_object_class_name(track->class_code));
+        print_double(out, track->x_m);
+        fputc(',', out);
+        print_double(out, track->y_m);
+        fputc(',', out);
+        if (track->has_prior_position) {
+            print_double(out, track->prior_x_m);
+            fputc(',', out);
+            print_double(out, track->prior_y_m);
+        } else {
+            fputc(',', out);
+        }
+        fprintf(out, ",%" PRId64, track->ground_truth_id);
+        for (size_t mode = 0; mode < PRIMM_MODE_COUNT; mode++) {
+            fputc(',', out);
+            print_double(out, track->mode_probabilities[mode]);
+        }
+        fputc('\n', out);
+    }
+}
+
+int main(int argc, char **argv) {
+    if (argc != 3) {
+        fprintf(stderr, "usage: %s INPUT.csv OUTPUT.csv\n", argv[0]);
+        return EXIT_FAILURE;
+    }
+    struct input in = {.path = argv[1]};
+    in.file = fopen(in.path, "r");
+    if (in.file == NULL) {
+        fprintf(stderr, "track_csv: cannot open %s: %s\n", in.path, strerror(errno));
+        return EXIT_FAILURE;
+    }
+    if (!next_record(&in)) {
+        fail("%s", in.path, 1, "no header");
+    }
+    for (int c = 0; c < COL_COUNT; c++) {
+        in.columns[c] = -1;
+        for (size_t i = 0; i < in.field_count; i++) {
+            if (strcmp(in.fields[i], COLUMN_NAMES[c]) == 0) {
+                in.columns[c] = (int)i;
+            }
+        }
+        if (c < REQUIRED_COLUMNS && in.columns[c] < 0) {
+            fail("missing header column `%s`", in.path, in.line_number, COLUMN_NAMES[c]);
+        }
+    }
+
+    PrimmTrackerOptions options = primm_tracker_options_default();
+    options.method = PRIMM_METHOD_IMM;
+    PrimmTracker *tracker = NULL;
+    check(primm_tracker_create(&options, &tracker), "creating the tracker");
+
+    FILE *out = fopen(argv[2], "w");
+    if (out == NULL) {
+        fprintf(stderr, "track_csv: cannot create %s: %s\n", argv[2], strerror(errno));
+        return EXIT_FAILURE;
+    }
+    fputs("frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct\n", out);
+
+    static PrimmMeasurement measurements[PRIMM_MAX_MEASUREMENTS_PER_FRAME];
+    static PrimmTrack tracks[PRIMM_MAX_TRACKS];
+    size_t count = 0;
+    int open = 0;
+    uint64_t frame = 0;
+    double timestamp_s = 0.0;
+    while (next_record(&in)) {
+        uint64_t row_frame = parse_u64(&in, COL_FRAME);
+        double row_t = parse_double(&in, COL_T);
+        if (!open || row_frame != frame) {
+            if (open) {
+                if (row_frame < frame) {
+                    fail("frame index `%s` decreases", in.path, in.line_number, field(&in, COL_FRAME));
+                }
+                track_frame(tracker, out, frame, timestamp_s, measurements, count, tracks);
+            }
+            open = 1;
+            frame = row_frame;
+            timestamp_s = row_t;
+            count = 0;
+        } else if (row_t != timestamp_s) {
+            fail("timestamp `%s` differs within a frame", in.path, in.line_number, field(&in, COL_T));
+        }
+        const char *class_name = field(&in, COL_CLASS);
+        if (*class_name == '\0') {
+            continue; /* the row of a frame without measurements */
+        }
+        if (count == PRIMM_MAX_MEASUREMENTS_PER_FRAME) {
+            fail("frame `%s` has too many measurements", in.path, in.line_number, field(&in, COL_FRAME));
+        }
+        int32_t class_code = primm_object_class_from_name(class_name);
+        if (class_code < 0) {
+            fail("unknown object class `%s`", in.path, in.line_number, class_name);
+        }
+        const char *gt = field(&in, COL_GT_ID);
+        const char *sensor = field(&in, COL_SENSOR_ID);
+        PrimmMeasurement *m = &measurements[count++];
+        m->x_m = parse_double(&in, COL_X);
+        m->y_m = parse_double(&in, COL_Y);
+        m->radial_velocity_mps = parse_double(&in, COL_VR);
+        m->rcs_dbsm = parse_double(&in, COL_RCS);
+        m->class_code = (PrimmObjectClass)class_code;
+        m->ground_truth_id = (*gt == '\0' || strcmp(gt, "-1") == 0) ? PRIMM_NO_GROUND_TRUTH_ID
+                                                                     : (int64_t)parse_u64(&in, COL_GT_ID);
+        m->sensor_id = *sensor == '\0' ? PRIMM_NO_SENSOR_ID : (int32_t)parse_u64(&in, COL_SENSOR_ID);
+    }
+    if (open) {
+        track_frame(tracker, out, frame, timestamp_s, measurements, count, tracks);
+    }
+
+    PrimmStats stats;
+    check(primm_tracker_stats(tracker, &stats), "reading the counters");
+    fprintf(stderr,
+            "imm: %" PRIu64 " frames, %" PRIu64 " measurements, %" PRIu64 " tracks started, %" PRIu64
+            " deleted -> %s\n",
+            stats.frames_tracked, stats.measurements_accepted, stats.tracks_initiated, stats.tracks_deleted,
+            argv[2]);
+    primm_tracker_destroy(tracker);
+    free(in.line);
+    fclose(in.file);
+    if (fclose(out) != 0) {
+        fprintf(stderr, "track_csv: cannot write %s\n", argv[2]);
+        return EXIT_FAILURE;
+    }
+    return EXIT_SUCCESS;
+}
