@@ -85,13 +85,6 @@ pub struct ImmPrior {
     pub fused: PositionEstimate,
 }
 
-/// The IMM between [`Imm::predict_physics`] and [`Imm::complete_prior`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PendingPrior {
-    prior: ImmPrior,
-    dt_s: f64,
-}
-
 /// The IMM's configuration, prepared once: stateless and shared by all tracks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Imm {
@@ -267,8 +260,9 @@ impl Imm {
         beta
     }
 
-    /// Mixing, per-mode prediction and prior fusion in one call: [`Imm::predict_physics`]
-    /// followed by [`Imm::complete_prior`].
+    /// Mixing, per-mode prediction and prior fusion in one call:
+    /// [`predict_physics_into`](Self::predict_physics_into) followed by
+    /// [`complete_prior_in_place`](Self::complete_prior_in_place).
     pub fn predict(&self, models: &ModeModels, posterior: &ImmState, context: &PredictContext) -> ImmPrior {
         let mut prior = ImmPrior::default();
         self.predict_physics_into(models, posterior, context.dt_s, &mut prior);
@@ -276,18 +270,11 @@ impl Imm {
         prior
     }
 
-    /// First half of the prediction, which needs no learned displacement: prior mode
-    /// probabilities, mixing of every mode, and the CV, CA and CT predictions. The PR mode is
-    /// left at its mixed starting point. Lets the caller predict the physics modes while the
-    /// learned predictor is still running.
-    pub fn predict_physics(&self, models: &ModeModels, posterior: &ImmState, dt_s: f64) -> PendingPrior {
-        let mut prior = ImmPrior::default();
-        self.predict_physics_into(models, posterior, dt_s, &mut prior);
-        PendingPrior { prior, dt_s }
-    }
-
-    /// [`predict_physics`](Self::predict_physics) written into `prior` in place (no copy of the
-    /// multi-mode state). `prior.available` and `prior.fused` are only meaningful after
+    /// First half of the prediction, which needs no learned displacement, written into `prior`
+    /// in place (no copy of the multi-mode state): prior mode probabilities, mixing of every
+    /// mode, and the CV, CA and CT predictions. The PR mode is left at its mixed starting point.
+    /// Lets the caller predict the physics modes while the learned predictor is still running.
+    /// `prior.available` and `prior.fused` are only meaningful after
     /// [`complete_prior_in_place`](Self::complete_prior_in_place).
     #[inline(always)]
     pub fn predict_physics_into(
@@ -348,22 +335,11 @@ impl Imm {
         prior.available = self.modes;
     }
 
-    /// Second half of the prediction: the PR prior from the learned displacement
-    /// (`eq:pr_prior`, `eq:pr_cov`) and the fused prior (`eq:prior_fusion`). Without a
-    /// displacement the PR mode sits the step out (see the module documentation).
-    pub fn complete_prior(
-        &self,
-        models: &ModeModels,
-        pending: &PendingPrior,
-        displacement_m: Option<DVec2>,
-    ) -> ImmPrior {
-        let mut prior = pending.prior;
-        self.complete_prior_in_place(models, &mut prior, pending.dt_s, displacement_m);
-        prior
-    }
-
-    /// [`complete_prior`](Self::complete_prior) on a prior filled by
-    /// [`predict_physics_into`](Self::predict_physics_into) for the same `dt_s`.
+    /// Second half of the prediction, in place on a prior filled by
+    /// [`predict_physics_into`](Self::predict_physics_into) for the same `dt_s`: the PR prior
+    /// from the learned displacement (`eq:pr_prior`, `eq:pr_cov`) and the fused prior
+    /// (`eq:prior_fusion`). Without a displacement the PR mode sits the step out (see the
+    /// module documentation).
     #[inline(always)]
     pub fn complete_prior_in_place(
         &self,
