@@ -23,7 +23,10 @@ use crate::config::ImmConfig;
 use crate::gaussian::{kalman_update_into, replace_position, Gaussian, PositionEstimate, UpdateError};
 use crate::measurement::Measurement;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
-use crate::motion::{ModeModels, MotionModel, PredictContext};
+use crate::motion::{
+    ConstantAcceleration, ConstantVelocity, CoordinatedTurn, LearnedDisplacement, ModeModels, MotionModel,
+    PredictContext,
+};
 use glam::{DMat2, DVec2};
 
 /// Mode probabilities in primm's mode order (PR, CV, CA, CT); inactive modes hold 0.
@@ -50,26 +53,136 @@ pub struct ImmState {
 impl ImmState {
     /// The position marginal of one mode.
     pub fn position(&self, mode: Mode) -> PositionEstimate {
-        match mode {
-            Mode::Learned => self.learned.position(),
-            Mode::ConstantVelocity => self.constant_velocity.position(),
-            Mode::ConstantAcceleration => self.constant_acceleration.position(),
-            Mode::CoordinatedTurn => self.coordinated_turn.position(),
-        }
+        for_mode(mode, Position(self))
     }
 
     /// The velocity estimate of one mode, m/s (PR: displacement over the last step).
     pub fn velocity(&self, mode: Mode) -> DVec2 {
-        match mode {
-            Mode::Learned => self.learned_velocity_mps,
-            Mode::ConstantVelocity => {
-                DVec2::new(self.constant_velocity.mean[2], self.constant_velocity.mean[3])
+        for_mode(mode, Velocity(self))
+    }
+}
+
+/// Where one mode lives, for a state of size `N`: its Gaussian in an [`ImmState`] and its model
+/// in [`ModeModels`]. One zero-sized type per mode implements it, so that [`for_mode`] can hand
+/// a [`ModeOperation`] the mode's state size, model and fields at compile time.
+trait ModeSlot<const N: usize> {
+    /// The mode.
+    const MODE: Mode;
+    /// The mode's motion model.
+    type Model: MotionModel<N>;
+    /// The mode's model among a class's models.
+    fn model(models: &ModeModels) -> &Self::Model;
+    /// The mode's Gaussian in `state`.
+    fn gaussian(state: &ImmState) -> &Gaussian<N>;
+    /// The mode's Gaussian in `state`, to write.
+    fn gaussian_mut(state: &mut ImmState) -> &mut Gaussian<N>;
+    /// The mode's velocity estimate in `state`, m/s.
+    fn velocity(state: &ImmState) -> DVec2;
+}
+
+/// Declares a mode's [`ModeSlot`]: `slot: mode, field (of ImmState and ModeModels), N, model,
+/// |state| velocity`.
+macro_rules! mode_slot {
+    ($(#[$doc:meta])* $slot:ident: $mode:ident, $field:ident, $n:literal, $model:ty,
+     |$state:ident| $velocity:expr) => {
+        $(#[$doc])*
+        struct $slot;
+
+        impl ModeSlot<$n> for $slot {
+            const MODE: Mode = Mode::$mode;
+            type Model = $model;
+            #[inline(always)]
+            fn model(models: &ModeModels) -> &$model {
+                &models.$field
             }
-            Mode::ConstantAcceleration => {
-                DVec2::new(self.constant_acceleration.mean[2], self.constant_acceleration.mean[3])
+            #[inline(always)]
+            fn gaussian(state: &ImmState) -> &Gaussian<$n> {
+                &state.$field
             }
-            Mode::CoordinatedTurn => DVec2::new(self.coordinated_turn.mean[2], self.coordinated_turn.mean[3]),
+            #[inline(always)]
+            fn gaussian_mut(state: &mut ImmState) -> &mut Gaussian<$n> {
+                &mut state.$field
+            }
+            #[inline(always)]
+            fn velocity($state: &ImmState) -> DVec2 {
+                $velocity
+            }
         }
+    };
+}
+
+mode_slot!(
+    /// PR, whose state has no velocity: the velocity of its last displacement.
+    LearnedSlot: Learned, learned, 2, LearnedDisplacement, |state| state.learned_velocity_mps
+);
+mode_slot!(
+    /// CV.
+    ConstantVelocitySlot: ConstantVelocity, constant_velocity, 4, ConstantVelocity,
+    |state| DVec2::new(state.constant_velocity.mean[2], state.constant_velocity.mean[3])
+);
+mode_slot!(
+    /// CA.
+    ConstantAccelerationSlot: ConstantAcceleration, constant_acceleration, 6, ConstantAcceleration,
+    |state| DVec2::new(state.constant_acceleration.mean[2], state.constant_acceleration.mean[3])
+);
+mode_slot!(
+    /// CT.
+    CoordinatedTurnSlot: CoordinatedTurn, coordinated_turn, 5, CoordinatedTurn,
+    |state| DVec2::new(state.coordinated_turn.mean[2], state.coordinated_turn.mean[3])
+);
+
+/// An operation on one mode, generic over the mode's state size and [`ModeSlot`].
+trait ModeOperation {
+    /// What the operation returns.
+    type Output;
+    /// Applies the operation to the mode of `S`.
+    fn apply<const N: usize, S: ModeSlot<N>>(self) -> Self::Output;
+}
+
+/// Applies `operation` to `mode`: the IMM's one per-mode dispatch.
+#[inline(always)]
+fn for_mode<O: ModeOperation>(mode: Mode, operation: O) -> O::Output {
+    match mode {
+        Mode::Learned => operation.apply::<2, LearnedSlot>(),
+        Mode::ConstantVelocity => operation.apply::<4, ConstantVelocitySlot>(),
+        Mode::ConstantAcceleration => operation.apply::<6, ConstantAccelerationSlot>(),
+        Mode::CoordinatedTurn => operation.apply::<5, CoordinatedTurnSlot>(),
+    }
+}
+
+/// A mode's position marginal.
+struct Position<'a>(&'a ImmState);
+
+impl ModeOperation for Position<'_> {
+    type Output = PositionEstimate;
+    #[inline(always)]
+    fn apply<const N: usize, S: ModeSlot<N>>(self) -> PositionEstimate {
+        S::gaussian(self.0).position()
+    }
+}
+
+/// A mode's velocity estimate, m/s.
+struct Velocity<'a>(&'a ImmState);
+
+impl ModeOperation for Velocity<'_> {
+    type Output = DVec2;
+    #[inline(always)]
+    fn apply<const N: usize, S: ModeSlot<N>>(self) -> DVec2 {
+        S::velocity(self.0)
+    }
+}
+
+/// A mode's Gaussian copied from one state into another.
+struct CopyMode<'a> {
+    from: &'a ImmState,
+    to: &'a mut ImmState,
+}
+
+impl ModeOperation for CopyMode<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn apply<const N: usize, S: ModeSlot<N>>(self) {
+        *S::gaussian_mut(self.to) = *S::gaussian(self.from);
     }
 }
 
@@ -137,41 +250,58 @@ fn outer(a: DVec2, b: DVec2) -> DMat2 {
 }
 
 /// One mode's Kalman update from `prior` into `posterior` and its log-likelihood; an inactive
-/// mode is copied unchanged.
-#[inline(always)]
-fn update_mode<const N: usize, M: MotionModel<N>>(
-    prior: &Gaussian<N>,
-    posterior: &mut Gaussian<N>,
-    model: &M,
+/// mode is copied unchanged (its log-likelihood left as it was).
+struct UpdateMode<'a> {
+    models: &'a ModeModels,
+    prior: &'a ImmState,
+    posterior: &'a mut ImmState,
     z: DVec2,
     active: bool,
-    log_likelihood: &mut f64,
-) -> Result<(), UpdateError> {
-    if !active {
-        *posterior = *prior;
-        return Ok(());
+    log_likelihood: &'a mut f64,
+}
+
+impl ModeOperation for UpdateMode<'_> {
+    type Output = Result<(), UpdateError>;
+    #[inline(always)]
+    fn apply<const N: usize, S: ModeSlot<N>>(self) -> Result<(), UpdateError> {
+        let (prior, posterior) = (S::gaussian(self.prior), S::gaussian_mut(self.posterior));
+        if !self.active {
+            *posterior = *prior;
+            return Ok(());
+        }
+        let noise = S::model(self.models).measurement_noise();
+        *self.log_likelihood = kalman_update_into(prior, self.z, &noise, posterior)?.log_likelihood;
+        Ok(())
     }
-    *log_likelihood = kalman_update_into(prior, z, &model.measurement_noise(), posterior)?.log_likelihood;
-    Ok(())
 }
 
 /// One mode's start (its posterior with the mixed position written in, `eq:mixed_state` …
-/// `eq:reconstructed_cov`) predicted into `prior`.
-#[inline(always)]
-fn mix_and_predict<const N: usize, M: MotionModel<N>>(
-    model: &M,
-    posterior: &Gaussian<N>,
-    mixed: &PositionEstimate,
-    context: &PredictContext,
-    prior: &mut Gaussian<N>,
-) {
-    *prior = *posterior;
-    // With nothing to mix (a single mode, or all weight on itself) the write-back is the
-    // identity; skipping it keeps single-mode filtering bit-identical to a plain filter.
-    if prior.position() != *mixed {
-        replace_position(prior, mixed);
+/// `eq:reconstructed_cov`) written into `prior` and, for CV, CA and CT, predicted. PR's
+/// prediction needs the learned displacement and waits for [`Imm::complete_prior_in_place`].
+struct MixAndPredict<'a> {
+    models: &'a ModeModels,
+    posterior: &'a ImmState,
+    mixed: &'a PositionEstimate,
+    context: &'a PredictContext,
+    prior: &'a mut ImmState,
+}
+
+impl ModeOperation for MixAndPredict<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn apply<const N: usize, S: ModeSlot<N>>(self) {
+        let prior = S::gaussian_mut(self.prior);
+        *prior = *S::gaussian(self.posterior);
+        // With nothing to mix (a single mode, or all weight on itself) the write-back is the
+        // identity; skipping it keeps single-mode filtering bit-identical to a plain filter.
+        if prior.position() != *self.mixed {
+            replace_position(prior, self.mixed);
+        }
+        // PR's prediction waits for the learned displacement (`complete_prior_in_place`).
+        if S::MODE != Mode::Learned {
+            S::model(self.models).predict_in_place(prior, self.context);
+        }
     }
-    model.predict_in_place(prior, context);
 }
 
 impl Imm {
@@ -286,51 +416,18 @@ impl Imm {
     ) {
         let c = self.prior_probabilities(&posterior.probabilities);
         let positions = mode_positions(posterior, self.modes);
-        let context = PredictContext { dt_s, displacement_m: None };
+        let context = &PredictContext { dt_s, displacement_m: None };
         let state = &mut prior.state;
         state.probabilities = c;
         state.learned_velocity_mps = posterior.learned_velocity_mps;
         for mode in self.modes.iter() {
             let beta = self.mixing_probabilities(&posterior.probabilities, &c, mode);
-            let start = mix(&positions, self.modes, &beta);
-            match mode {
-                Mode::Learned => {
-                    state.learned = posterior.learned;
-                    if positions[mode.index()] != start {
-                        replace_position(&mut state.learned, &start);
-                    }
-                }
-                Mode::ConstantVelocity => mix_and_predict(
-                    &models.constant_velocity,
-                    &posterior.constant_velocity,
-                    &start,
-                    &context,
-                    &mut state.constant_velocity,
-                ),
-                Mode::ConstantAcceleration => mix_and_predict(
-                    &models.constant_acceleration,
-                    &posterior.constant_acceleration,
-                    &start,
-                    &context,
-                    &mut state.constant_acceleration,
-                ),
-                Mode::CoordinatedTurn => mix_and_predict(
-                    &models.coordinated_turn,
-                    &posterior.coordinated_turn,
-                    &start,
-                    &context,
-                    &mut state.coordinated_turn,
-                ),
-            }
+            let mixed = mix(&positions, self.modes, &beta);
+            for_mode(mode, MixAndPredict { models, posterior, mixed: &mixed, context, prior: state });
         }
         // Inactive modes are carried along unchanged, so that no stale values linger.
         for mode in ModeSet::ALL.iter().filter(|mode| !self.modes.contains(*mode)) {
-            match mode {
-                Mode::Learned => state.learned = posterior.learned,
-                Mode::ConstantVelocity => state.constant_velocity = posterior.constant_velocity,
-                Mode::ConstantAcceleration => state.constant_acceleration = posterior.constant_acceleration,
-                Mode::CoordinatedTurn => state.coordinated_turn = posterior.coordinated_turn,
-            }
+            for_mode(mode, CopyMode { from: posterior, to: state });
         }
         prior.available = self.modes;
     }
@@ -407,44 +504,18 @@ impl Imm {
         posterior: &mut ImmState,
     ) -> Result<ModeProbabilities, UpdateError> {
         let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
-        let (from, to) = (&prior.state, posterior);
         for mode in ModeSet::ALL.iter() {
-            let active = self.modes.contains(mode);
-            let i = mode.index();
-            match mode {
-                Mode::Learned => update_mode(
-                    &from.learned,
-                    &mut to.learned,
-                    &models.learned,
+            for_mode(
+                mode,
+                UpdateMode {
+                    models,
+                    prior: &prior.state,
+                    posterior: &mut *posterior,
                     z,
-                    active,
-                    &mut log_likelihood[i],
-                )?,
-                Mode::ConstantVelocity => update_mode(
-                    &from.constant_velocity,
-                    &mut to.constant_velocity,
-                    &models.constant_velocity,
-                    z,
-                    active,
-                    &mut log_likelihood[i],
-                )?,
-                Mode::ConstantAcceleration => update_mode(
-                    &from.constant_acceleration,
-                    &mut to.constant_acceleration,
-                    &models.constant_acceleration,
-                    z,
-                    active,
-                    &mut log_likelihood[i],
-                )?,
-                Mode::CoordinatedTurn => update_mode(
-                    &from.coordinated_turn,
-                    &mut to.coordinated_turn,
-                    &models.coordinated_turn,
-                    z,
-                    active,
-                    &mut log_likelihood[i],
-                )?,
-            }
+                    active: self.modes.contains(mode),
+                    log_likelihood: &mut log_likelihood[mode.index()],
+                },
+            )?;
         }
         Ok(log_likelihood)
     }
