@@ -8,7 +8,8 @@ use primm_core::config::Config;
 use primm_core::gaussian::kalman_update;
 use primm_core::imm::Imm;
 use primm_core::mode::{Method, Mode, ModeSet};
-use primm_core::motion::coordinated_turn::{Matrix5, Vector5};
+use primm_core::motion::constant_velocity::index as cv;
+use primm_core::motion::coordinated_turn::{index as ct, Matrix5, Vector5};
 use primm_core::motion::{ConstantVelocity, CoordinatedTurn, ModeModels, MotionModel, PredictContext};
 
 /// Wilson–Hilferty approximation of the χ² quantile with `k` degrees of freedom at the standard
@@ -60,7 +61,7 @@ fn constant_velocity_filter_is_consistent_on_motion_drawn_from_its_own_model() {
             truth =
                 ConstantVelocity::transition(dt) * truth + common::sample(&mut rng, &model.process_noise(dt));
             let noise = common::sample(&mut rng, &r);
-            let z = DVec2::new(truth[0] + noise[0], truth[1] + noise[1]);
+            let z = DVec2::new(truth[cv::X] + noise.x, truth[cv::Y] + noise.y);
             let prior = model.predict(&estimate, &PredictContext { dt_s: dt, displacement_m: None });
             estimate = kalman_update(&prior, z, &r).unwrap().posterior;
             let error = truth - estimate.mean;
@@ -93,7 +94,7 @@ fn coordinated_turn_filter_is_consistent_on_motion_drawn_from_its_own_model() {
             truth =
                 CoordinatedTurn::transition(&truth, dt) + common::sample(&mut rng, &model.process_noise(dt));
             let noise = common::sample(&mut rng, &r);
-            let z = DVec2::new(truth[0] + noise[0], truth[1] + noise[1]);
+            let z = DVec2::new(truth[ct::X] + noise.x, truth[ct::Y] + noise.y);
             let prior = model.predict(&estimate, &PredictContext { dt_s: dt, displacement_m: None });
             estimate = kalman_update(&prior, z, &r).unwrap().posterior;
             let error = truth - estimate.mean;

@@ -7,9 +7,11 @@ use crate::common;
 use glam::{DMat2, DVec2};
 use nalgebra::{Matrix2, SMatrix, SVector};
 use primm_core::config::Config;
+use primm_core::gaussian::index::{OTHERS, X, Y};
 use primm_core::gaussian::{replace_position, Gaussian, PositionEstimate};
 use primm_core::imm::{mix_positions, Imm, ImmState};
 use primm_core::mode::{Mode, ModeSet};
+use primm_core::motion::constant_velocity::index as cv;
 use primm_core::motion::{ModeModels, PredictContext};
 use proptest::prelude::*;
 
@@ -74,7 +76,7 @@ proptest! {
                 prop_assert!(state.probabilities[mode.index()] >= floor * (1.0 - 1e-12), "{:?} below the floor", mode);
             }
             // Re-anchor the truth now and then so that the filter stays near it.
-            if step % 200 == 0 { position = DVec2::new(state.constant_velocity.mean[0], state.constant_velocity.mean[1]); }
+            if step % 200 == 0 { position = DVec2::new(state.constant_velocity.mean[cv::X], state.constant_velocity.mean[cv::Y]); }
         }
     }
 
@@ -118,9 +120,9 @@ proptest! {
 
         // B = P_hp P_pp⁻¹ and C = P_hh − B P_pp Bᵀ, before and after.
         let conditional = |p: &SMatrix<f64, 6, 6>| {
-            let p_pp = p.fixed_view::<2, 2>(0, 0).into_owned();
-            let p_hp = p.fixed_view::<4, 2>(2, 0).into_owned();
-            let p_hh = p.fixed_view::<4, 4>(2, 2).into_owned();
+            let p_pp = p.fixed_view::<2, 2>(X, X).into_owned();
+            let p_hp = p.fixed_view::<4, 2>(OTHERS, X).into_owned();
+            let p_hh = p.fixed_view::<4, 4>(OTHERS, OTHERS).into_owned();
             let b = p_hp * p_pp.try_inverse().unwrap();
             (b, p_hh - b * p_pp * b.transpose())
         };
@@ -130,10 +132,10 @@ proptest! {
         prop_assert!((b_before - b_after).abs().max() < 1e-7 * (1.0 + b_before.abs().max()));
         prop_assert!((c_before - c_after).abs().max() < 1e-7 * scale);
         // The position block is the mixed one; the non-position mean is the mode's own.
-        prop_assert!((g.covariance.fixed_view::<2, 2>(0, 0) - p_bar).abs().max() < 1e-12);
-        prop_assert_eq!(g.mean[0], new_mean[0]);
-        prop_assert_eq!(g.mean[1], new_mean[1]);
-        prop_assert_eq!(g.mean.fixed_rows::<4>(2).into_owned(), before.mean.fixed_rows::<4>(2).into_owned());
+        prop_assert!((g.covariance.fixed_view::<2, 2>(X, X) - p_bar).abs().max() < 1e-12);
+        prop_assert_eq!(g.mean[X], new_mean[0]);
+        prop_assert_eq!(g.mean[Y], new_mean[1]);
+        prop_assert_eq!(g.mean.fixed_rows::<4>(OTHERS).into_owned(), before.mean.fixed_rows::<4>(OTHERS).into_owned());
         // And the full covariance stays positive semi-definite.
         prop_assert!(nalgebra::Cholesky::new(g.covariance + SMatrix::<f64, 6, 6>::identity() * 1e-9 * scale).is_some());
     }

@@ -6,13 +6,14 @@ use crate::common;
 use glam::DVec2;
 use nalgebra::{Matrix2, Matrix4, SMatrix, Vector4};
 use primm_core::gaussian::{kalman_update, Gaussian};
+use primm_core::motion::constant_velocity::index as cv;
 use primm_core::motion::coordinated_turn::{
-    turn_functions_closed_form, turn_functions_series, Vector5, TAYLOR_THRESHOLD,
+    index as ct, turn_functions_closed_form, turn_functions_series, Vector5, TAYLOR_THRESHOLD,
 };
 use primm_core::motion::{ConstantVelocity, CoordinatedTurn, ModeModels, MotionModel, PredictContext};
 
 fn cv_prediction(state: &Vector5, dt: f64) -> Vector4<f64> {
-    ConstantVelocity::transition(dt) * Vector4::new(state[0], state[1], state[2], state[3])
+    ConstantVelocity::transition(dt) * Vector4::new(state[ct::X], state[ct::Y], state[ct::VX], state[ct::VY])
 }
 
 #[test]
@@ -147,8 +148,8 @@ fn constant_velocity_converges_to_the_true_state_on_noise_free_straight_motion()
     }
     let truth = Vector4::new(start[0] + velocity_x * t, start[1] + velocity_y * t, velocity_x, velocity_y);
     let error = estimate.mean - truth;
-    assert!(error.fixed_rows::<2>(0).norm() < 1e-3, "position error {error}");
-    assert!(error.fixed_rows::<2>(2).norm() < 1e-3, "velocity error {error}");
+    assert!(error.fixed_rows::<2>(cv::X).norm() < 1e-3, "position error {error}");
+    assert!(error.fixed_rows::<2>(cv::VX).norm() < 1e-3, "velocity error {error}");
 }
 
 #[test]
@@ -188,11 +189,11 @@ fn initial_velocity_lies_along_the_line_of_sight_with_the_measured_radial_speed(
     let models = ModeModels::from_config(&common::config().classes.car);
     let m = common::measurement(30.0, 40.0, -5.0);
     let g = models.constant_velocity.initiate(&m);
-    assert!((g.mean[2] - (-3.0)).abs() < 1e-12 && (g.mean[3] - (-4.0)).abs() < 1e-12);
+    assert!((g.mean[cv::VX] - (-3.0)).abs() < 1e-12 && (g.mean[cv::VY] - (-4.0)).abs() < 1e-12);
     // Variance along the line of sight is the radial-velocity variance, across it the wide one.
     let along = nalgebra::Vector2::new(0.6, 0.8);
     let across = nalgebra::Vector2::new(-0.8, 0.6);
-    let velocity_covariance = g.covariance.fixed_view::<2, 2>(2, 2).into_owned();
+    let velocity_covariance = g.covariance.fixed_view::<2, 2>(cv::VX, cv::VX).into_owned();
     let config = common::config();
     assert!(
         ((along.transpose() * velocity_covariance * along)[(0, 0)]

@@ -13,7 +13,19 @@
 //! Nothing here allocates: all matrices are `nalgebra` static matrices.
 
 use glam::{DMat2, DVec2};
+use index::{OTHERS, X, Y};
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+
+/// Named indices shared by every mode's state: the position comes first, then the mode's other
+/// states. Each motion model's `index` module names the rest of its layout.
+pub mod index {
+    /// x position, m.
+    pub const X: usize = 0;
+    /// y position, m.
+    pub const Y: usize = 1;
+    /// The first of the mode's other states `h` (`eq:cov_partition`): elements `OTHERS..N`.
+    pub const OTHERS: usize = 2;
+}
 
 /// `ln(2π)`, used by the bivariate Gaussian log-density.
 const LN_TWO_PI: f64 = 1.837_877_066_409_345_5;
@@ -25,7 +37,7 @@ pub const PSEUDO_INVERSE_RELATIVE_TOLERANCE: f64 = 1e-12;
 /// A mode's estimate: mean and covariance, position first.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Gaussian<const N: usize> {
-    /// State mean; elements 0 and 1 are the x and y position in metres.
+    /// State mean; elements [`X`] and [`Y`] are the position in metres.
     pub mean: SVector<f64, N>,
     /// State covariance (units: squares of the state's units).
     pub covariance: SMatrix<f64, N, N>,
@@ -56,14 +68,14 @@ impl<const N: usize> Gaussian<N> {
     /// The position marginal `(Hx, HPHᵀ)` with `H = [I₂ 0]`.
     pub fn position(&self) -> PositionEstimate {
         PositionEstimate {
-            mean: DVec2::new(self.mean[0], self.mean[1]),
+            mean: DVec2::new(self.mean[X], self.mean[Y]),
             covariance: to_glam(&self.position_covariance()),
         }
     }
 
     /// The 2×2 position block `P_pp` of the covariance.
     pub fn position_covariance(&self) -> Matrix2<f64> {
-        self.covariance.fixed_view::<2, 2>(0, 0).into_owned()
+        self.covariance.fixed_view::<2, 2>(X, X).into_owned()
     }
 }
 
@@ -110,11 +122,11 @@ pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &Posi
     let p = &mut gaussian.covariance;
     // The blocks of eq:reconstructed_cov, written out so that only O(N²) products remain:
     // top-left P̄; off-diagonal B P̄; bottom-right C + B P̄ Bᵀ = P_hh + B (P̄ − P_pp) Bᵀ,
-    // with B = P_hp P_pp^† in rows 2.. of `b`.
+    // with B = P_hp P_pp^† in rows OTHERS.. of `b`.
     let mut b = SMatrix::<f64, N, 2>::zeros();
-    for r in 2..N {
+    for r in OTHERS..N {
         for c in 0..2 {
-            b[(r, c)] = p[(r, 0)] * p_pp_pinv[(0, c)] + p[(r, 1)] * p_pp_pinv[(1, c)];
+            b[(r, c)] = p[(r, X)] * p_pp_pinv[(0, c)] + p[(r, Y)] * p_pp_pinv[(1, c)];
         }
     }
     let p_bar_01 = 0.5 * (p_bar[(0, 1)] + p_bar[(1, 0)]);
@@ -125,19 +137,19 @@ pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &Posi
     // Written in place: row r's pass reads the position columns only through `b` (computed
     // above) and reads P_hh entries (r, c) and (c, r) with c ≥ r, none of which an earlier
     // row's pass has written.
-    p[(0, 0)] = p_bar[(0, 0)];
-    p[(1, 1)] = p_bar[(1, 1)];
-    p[(0, 1)] = p_bar_01;
-    p[(1, 0)] = p_bar_01;
-    for r in 2..N {
+    p[(X, X)] = p_bar[(0, 0)];
+    p[(Y, Y)] = p_bar[(1, 1)];
+    p[(X, Y)] = p_bar_01;
+    p[(Y, X)] = p_bar_01;
+    for r in OTHERS..N {
         let (b0, b1) = (b[(r, 0)], b[(r, 1)]);
         // Row r of B P̄ (P̄ symmetric).
         let cross0 = b0 * p_bar[(0, 0)] + b1 * p_bar_01;
         let cross1 = b0 * p_bar_01 + b1 * p_bar[(1, 1)];
-        p[(r, 0)] = cross0;
-        p[(0, r)] = cross0;
-        p[(r, 1)] = cross1;
-        p[(1, r)] = cross1;
+        p[(r, X)] = cross0;
+        p[(X, r)] = cross0;
+        p[(r, Y)] = cross1;
+        p[(Y, r)] = cross1;
         // Row r of B Δ (Δ symmetric).
         let (d0, d1) = (b0 * delta[0][0] + b1 * delta[0][1], b0 * delta[0][1] + b1 * delta[1][1]);
         for c in r..N {
@@ -146,8 +158,8 @@ pub fn replace_position<const N: usize>(gaussian: &mut Gaussian<N>, mixed: &Posi
             p[(c, r)] = value;
         }
     }
-    gaussian.mean[0] = mixed.mean.x;
-    gaussian.mean[1] = mixed.mean.y;
+    gaussian.mean[X] = mixed.mean.x;
+    gaussian.mean[Y] = mixed.mean.y;
 }
 
 /// Makes a covariance exactly symmetric by averaging it with its transpose.
@@ -220,10 +232,10 @@ pub fn kalman_update_into<const N: usize>(
     posterior: &mut Gaussian<N>,
 ) -> Result<UpdateTerms, UpdateError> {
     let p = &prior.covariance;
-    let innovation = Vector2::new(z.x - prior.mean[0], z.y - prior.mean[1]);
+    let innovation = Vector2::new(z.x - prior.mean[X], z.y - prior.mean[Y]);
     // S = H P Hᵀ + R is the top-left block plus R, symmetrised.
-    let (s00, s11) = (p[(0, 0)] + r[(0, 0)], p[(1, 1)] + r[(1, 1)]);
-    let s01 = 0.5 * (p[(0, 1)] + p[(1, 0)] + r[(0, 1)] + r[(1, 0)]);
+    let (s00, s11) = (p[(X, X)] + r[(0, 0)], p[(Y, Y)] + r[(1, 1)]);
+    let s01 = 0.5 * (p[(X, Y)] + p[(Y, X)] + r[(0, 1)] + r[(1, 0)]);
     let determinant = s00 * s11 - s01 * s01;
     // Positive definite exactly when both leading minors are positive (Sylvester).
     if !(s00 > 0.0 && determinant > 0.0) {
@@ -242,18 +254,18 @@ pub fn kalman_update_into<const N: usize>(
     let mut gain = [[0.0; 2]; N];
     let mut a_left = [[0.0; 2]; N];
     for row in 0..N {
-        let (p0, p1) = (p[(row, 0)], p[(row, 1)]);
+        let (p0, p1) = (p[(row, X)], p[(row, Y)]);
         let k = [p0 * i00 + p1 * i01, p0 * i01 + p1 * i11];
         gain[row] = k;
         a_left[row] =
-            [p0 - (k[0] * p[(0, 0)] + k[1] * p[(1, 0)]), p1 - (k[0] * p[(0, 1)] + k[1] * p[(1, 1)])];
+            [p0 - (k[0] * p[(X, X)] + k[1] * p[(Y, X)]), p1 - (k[0] * p[(X, Y)] + k[1] * p[(Y, Y)])];
     }
     // Joseph form (I − KH)P(I − KH)ᵀ + KRKᵀ with H = [I₂ 0], element by element in O(N²):
     // A − A[:, 0..2]·Kᵀ + K R Kᵀ, where A = P − K·P[0..2, :]. Upper triangle, mirrored.
     let (r00, r01, r10, r11) = (r[(0, 0)], r[(0, 1)], r[(1, 0)], r[(1, 1)]);
     for column in 0..N {
         let k = gain[column];
-        let (top0, top1) = (p[(0, column)], p[(1, column)]);
+        let (top0, top1) = (p[(X, column)], p[(Y, column)]);
         // Column `column` of R Kᵀ.
         let (rk0, rk1) = (r00 * k[0] + r01 * k[1], r10 * k[0] + r11 * k[1]);
         for row in 0..=column {
@@ -367,8 +379,8 @@ mod tests {
         for i in 0..50 {
             let angle = f64::from(i) * 0.41;
             let mut covariance = spd4() * (0.5 + f64::from(i % 5));
-            covariance[(0, 1)] += 0.1 * angle.sin();
-            covariance[(1, 0)] = covariance[(0, 1)];
+            covariance[(X, Y)] += 0.1 * angle.sin();
+            covariance[(Y, X)] = covariance[(X, Y)];
             let prior = Gaussian::new(Vector4::new(angle.cos(), angle.sin(), 2.0, -1.0), covariance);
             let r = Matrix2::new(0.3 + 0.1 * f64::from(i % 3), 0.05, 0.05, 0.2);
             let z = DVec2::new(1.0 + angle.sin(), -0.5 + angle.cos());
@@ -386,7 +398,7 @@ mod tests {
     #[test]
     fn kalman_update_refuses_an_innovation_covariance_that_is_not_positive_definite() {
         let mut prior = Gaussian::new(Vector4::zeros(), spd4());
-        prior.covariance[(0, 0)] = -5.0;
+        prior.covariance[(X, X)] = -5.0;
         assert_eq!(kalman_update(&prior, DVec2::ZERO, &Matrix2::identity()), Err(UpdateError));
         let prior = Gaussian::new(Vector4::zeros(), Matrix4::zeros());
         assert_eq!(kalman_update(&prior, DVec2::ZERO, &Matrix2::zeros()), Err(UpdateError));
@@ -395,17 +407,17 @@ mod tests {
     /// eq:reconstructed_cov assembled block by block with general nalgebra products.
     fn reference_replace(g: &Gaussian<4>, mixed: &PositionEstimate) -> Matrix4<f64> {
         let p = g.covariance;
-        let p_pp = p.fixed_view::<2, 2>(0, 0).into_owned();
-        let p_hp = p.fixed_view::<2, 2>(2, 0).into_owned();
-        let p_hh = p.fixed_view::<2, 2>(2, 2).into_owned();
+        let p_pp = p.fixed_view::<2, 2>(X, X).into_owned();
+        let p_hp = p.fixed_view::<2, 2>(OTHERS, X).into_owned();
+        let p_hh = p.fixed_view::<2, 2>(OTHERS, OTHERS).into_owned();
         let b = p_hp * p_pp.pseudo_inverse(1e-12).unwrap();
         let p_bar = to_nalgebra(&mixed.covariance);
         let c = p_hh - b * p_pp * b.transpose();
         let mut out = Matrix4::zeros();
-        out.fixed_view_mut::<2, 2>(0, 0).copy_from(&p_bar);
-        out.fixed_view_mut::<2, 2>(2, 0).copy_from(&(b * p_bar));
-        out.fixed_view_mut::<2, 2>(0, 2).copy_from(&(b * p_bar).transpose());
-        out.fixed_view_mut::<2, 2>(2, 2).copy_from(&(c + b * p_bar * b.transpose()));
+        out.fixed_view_mut::<2, 2>(X, X).copy_from(&p_bar);
+        out.fixed_view_mut::<2, 2>(OTHERS, X).copy_from(&(b * p_bar));
+        out.fixed_view_mut::<2, 2>(X, OTHERS).copy_from(&(b * p_bar).transpose());
+        out.fixed_view_mut::<2, 2>(OTHERS, OTHERS).copy_from(&(c + b * p_bar * b.transpose()));
         out
     }
 
@@ -417,7 +429,7 @@ mod tests {
             if i % 5 == 0 {
                 // A singular position block (rank one), where B comes from the pseudo-inverse.
                 let v = Vector2::new(angle.cos(), angle.sin());
-                g.covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(&(v * v.transpose() * 2.0));
+                g.covariance.fixed_view_mut::<2, 2>(X, X).copy_from(&(v * v.transpose() * 2.0));
             }
             let mixed = PositionEstimate {
                 mean: DVec2::new(angle.sin(), 0.5),
@@ -426,7 +438,7 @@ mod tests {
             let reference = reference_replace(&g, &mixed);
             replace_position(&mut g, &mixed);
             assert!((g.covariance - reference).abs().max() < 1e-9 * reference.abs().max(), "case {i}");
-            assert_eq!((g.mean[0], g.mean[1], g.mean[2]), (mixed.mean.x, mixed.mean.y, 3.0));
+            assert_eq!((g.mean[X], g.mean[Y], g.mean[OTHERS]), (mixed.mean.x, mixed.mean.y, 3.0));
         }
     }
 }

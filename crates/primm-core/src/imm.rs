@@ -23,6 +23,9 @@ use crate::config::ImmConfig;
 use crate::gaussian::{kalman_update_into, replace_position, Gaussian, PositionEstimate, UpdateError};
 use crate::measurement::Measurement;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
+use crate::motion::constant_acceleration::index as ca;
+use crate::motion::constant_velocity::index as cv;
+use crate::motion::coordinated_turn::index as ct;
 use crate::motion::{
     ConstantAcceleration, ConstantVelocity, CoordinatedTurn, LearnedDisplacement, ModeModels, MotionModel,
     PredictContext,
@@ -118,17 +121,17 @@ mode_slot!(
 mode_slot!(
     /// CV.
     ConstantVelocitySlot: ConstantVelocity, constant_velocity, 4, ConstantVelocity,
-    |state| DVec2::new(state.constant_velocity.mean[2], state.constant_velocity.mean[3])
+    |state| DVec2::new(state.constant_velocity.mean[cv::VX], state.constant_velocity.mean[cv::VY])
 );
 mode_slot!(
     /// CA.
     ConstantAccelerationSlot: ConstantAcceleration, constant_acceleration, 6, ConstantAcceleration,
-    |state| DVec2::new(state.constant_acceleration.mean[2], state.constant_acceleration.mean[3])
+    |state| DVec2::new(state.constant_acceleration.mean[ca::VX], state.constant_acceleration.mean[ca::VY])
 );
 mode_slot!(
     /// CT.
     CoordinatedTurnSlot: CoordinatedTurn, coordinated_turn, 5, CoordinatedTurn,
-    |state| DVec2::new(state.coordinated_turn.mean[2], state.coordinated_turn.mean[3])
+    |state| DVec2::new(state.coordinated_turn.mean[ct::VX], state.coordinated_turn.mean[ct::VY])
 );
 
 /// An operation on one mode, generic over the mode's state size and [`ModeSlot`].
@@ -352,7 +355,7 @@ impl Imm {
             constant_acceleration: models.constant_acceleration.initiate(measurement),
             coordinated_turn: models.coordinated_turn.initiate(measurement),
             probabilities: self.initial_probabilities,
-            learned_velocity_mps: DVec2::new(constant_velocity.mean[2], constant_velocity.mean[3]),
+            learned_velocity_mps: DVec2::new(constant_velocity.mean[cv::VX], constant_velocity.mean[cv::VY]),
         }
     }
 

@@ -5,16 +5,9 @@ use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use nalgebra::{Matrix2, Matrix6};
 
-/// Named state indices.
+/// Named indices of the state `[x, y, vx, vy, ax, ay]`.
 pub mod index {
-    /// x position, m.
-    pub const X: usize = 0;
-    /// y position, m.
-    pub const Y: usize = 1;
-    /// x velocity, m/s.
-    pub const VX: usize = 2;
-    /// y velocity, m/s.
-    pub const VY: usize = 3;
+    pub use crate::motion::index::{VX, VY, X, Y};
     /// x acceleration, m/s².
     pub const AX: usize = 4;
     /// y acceleration, m/s².

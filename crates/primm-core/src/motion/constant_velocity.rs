@@ -5,16 +5,9 @@ use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use nalgebra::{Matrix2, Matrix4};
 
-/// Named state indices.
+/// Named indices of the state `[x, y, vx, vy]`.
 pub mod index {
-    /// x position, m.
-    pub const X: usize = 0;
-    /// y position, m.
-    pub const Y: usize = 1;
-    /// x velocity, m/s.
-    pub const VX: usize = 2;
-    /// y velocity, m/s.
-    pub const VY: usize = 3;
+    pub use crate::motion::index::{VX, VY, X, Y};
 }
 
 /// Constant velocity with continuous white-noise acceleration.

@@ -21,16 +21,9 @@ pub type Matrix5 = SMatrix<f64, 5, 5>;
 /// 5-vector.
 pub type Vector5 = SVector<f64, 5>;
 
-/// Named state indices.
+/// Named indices of the state `[x, y, vx, vy, ω]`.
 pub mod index {
-    /// x position, m.
-    pub const X: usize = 0;
-    /// y position, m.
-    pub const Y: usize = 1;
-    /// x velocity, m/s.
-    pub const VX: usize = 2;
-    /// y velocity, m/s.
-    pub const VY: usize = 3;
+    pub use crate::motion::index::{VX, VY, X, Y};
     /// Turn rate, rad/s (positive counter-clockwise).
     pub const OMEGA: usize = 4;
 }

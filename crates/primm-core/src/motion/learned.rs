@@ -11,6 +11,11 @@ use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use nalgebra::{Matrix2, Vector2};
 
+/// Named indices of the state `[x, y]`.
+pub mod index {
+    pub use crate::gaussian::index::{X, Y};
+}
+
 /// PR filter noise.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LearnedDisplacement {

@@ -29,7 +29,18 @@ use crate::config::ClassConfig;
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
 use glam::DVec2;
+use index::{VX, VY, X, Y};
 use nalgebra::{Matrix2, Vector2};
+
+/// Named indices of the position-velocity layout `[x, y, vx, vy, …]` with which the CV, CA
+/// and CT states begin (each model's own `index` module re-exports these and names the rest).
+pub mod index {
+    pub use crate::gaussian::index::{X, Y};
+    /// x velocity, m/s.
+    pub const VX: usize = 2;
+    /// y velocity, m/s.
+    pub const VY: usize = 3;
+}
 
 /// What a prediction needs besides the posterior.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -133,7 +144,8 @@ impl InitialVelocity {
 }
 
 /// A state of size `N` with the measured position (covariance `R`) and the line-of-sight
-/// velocity of [`InitialVelocity`] in elements 2 and 3; every other element zero.
+/// velocity of [`InitialVelocity`] at [`VX`](index::VX) and [`VY`](index::VY); every other
+/// element zero.
 pub(crate) fn initiate_position_velocity<const N: usize>(
     measurement: &Measurement,
     measurement_noise_m2: &Matrix2<f64>,
@@ -141,12 +153,12 @@ pub(crate) fn initiate_position_velocity<const N: usize>(
 ) -> Gaussian<N> {
     let (velocity, velocity_covariance) = initial_velocity.estimate(measurement);
     let mut gaussian: Gaussian<N> = Gaussian::new(nalgebra::SVector::zeros(), nalgebra::SMatrix::zeros());
-    gaussian.mean[0] = measurement.x_m;
-    gaussian.mean[1] = measurement.y_m;
-    gaussian.mean[2] = velocity.x;
-    gaussian.mean[3] = velocity.y;
-    gaussian.covariance.fixed_view_mut::<2, 2>(0, 0).copy_from(measurement_noise_m2);
-    gaussian.covariance.fixed_view_mut::<2, 2>(2, 2).copy_from(&velocity_covariance);
+    gaussian.mean[X] = measurement.x_m;
+    gaussian.mean[Y] = measurement.y_m;
+    gaussian.mean[VX] = velocity.x;
+    gaussian.mean[VY] = velocity.y;
+    gaussian.covariance.fixed_view_mut::<2, 2>(X, X).copy_from(measurement_noise_m2);
+    gaussian.covariance.fixed_view_mut::<2, 2>(VX, VX).copy_from(&velocity_covariance);
     gaussian
 }
 
@@ -178,8 +190,8 @@ pub fn propagate_linear_in_place<const N: usize>(gaussian: &mut Gaussian<N>, ter
     }
 }
 
-/// `covariance += q·Q_axis(Δt)` on both axes' `[position, velocity]` pairs (indices 0/2 and
-/// 1/3, as CV and CT lay out their states), for acceleration PSD `q` m²/s³.
+/// `covariance += q·Q_axis(Δt)` on both axes' `[position, velocity]` pairs (`X`/`VX` and
+/// `Y`/`VY` of [`index`], as CV and CT lay out their states), for acceleration PSD `q` m²/s³.
 #[inline]
 pub(crate) fn add_white_acceleration<const N: usize>(
     covariance: &mut nalgebra::SMatrix<f64, N, N>,
@@ -187,7 +199,7 @@ pub(crate) fn add_white_acceleration<const N: usize>(
     dt: f64,
 ) {
     let block = white_acceleration_block(dt);
-    for (position, velocity) in [(0, 2), (1, 3)] {
+    for (position, velocity) in [(X, VX), (Y, VY)] {
         covariance[(position, position)] += q * block[0][0];
         covariance[(position, velocity)] += q * block[0][1];
         covariance[(velocity, position)] += q * block[1][0];
