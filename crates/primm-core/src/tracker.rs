@@ -11,13 +11,13 @@ use crate::association::associator::Associator;
 use crate::config::{Config, ConfigError};
 use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
-use crate::kernels;
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::mode::{Mode, ModeSet};
 use crate::motion::ModeModels;
 use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput, TrackStatus};
+use crate::track_loops;
 use crate::track_table::{TrackTable, MAX_TRACKS};
 use crate::validation::{validate_frame, validate_measurement, FrameError, MeasurementRejection};
 use alloc::boxed::Box;
@@ -276,7 +276,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// Mixing and the CV, CA and CT predictions, while the predictor works.
     fn predict_physics(&mut self, dt_s: f64) {
         self.dt_s = dt_s;
-        kernels::predict_physics(&self.imm, &self.models, self.table.tracks(), dt_s, &mut self.priors[..]);
+        track_loops::predict_physics(
+            &self.imm,
+            &self.models,
+            self.table.tracks(),
+            dt_s,
+            &mut self.priors[..],
+        );
     }
 
     /// Collects the displacements; the PR priors and the fused priors (`eq:prior_fusion`).
@@ -291,7 +297,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.stats.learned_predictions_missing += missing;
             self.stats.frames_with_learned_predictions_missing += u64::from(missing > 0);
         }
-        kernels::complete_priors(
+        track_loops::complete_priors(
             &self.imm,
             &self.models,
             self.table.tracks(),
@@ -326,7 +332,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 self.track_to_measurement[i] = None;
             }
         }
-        kernels::update(
+        track_loops::update(
             &self.imm,
             &self.models,
             self.table.tracks_mut(),

@@ -1,7 +1,8 @@
-//! The per-track loops of `primm_core::kernels` (compiled for baseline x86-64 and for AVX2 + FMA,
-//! chosen at run time) compute exactly what the plain IMM calls compute, bit for bit, on tracks
-//! taken from a running tracker. On a CPU with AVX2 the kernels run their AVX2 version while
-//! the reference loops below are compiled for the baseline, so the comparison covers both.
+//! The per-track loops of `primm_core::track_loops` (compiled for baseline x86-64 and for AVX2 +
+//! FMA, chosen at run time) compute exactly what the plain IMM calls compute, bit for bit, on
+//! tracks taken from a running tracker. On a CPU with AVX2 the dispatched loops run their AVX2
+//! version while the reference loops below are compiled for the baseline, so the comparison
+//! covers both.
 
 use crate::common;
 
@@ -10,11 +11,11 @@ use glam::DVec2;
 use primm_core::config::Config;
 use primm_core::gaussian::UpdateError;
 use primm_core::imm::{Imm, ImmPrior};
-use primm_core::kernels::{self, ClassModels};
 use primm_core::measurement::{Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::motion::ModeModels;
 use primm_core::track::Track;
+use primm_core::track_loops::{self, ClassModels};
 use primm_core::tracker::Tracker;
 
 /// The tracks of a tracker running `method` on 24 lanes after `frames` frames.
@@ -48,7 +49,7 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
         let dt_s = 0.05;
 
         let mut dispatched = vec![ImmPrior::default(); tracks.len()];
-        kernels::predict_physics(&imm, &models, &tracks, dt_s, &mut dispatched);
+        track_loops::predict_physics(&imm, &models, &tracks, dt_s, &mut dispatched);
         let mut plain = vec![ImmPrior::default(); tracks.len()];
         for (track, prior) in tracks.iter().zip(plain.iter_mut()) {
             imm.predict_physics_into(&models[track.class.index()], &track.estimate, dt_s, prior);
@@ -59,7 +60,7 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
         let displacements: Vec<Option<DVec2>> = (0..tracks.len())
             .map(|i| (i % 3 != 0).then(|| DVec2::new(0.4 + 0.01 * i as f64, -0.05)))
             .collect();
-        kernels::complete_priors(&imm, &models, &tracks, dt_s, &displacements, &mut dispatched);
+        track_loops::complete_priors(&imm, &models, &tracks, dt_s, &displacements, &mut dispatched);
         for ((track, prior), displacement) in tracks.iter().zip(plain.iter_mut()).zip(&displacements) {
             imm.complete_prior_in_place(&models[track.class.index()], prior, dt_s, *displacement);
         }
@@ -75,7 +76,7 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
             .collect();
         let mut dispatched_tracks = tracks.clone();
         let mut outcomes = vec![Err(UpdateError); tracks.len()];
-        kernels::update(&imm, &models, &mut dispatched_tracks, &dispatched, &measurements, &mut outcomes);
+        track_loops::update(&imm, &models, &mut dispatched_tracks, &dispatched, &measurements, &mut outcomes);
         let mut plain_tracks = tracks.clone();
         for (i, track) in plain_tracks.iter_mut().enumerate() {
             let expected = match measurements[i] {
