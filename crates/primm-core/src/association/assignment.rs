@@ -251,6 +251,29 @@ impl AssignmentSolver {
         costs: &[f64],
         row_to_col: &mut [Option<usize>],
     ) -> Result<AssignmentSummary, AssignmentError> {
+        self.check_dimensions(rows, cols, costs, row_to_col)?;
+        let live = self.find_live_lines(cols, costs)?;
+        let shape = ReducedShape::new(&live)?;
+
+        // All checks passed: from here on the call succeeds.
+        let row_to_col = &mut row_to_col[..rows];
+        row_to_col.fill(None);
+        if shape.short == 0 {
+            return Ok(AssignmentSummary { pairs: 0, total_cost: 0.0 });
+        }
+        self.write_reduced(cols, costs, &live, &shape);
+        self.core.solve(shape.short, shape.long, &self.reduced[..shape.short * shape.long]);
+        Ok(self.read_pairs(cols, costs, &live, &shape, row_to_col))
+    }
+
+    /// Checks the problem against the capacity and the slices against the problem.
+    fn check_dimensions(
+        &self,
+        rows: usize,
+        cols: usize,
+        costs: &[f64],
+        row_to_col: &[Option<usize>],
+    ) -> Result<(), AssignmentError> {
         if rows > self.max_rows || cols > self.max_cols {
             return Err(AssignmentError::CapacityExceeded {
                 rows,
@@ -267,13 +290,16 @@ impl AssignmentSolver {
         if row_to_col.len() < rows {
             return Err(AssignmentError::OutputTooShort { rows, actual: row_to_col.len() });
         }
+        Ok(())
+    }
 
-        // Validate every entry, find live rows/columns and the range of allowed costs.
+    /// Validates every entry of the row-major `costs` (`cols` columns), records the live rows
+    /// and columns (those with an allowed entry) in `live_rows` and `live_cols`, and finds the
+    /// range of the allowed costs.
+    fn find_live_lines(&mut self, cols: usize, costs: &[f64]) -> Result<LiveLines, AssignmentError> {
         let col_is_live = &mut self.col_is_live[..cols];
         col_is_live.fill(false);
-        let mut live_row_count = 0;
-        let mut lowest = f64::INFINITY;
-        let mut highest = f64::NEG_INFINITY;
+        let mut live = LiveLines { rows: 0, cols: 0, lowest: f64::INFINITY, highest: f64::NEG_INFINITY };
         if cols > 0 {
             for (row, row_costs) in costs.chunks_exact(cols).enumerate() {
                 let mut row_is_live = false;
@@ -281,8 +307,8 @@ impl AssignmentSolver {
                     if cost.is_finite() {
                         row_is_live = true;
                         col_is_live[col] = true;
-                        lowest = lowest.min(cost);
-                        highest = highest.max(cost);
+                        live.lowest = live.lowest.min(cost);
+                        live.highest = live.highest.max(cost);
                     } else if cost.is_nan() {
                         return Err(AssignmentError::NanCost { row, col });
                     } else if cost == f64::NEG_INFINITY {
@@ -290,73 +316,65 @@ impl AssignmentSolver {
                     }
                 }
                 if row_is_live {
-                    self.live_rows[live_row_count] = row;
-                    live_row_count += 1;
+                    self.live_rows[live.rows] = row;
+                    live.rows += 1;
                 }
             }
         }
-        let mut live_col_count = 0;
-        for (col, &live) in col_is_live.iter().enumerate() {
-            if live {
-                self.live_cols[live_col_count] = col;
-                live_col_count += 1;
+        for (col, &is_live) in col_is_live.iter().enumerate() {
+            if is_live {
+                self.live_cols[live.cols] = col;
+                live.cols += 1;
             }
         }
+        Ok(live)
+    }
 
-        // Orientation and the substitute for forbidden entries (see the module documentation).
-        let transposed = live_row_count > live_col_count;
-        let (short, long) =
-            if transposed { (live_col_count, live_row_count) } else { (live_row_count, live_col_count) };
-        let mut forbidden_cost = 0.0;
-        if short > 0 {
-            let span = highest - lowest;
-            let scale = span + lowest.abs().max(highest.abs()).max(1.0);
-            let lines = short as f64 + 1.0;
-            forbidden_cost = highest + lines * scale;
-            let bound = OVERFLOW_HEADROOM * lines * (forbidden_cost.abs() + lowest.abs());
-            if !bound.is_finite() {
-                return Err(AssignmentError::CostRangeTooLarge { lowest, highest });
-            }
-        }
-
-        // All checks passed: from here on the call succeeds.
-        let row_to_col = &mut row_to_col[..rows];
-        row_to_col.fill(None);
-        if short == 0 {
-            return Ok(AssignmentSummary { pairs: 0, total_cost: 0.0 });
-        }
-
-        let live_rows = &self.live_rows[..live_row_count];
-        let live_cols = &self.live_cols[..live_col_count];
-        let reduced = &mut self.reduced[..short * long];
+    /// Writes the reduced, finite, short-side-major matrix of the live lines into `reduced`,
+    /// forbidden entries replaced by the substitute value.
+    fn write_reduced(&mut self, cols: usize, costs: &[f64], live: &LiveLines, shape: &ReducedShape) {
+        let live_rows = &self.live_rows[..live.rows];
+        let live_cols = &self.live_cols[..live.cols];
+        let reduced = &mut self.reduced[..shape.short * shape.long];
         let finite_or_forbidden = |cost: f64| {
             if cost.is_finite() {
                 cost
             } else {
-                forbidden_cost
+                shape.forbidden_cost
             }
         };
-        if transposed {
-            for (line, &col) in reduced.chunks_exact_mut(long).zip(live_cols) {
+        if shape.transposed {
+            for (line, &col) in reduced.chunks_exact_mut(shape.long).zip(live_cols) {
                 for (slot, &row) in line.iter_mut().zip(live_rows) {
                     *slot = finite_or_forbidden(costs[row * cols + col]);
                 }
             }
         } else {
-            for (line, &row) in reduced.chunks_exact_mut(long).zip(live_rows) {
+            for (line, &row) in reduced.chunks_exact_mut(shape.long).zip(live_rows) {
                 let row_costs = &costs[row * cols..(row + 1) * cols];
                 for (slot, &col) in line.iter_mut().zip(live_cols) {
                     *slot = finite_or_forbidden(row_costs[col]);
                 }
             }
         }
+    }
 
-        self.core.solve(short, long, reduced);
-
+    /// Translates the core's assignment back to original rows and columns in `row_to_col`,
+    /// dropping pairs on forbidden entries, and sums the costs of the pairs kept.
+    fn read_pairs(
+        &self,
+        cols: usize,
+        costs: &[f64],
+        live: &LiveLines,
+        shape: &ReducedShape,
+        row_to_col: &mut [Option<usize>],
+    ) -> AssignmentSummary {
+        let live_rows = &self.live_rows[..live.rows];
+        let live_cols = &self.live_cols[..live.cols];
         let mut pairs = 0;
         let mut total_cost = 0.0;
-        for (short_index, &long_index) in self.core.col_for_row[..short].iter().enumerate() {
-            let (row, col) = if transposed {
+        for (short_index, &long_index) in self.core.col_for_row[..shape.short].iter().enumerate() {
+            let (row, col) = if shape.transposed {
                 (live_rows[long_index], live_cols[short_index])
             } else {
                 (live_rows[short_index], live_cols[long_index])
@@ -368,7 +386,54 @@ impl AssignmentSolver {
                 total_cost += cost;
             }
         }
-        Ok(AssignmentSummary { pairs, total_cost })
+        AssignmentSummary { pairs, total_cost }
+    }
+}
+
+/// What pruning found: how many rows and columns are live (their original indices lead
+/// [`AssignmentSolver`]'s `live_rows` and `live_cols`) and the range of the allowed costs
+/// (`lowest > highest` when there is none).
+#[derive(Debug, Clone, Copy)]
+struct LiveLines {
+    rows: usize,
+    cols: usize,
+    lowest: f64,
+    highest: f64,
+}
+
+/// The reduced problem: its orientation, its sizes and the substitute `M` for forbidden
+/// entries (see the module documentation).
+#[derive(Debug, Clone, Copy)]
+struct ReducedShape {
+    /// The live columns are the short side (more live rows than columns survive pruning).
+    transposed: bool,
+    /// Lines on the short side, `n`.
+    short: usize,
+    /// Lines on the long side.
+    long: usize,
+    /// `M`; zero when `short` is zero.
+    forbidden_cost: f64,
+}
+
+impl ReducedShape {
+    /// Orientation and `M` for the live lines; refuses allowed costs whose range would let the
+    /// core's intermediate values overflow `f64`.
+    fn new(live: &LiveLines) -> Result<Self, AssignmentError> {
+        let transposed = live.rows > live.cols;
+        let (short, long) = if transposed { (live.cols, live.rows) } else { (live.rows, live.cols) };
+        let (lowest, highest) = (live.lowest, live.highest);
+        let mut forbidden_cost = 0.0;
+        if short > 0 {
+            let span = highest - lowest;
+            let scale = span + lowest.abs().max(highest.abs()).max(1.0);
+            let lines = short as f64 + 1.0;
+            forbidden_cost = highest + lines * scale;
+            let bound = OVERFLOW_HEADROOM * lines * (forbidden_cost.abs() + lowest.abs());
+            if !bound.is_finite() {
+                return Err(AssignmentError::CostRangeTooLarge { lowest, highest });
+            }
+        }
+        Ok(Self { transposed, short, long, forbidden_cost })
     }
 }
 
