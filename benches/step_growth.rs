@@ -114,14 +114,14 @@ fn run<P: DisplacementPredictor>(method: Method, predictor: P, count: usize, fra
     for (k, frame) in scene.iter().enumerate() {
         let mut clock = StageClock { last: Instant::now(), stages: [0; Stage::COUNT] };
         let start = clock.last;
-        let outputs = tracker.step_observed(frame, &mut clock, |_| {}).unwrap();
+        let summary = tracker.step_observed(frame, &mut clock, |_| {}).unwrap();
         let elapsed = start.elapsed().as_nanos() as u64;
         if k >= WARM_UP_FRAMES {
             step.record(elapsed.max(1)).unwrap();
             for (histogram, &value) in stages.iter_mut().zip(clock.stages.iter()) {
                 histogram.record(value.max(1)).unwrap();
             }
-            emitted = outputs;
+            emitted = summary.live_tracks;
         }
     }
     Row {

@@ -3,6 +3,8 @@
 //! The step reads like the algorithm of the paper (Section III): validate, predict every
 //! mode of every track (the learned predictor runs on its batch meanwhile), fuse the priors,
 //! associate per class, update, coast, initiate, delete, report. Each role is a method below.
+//! Every step also returns (or keeps, for [`Tracker::last_step`]) a [`StepSummary`] of what it
+//! did; [`TrackerStats`] adds the summaries up since the tracker was built.
 //! The tracker never reads a clock: time comes from frames, so a replay is bit-for-bit
 //! repeatable.
 
@@ -77,6 +79,53 @@ pub struct TrackerStats {
     pub resets: u64,
 }
 
+/// What one step did: the per-frame counterpart of [`TrackerStats`]. Returned by
+/// [`Tracker::step_into`] and [`Tracker::step_observed`]; the latest one is kept for
+/// [`Tracker::last_step`] (which is how [`Tracker::step`] reports it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct StepSummary {
+    /// Measurements of the frame accepted by validation.
+    pub measurements_accepted: usize,
+    /// Measurements of the frame rejected by validation (unknown class code, NaN or infinite
+    /// value, absurd magnitude; [`TrackerStats`] counts each reason).
+    pub measurements_rejected: usize,
+    /// Existing tracks updated by a measurement of the frame.
+    pub assigned: usize,
+    /// Tracks started by an unassigned measurement.
+    pub initiated: usize,
+    /// Unassigned measurements that could not start a track because the table was full.
+    pub initiations_refused_table_full: usize,
+    /// Tracks confirmed in this step (a track started and confirmed at once included).
+    pub newly_confirmed: usize,
+    /// Kalman updates refused for numerical reasons (the track coasted instead).
+    pub update_failures: usize,
+    /// Tracks deleted.
+    pub deleted: usize,
+    /// Tracks for which the learned predictor gave no displacement (PR sat out).
+    pub predictions_missing: usize,
+    /// Live tracks after the step: the number of outputs reported.
+    pub live_tracks: usize,
+    /// Confirmed tracks among the live ones.
+    pub confirmed_tracks: usize,
+}
+
+impl TrackerStats {
+    /// Adds one step's counts (the rejected measurements are counted per reason where they are
+    /// rejected).
+    fn add_step(&mut self, step: &StepSummary) {
+        let count = |n: usize| n as u64;
+        self.measurements_accepted += count(step.measurements_accepted);
+        self.tracks_initiated += count(step.initiated);
+        self.tracks_confirmed += count(step.newly_confirmed);
+        self.tracks_deleted += count(step.deleted);
+        self.initiations_refused_table_full += count(step.initiations_refused_table_full);
+        self.learned_predictions_missing += count(step.predictions_missing);
+        self.frames_with_learned_predictions_missing += u64::from(step.predictions_missing > 0);
+        self.update_failures += count(step.update_failures);
+    }
+}
+
 /// What happened to each measurement of the current frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum MeasurementFate {
@@ -107,6 +156,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     associator: Associator,
     last_timestamp_s: Option<f64>,
     stats: TrackerStats,
+    /// What the latest step did.
+    last_step: StepSummary,
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
     displacements: Box<[Option<DVec2>; MAX_TRACKS]>,
@@ -145,6 +196,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             associator: Associator::new(),
             last_timestamp_s: None,
             stats: TrackerStats::default(),
+            last_step: StepSummary::default(),
             requests: Box::new(ArrayVec::new()),
             displacements: Box::new([None; MAX_TRACKS]),
             priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
@@ -159,7 +211,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
         })
     }
 
-    /// Tracks one frame and returns the state of every live track.
+    /// Tracks one frame and returns the state of every live track; [`last_step`](Self::last_step)
+    /// then says what the step did (the outputs borrow the tracker: read it once done with
+    /// them).
     pub fn step<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<&[TrackOutput], StepError> {
         self.advance(frame, &mut NoObserver)?;
         self.outputs.clear();
@@ -170,12 +224,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Tracks one frame and hands every live track's output to `sink`, in table order, instead
     /// of collecting them: lets a caller write them straight into their destination (e.g. a
-    /// loaned shared-memory sample). Returns the number of outputs.
+    /// loaned shared-memory sample). Returns what the step did (its
+    /// [`live_tracks`](StepSummary::live_tracks) is the number of outputs).
     pub fn step_into<F: FrameView + ?Sized>(
         &mut self,
         frame: &F,
         sink: impl FnMut(&TrackOutput),
-    ) -> Result<usize, StepError> {
+    ) -> Result<StepSummary, StepError> {
         self.step_observed(frame, &mut NoObserver, sink)
     }
 
@@ -186,15 +241,31 @@ impl<P: DisplacementPredictor> Tracker<P> {
         frame: &F,
         observer: &mut O,
         sink: impl FnMut(&TrackOutput),
-    ) -> Result<usize, StepError> {
+    ) -> Result<StepSummary, StepError> {
         self.advance(frame, observer)?;
-        let count = report(&self.table, &self.rows[..], &self.imm, sink);
+        report(&self.table, &self.rows[..], &self.imm, sink);
         observer.stage_finished(Stage::Report);
-        Ok(count)
+        Ok(self.last_step)
     }
 
-    /// Everything but the report.
+    /// Everything but the report; counts what the step did into
+    /// [`last_step`](Self::last_step) and the statistics, also when it fails.
     fn advance<F: FrameView + ?Sized, O: StageObserver>(
+        &mut self,
+        frame: &F,
+        observer: &mut O,
+    ) -> Result<(), StepError> {
+        self.last_step = StepSummary::default();
+        let result = self.run_stages(frame, observer);
+        self.last_step.live_tracks = self.table.len();
+        self.last_step.confirmed_tracks =
+            self.table.tracks().iter().filter(|track| track.status == TrackStatus::Confirmed).count();
+        self.stats.add_step(&self.last_step);
+        result
+    }
+
+    /// The stages of a step up to the report.
+    fn run_stages<F: FrameView + ?Sized, O: StageObserver>(
         &mut self,
         frame: &F,
         observer: &mut O,
@@ -242,14 +313,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.accepted[index] = verdict.is_ok();
             self.fates[index] =
                 if verdict.is_ok() { MeasurementFate::Unassigned } else { MeasurementFate::Rejected };
-            match verdict {
-                Ok(_) => self.stats.measurements_accepted += 1,
-                Err(MeasurementRejection::UnknownClass) => {
-                    self.stats.measurements_rejected_unknown_class += 1
+            let rejections = match verdict {
+                Ok(_) => {
+                    self.last_step.measurements_accepted += 1;
+                    continue;
                 }
-                Err(MeasurementRejection::NonFinite) => self.stats.measurements_rejected_non_finite += 1,
-                Err(MeasurementRejection::OutOfRange) => self.stats.measurements_rejected_out_of_range += 1,
-            }
+                Err(MeasurementRejection::UnknownClass) => {
+                    &mut self.stats.measurements_rejected_unknown_class
+                }
+                Err(MeasurementRejection::NonFinite) => &mut self.stats.measurements_rejected_non_finite,
+                Err(MeasurementRejection::OutOfRange) => &mut self.stats.measurements_rejected_out_of_range,
+            };
+            *rejections += 1;
+            self.last_step.measurements_rejected += 1;
         }
         Ok(dt_s)
     }
@@ -293,9 +369,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             displacements.fill(None);
         } else {
             self.predictor.collect(displacements);
-            let missing = displacements.iter().filter(|d| d.is_none()).count() as u64;
-            self.stats.learned_predictions_missing += missing;
-            self.stats.frames_with_learned_predictions_missing += u64::from(missing > 0);
+            self.last_step.predictions_missing = displacements.iter().filter(|d| d.is_none()).count();
         }
         track_loops::complete_priors(
             &self.imm,
@@ -350,13 +424,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if self.update_outcomes[i].is_ok() {
                 let was_confirmed = track.status == TrackStatus::Confirmed;
                 track.record_hit(&measurement, t, confirmation_hits);
-                self.stats.tracks_confirmed +=
-                    u64::from(!was_confirmed && track.status == TrackStatus::Confirmed);
+                self.last_step.assigned += 1;
+                self.last_step.newly_confirmed +=
+                    usize::from(!was_confirmed && track.status == TrackStatus::Confirmed);
                 self.fates[usize::from(index)] = MeasurementFate::Assigned;
             } else {
                 // Numerically unusable: the track coasts and the measurement is free to start a
                 // track of its own.
-                self.stats.update_failures += 1;
+                self.last_step.update_failures += 1;
                 self.track_to_measurement[i] = None;
             }
         }
@@ -390,11 +465,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let estimate = self.imm.initiate(&self.models[measurement.class.index()], &measurement);
             match self.table.insert(|id| Track::new(id, &measurement, t, estimate)) {
                 Ok(track) => {
-                    self.stats.tracks_initiated += 1;
+                    self.last_step.initiated += 1;
                     // A confirmation threshold of one hit confirms at once.
                     if track.hits >= confirmation_hits {
                         track.status = TrackStatus::Confirmed;
-                        self.stats.tracks_confirmed += 1;
+                        self.last_step.newly_confirmed += 1;
                     }
                     self.rows[self.table.len() - 1] = RowRecord {
                         prior_position_m: None,
@@ -403,7 +478,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     };
                     self.fates[index] = MeasurementFate::Assigned;
                 }
-                Err(_) => self.stats.initiations_refused_table_full += 1,
+                Err(_) => self.last_step.initiations_refused_table_full += 1,
             }
         }
     }
@@ -427,20 +502,28 @@ impl<P: DisplacementPredictor> Tracker<P> {
             read += 1;
             keep
         });
-        self.stats.tracks_deleted += deleted as u64;
+        self.last_step.deleted = deleted;
     }
 
     /// Removes every track and forgets the last timestamp, e.g. after a gap in the stream that
-    /// [`FrameError::IntervalTooLong`] reported. Ids keep counting; statistics are kept.
+    /// [`FrameError::IntervalTooLong`] reported. Ids keep counting; statistics are kept;
+    /// [`last_step`](Self::last_step) is cleared.
     pub fn reset(&mut self) {
         self.table.clear();
         self.last_timestamp_s = None;
+        self.last_step = StepSummary::default();
         self.stats.resets += 1;
     }
 
     /// The counters.
     pub fn stats(&self) -> &TrackerStats {
         &self.stats
+    }
+
+    /// What the latest step did. After a failed step: what it counted before it failed (a frame
+    /// rejected by validation counts no measurement) and the unchanged tracks.
+    pub fn last_step(&self) -> &StepSummary {
+        &self.last_step
     }
 
     /// The live tracks.
@@ -464,8 +547,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 }
 
-/// The output record of every live track, handed to `sink`; returns the count.
-fn report(table: &TrackTable, rows: &[RowRecord], imm: &Imm, mut sink: impl FnMut(&TrackOutput)) -> usize {
+/// The output record of every live track, handed to `sink`.
+fn report(table: &TrackTable, rows: &[RowRecord], imm: &Imm, mut sink: impl FnMut(&TrackOutput)) {
     for (track, row) in table.tracks().iter().zip(rows.iter()) {
         let fused = imm.fuse_posterior(&track.estimate, row.available);
         sink(&TrackOutput {
@@ -484,5 +567,4 @@ fn report(table: &TrackTable, rows: &[RowRecord], imm: &Imm, mut sink: impl FnMu
             measurement_index: row.measurement_index,
         });
     }
-    table.len()
 }

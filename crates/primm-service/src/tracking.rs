@@ -235,7 +235,6 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         let frame: &MeasurementFrame = &sample;
         let mut flags = self.follow_stream(origin, frame);
 
-        let stats_before = *self.tracker.stats();
         let mut loan = match self.output.loan_uninit() {
             Ok(loan) => Some(loan),
             Err(error) => {
@@ -267,11 +266,11 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 }
             });
         }
-        let status = match &result {
-            Ok(_) => {
+        let (status, step) = match &result {
+            Ok(step) => {
                 self.counters.frames_tracked += 1;
                 self.stream.tracker_dirty = true;
-                FrameStatus::Tracked
+                (FrameStatus::Tracked, *step)
             }
             Err(error) => {
                 self.counters.frames_rejected += 1;
@@ -283,17 +282,11 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                         "measurement frame rejected"
                     );
                 }
-                FrameStatus::of_error(error)
+                // What the failed step counted before it failed.
+                (FrameStatus::of_error(error), *self.tracker.last_step())
             }
         };
-        let stats = self.tracker.stats();
-        let accepted = stats.measurements_accepted - stats_before.measurements_accepted;
-        let rejected = (stats.measurements_rejected_unknown_class
-            + stats.measurements_rejected_non_finite
-            + stats.measurements_rejected_out_of_range)
-            - (stats_before.measurements_rejected_unknown_class
-                + stats_before.measurements_rejected_non_finite
-                + stats_before.measurements_rejected_out_of_range);
+        let saturating_u16 = |count: usize| u16::try_from(count).unwrap_or(u16::MAX);
         if frame.flags & FRAME_FLAG_STREAM_END != 0 {
             flags |= TRACK_FLAG_STREAM_END;
         }
@@ -306,8 +299,8 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             publish_time_ns: 0,
             status,
             flags,
-            measurements_accepted: accepted.min(u64::from(u16::MAX)) as u16,
-            measurements_rejected: rejected.min(u64::from(u16::MAX)) as u16,
+            measurements_accepted: saturating_u16(step.measurements_accepted),
+            measurements_rejected: saturating_u16(step.measurements_rejected),
         };
         // The input sample goes back to its publisher before the answer is sent.
         drop(sample);
