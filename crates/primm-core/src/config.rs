@@ -351,115 +351,141 @@ impl Config {
 
     /// Checks every value; the error names the first offending key.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        let imm = &self.imm;
-        if imm.modes.is_empty() {
-            return Err(invalid("imm.modes", "at least one mode must be active"));
+        validate_imm(&self.imm)?;
+        validate_association(&self.association)?;
+        validate_tracker_and_predictor(&self.tracker, &self.predictor)?;
+        for class in ObjectClass::ALL {
+            validate_class(class, self.classes.get(class))?;
         }
-        for (i, row) in imm.transition.iter().enumerate() {
-            for (j, &p) in row.iter().enumerate() {
-                if !(0.0..=1.0).contains(&p) {
-                    return Err(invalid(
-                        format!("imm.transition[{i}][{j}]"),
-                        format!("must be a probability in [0, 1], got {p}"),
-                    ));
-                }
-            }
-            let sum: f64 = row.iter().sum();
-            if (sum - 1.0).abs() > 1e-9 {
-                return Err(invalid(
-                    format!("imm.transition[{i}]"),
-                    format!("row must sum to 1, sums to {sum}"),
-                ));
-            }
+        Ok(())
+    }
+}
+
+/// The `imm` section: mode set, transition matrix, initial probabilities, temperature, floor.
+fn validate_imm(imm: &ImmConfig) -> Result<(), ConfigError> {
+    if imm.modes.is_empty() {
+        return Err(invalid("imm.modes", "at least one mode must be active"));
+    }
+    validate_transition(imm)?;
+    for (i, &p) in imm.initial_mode_probabilities.iter().enumerate() {
+        if !(0.0..=1.0).contains(&p) {
+            return Err(invalid(
+                format!("imm.initial_mode_probabilities[{i}]"),
+                format!("must be a probability in [0, 1], got {p}"),
+            ));
         }
-        for mode in imm.modes.iter() {
-            let i = mode.index();
-            let active_sum: f64 = imm.modes.iter().map(|to| imm.transition[i][to.index()]).sum();
-            if active_sum <= 0.0 {
-                return Err(invalid(
-                    format!("imm.transition[{i}]"),
-                    "row has no probability mass on the active modes",
-                ));
-            }
-        }
-        for (i, &p) in imm.initial_mode_probabilities.iter().enumerate() {
+    }
+    if imm.modes.iter().map(|m| imm.initial_mode_probabilities[m.index()]).sum::<f64>() <= 0.0 {
+        return Err(invalid("imm.initial_mode_probabilities", "no probability mass on the active modes"));
+    }
+    positive("imm.likelihood_temperature", imm.likelihood_temperature)?;
+    let floor = imm.mode_probability_floor;
+    if !(floor >= 0.0 && floor < 1.0 / imm.modes.len() as f64) {
+        return Err(invalid(
+            "imm.mode_probability_floor",
+            format!("must be in [0, 1/number of active modes), got {floor}"),
+        ));
+    }
+    Ok(())
+}
+
+/// `imm.transition`: probabilities, rows summing to 1, and mass on the active modes in the row
+/// of every active mode.
+fn validate_transition(imm: &ImmConfig) -> Result<(), ConfigError> {
+    for (i, row) in imm.transition.iter().enumerate() {
+        for (j, &p) in row.iter().enumerate() {
             if !(0.0..=1.0).contains(&p) {
                 return Err(invalid(
-                    format!("imm.initial_mode_probabilities[{i}]"),
+                    format!("imm.transition[{i}][{j}]"),
                     format!("must be a probability in [0, 1], got {p}"),
                 ));
             }
         }
-        if imm.modes.iter().map(|m| imm.initial_mode_probabilities[m.index()]).sum::<f64>() <= 0.0 {
-            return Err(invalid("imm.initial_mode_probabilities", "no probability mass on the active modes"));
+        let sum: f64 = row.iter().sum();
+        if (sum - 1.0).abs() > 1e-9 {
+            return Err(invalid(format!("imm.transition[{i}]"), format!("row must sum to 1, sums to {sum}")));
         }
-        positive("imm.likelihood_temperature", imm.likelihood_temperature)?;
-        let floor = imm.mode_probability_floor;
-        if !(floor >= 0.0 && floor < 1.0 / imm.modes.len() as f64) {
+    }
+    for mode in imm.modes.iter() {
+        let i = mode.index();
+        let active_sum: f64 = imm.modes.iter().map(|to| imm.transition[i][to.index()]).sum();
+        if active_sum <= 0.0 {
             return Err(invalid(
-                "imm.mode_probability_floor",
-                format!("must be in [0, 1/number of active modes), got {floor}"),
+                format!("imm.transition[{i}]"),
+                "row has no probability mass on the active modes",
             ));
         }
-        if !(self.association.velocity_weight_s.is_finite() && self.association.velocity_weight_s >= 0.0) {
-            return Err(invalid("association.velocity_weight_s", "must be a finite number >= 0"));
-        }
-        if !(self.association.velocity_cap_mps.is_finite() && self.association.velocity_cap_mps >= 0.0) {
-            return Err(invalid("association.velocity_cap_mps", "must be a finite number >= 0"));
-        }
-        let tracker = &self.tracker;
-        positive("tracker.max_frame_interval_s", tracker.max_frame_interval_s)?;
-        positive("predictor.deadline_ms", self.predictor.deadline_ms)?;
-        if self.predictor.deadline_ms > 1000.0 {
-            return Err(invalid("predictor.deadline_ms", "must be at most 1000 ms (one second)"));
-        }
-        positive("tracker.max_coast_s", tracker.max_coast_s)?;
-        positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
-        if tracker.confirmation_hits == 0 {
-            return Err(invalid("tracker.confirmation_hits", "must be at least 1"));
-        }
-        for class in ObjectClass::ALL {
-            let section = self.classes.get(class);
-            let key = |name: &str| format!("classes.{}.{}", class.name(), name);
-            positive(&key("gate_m"), section.gate_m)?;
-            covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
-            positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
-            positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
-            positive(
-                &key("constant_velocity.acceleration_psd_m2_per_s3"),
-                section.constant_velocity.acceleration_psd_m2_per_s3,
-            )?;
-            positive(
-                &key("constant_acceleration.jerk_psd_m2_per_s5"),
-                section.constant_acceleration.jerk_psd_m2_per_s5,
-            )?;
-            positive(
-                &key("constant_acceleration.initial_acceleration_std_mps2"),
-                section.constant_acceleration.initial_acceleration_std_mps2,
-            )?;
-            positive(
-                &key("coordinated_turn.acceleration_psd_m2_per_s3"),
-                section.coordinated_turn.acceleration_psd_m2_per_s3,
-            )?;
-            positive(
-                &key("coordinated_turn.turn_rate_psd_rad2_per_s3"),
-                section.coordinated_turn.turn_rate_psd_rad2_per_s3,
-            )?;
-            positive(
-                &key("coordinated_turn.initial_turn_rate_std_radps"),
-                section.coordinated_turn.initial_turn_rate_std_radps,
-            )?;
-            covariance(
-                &key("learned.process_noise_covariance_m2"),
-                &section.learned.process_noise_covariance_m2,
-            )?;
-            covariance(
-                &key("learned.measurement_noise_covariance_m2"),
-                &section.learned.measurement_noise_covariance_m2,
-            )?;
-        }
-        Ok(())
     }
+    Ok(())
+}
+
+/// The `association` section.
+fn validate_association(association: &AssociationConfig) -> Result<(), ConfigError> {
+    if !(association.velocity_weight_s.is_finite() && association.velocity_weight_s >= 0.0) {
+        return Err(invalid("association.velocity_weight_s", "must be a finite number >= 0"));
+    }
+    if !(association.velocity_cap_mps.is_finite() && association.velocity_cap_mps >= 0.0) {
+        return Err(invalid("association.velocity_cap_mps", "must be a finite number >= 0"));
+    }
+    Ok(())
+}
+
+/// The `tracker` and `predictor` sections; the deadline is checked between the frame interval
+/// and the coast times, so that the first offending key named stays what it was.
+fn validate_tracker_and_predictor(
+    tracker: &TrackerConfig,
+    predictor: &PredictorConfig,
+) -> Result<(), ConfigError> {
+    positive("tracker.max_frame_interval_s", tracker.max_frame_interval_s)?;
+    positive("predictor.deadline_ms", predictor.deadline_ms)?;
+    if predictor.deadline_ms > 1000.0 {
+        return Err(invalid("predictor.deadline_ms", "must be at most 1000 ms (one second)"));
+    }
+    positive("tracker.max_coast_s", tracker.max_coast_s)?;
+    positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
+    if tracker.confirmation_hits == 0 {
+        return Err(invalid("tracker.confirmation_hits", "must be at least 1"));
+    }
+    Ok(())
+}
+
+/// The section `classes.<class>`.
+fn validate_class(class: ObjectClass, section: &ClassConfig) -> Result<(), ConfigError> {
+    let key = |name: &str| format!("classes.{}.{}", class.name(), name);
+    positive(&key("gate_m"), section.gate_m)?;
+    covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
+    positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
+    positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
+    positive(
+        &key("constant_velocity.acceleration_psd_m2_per_s3"),
+        section.constant_velocity.acceleration_psd_m2_per_s3,
+    )?;
+    positive(
+        &key("constant_acceleration.jerk_psd_m2_per_s5"),
+        section.constant_acceleration.jerk_psd_m2_per_s5,
+    )?;
+    positive(
+        &key("constant_acceleration.initial_acceleration_std_mps2"),
+        section.constant_acceleration.initial_acceleration_std_mps2,
+    )?;
+    positive(
+        &key("coordinated_turn.acceleration_psd_m2_per_s3"),
+        section.coordinated_turn.acceleration_psd_m2_per_s3,
+    )?;
+    positive(
+        &key("coordinated_turn.turn_rate_psd_rad2_per_s3"),
+        section.coordinated_turn.turn_rate_psd_rad2_per_s3,
+    )?;
+    positive(
+        &key("coordinated_turn.initial_turn_rate_std_radps"),
+        section.coordinated_turn.initial_turn_rate_std_radps,
+    )?;
+    covariance(&key("learned.process_noise_covariance_m2"), &section.learned.process_noise_covariance_m2)?;
+    covariance(
+        &key("learned.measurement_noise_covariance_m2"),
+        &section.learned.measurement_noise_covariance_m2,
+    )?;
+    Ok(())
 }
 
 #[cfg(test)]
