@@ -69,7 +69,7 @@ fn scene(count: usize, frames: usize, seed: u64) -> Vec<Frame> {
 /// Times the stages with the monotonic clock.
 struct StageClock {
     last: Instant,
-    stages: [u64; Stage::COUNT],
+    stages: [u64; Stage::TRACKER_COUNT],
 }
 
 impl StageObserver for StageClock {
@@ -109,10 +109,10 @@ fn run<P: DisplacementPredictor>(method: Method, predictor: P, count: usize, fra
     let mut tracker = Tracker::with_predictor(config, predictor).unwrap();
     let scene = scene(count, WARM_UP_FRAMES + frames, 7 + count as u64);
     let mut step = histogram();
-    let mut stages: Vec<Histogram<u64>> = (0..Stage::COUNT).map(|_| histogram()).collect();
+    let mut stages: Vec<Histogram<u64>> = (0..Stage::TRACKER_COUNT).map(|_| histogram()).collect();
     let mut emitted = 0usize;
     for (k, frame) in scene.iter().enumerate() {
-        let mut clock = StageClock { last: Instant::now(), stages: [0; Stage::COUNT] };
+        let mut clock = StageClock { last: Instant::now(), stages: [0; Stage::TRACKER_COUNT] };
         let start = clock.last;
         let summary = tracker.step_observed(frame, &mut clock, |_| {}).unwrap();
         let elapsed = start.elapsed().as_nanos() as u64;
@@ -134,7 +134,7 @@ fn run<P: DisplacementPredictor>(method: Method, predictor: P, count: usize, fra
         step_p99_us: us(step.value_at_quantile(0.99)),
         step_max_us: us(step.max()),
         per_object_p50_us: us(step.value_at_quantile(0.5)) / count as f64,
-        stage_p50_us: Stage::ALL
+        stage_p50_us: Stage::TRACKER
             .iter()
             .map(|stage| (stage.name().to_string(), us(stages[stage.index()].value_at_quantile(0.5))))
             .collect(),
@@ -144,7 +144,7 @@ fn run<P: DisplacementPredictor>(method: Method, predictor: P, count: usize, fra
 
 fn table(rows: &[Row]) -> String {
     let mut out = String::new();
-    let stage_names: Vec<&str> = Stage::ALL.iter().map(|s| s.name()).collect();
+    let stage_names: Vec<&str> = Stage::TRACKER.iter().map(|s| s.name()).collect();
     writeln!(
         out,
         "| method | objects | tracks | frames | step p50 µs | p90 µs | p99 µs | max µs | p50 µs/object | {} (p50 µs) | PR missing |",

@@ -3,13 +3,13 @@
 
 use hdrhistogram::Histogram;
 use primm_core::stage_timing::{Stage, StageObserver};
-use primm_wire::{LatencyReport, LatencyStage, StageLatency, STAGE_CAPACITY};
+use primm_wire::{LatencyReport, StageLatency, STAGE_CAPACITY};
 use std::fmt::Write as _;
 
 /// Highest latency a histogram records exactly, ns; larger values are clamped to it.
 pub const MAX_TRACKABLE_NS: u64 = 60_000_000_000;
 
-/// One histogram per [`LatencyStage`], allocated once.
+/// One histogram per [`Stage`], allocated once.
 #[derive(Debug, Clone)]
 pub struct LatencyHistograms {
     stages: Vec<Histogram<u64>>,
@@ -24,7 +24,7 @@ impl Default for LatencyHistograms {
 impl LatencyHistograms {
     /// Empty histograms.
     pub fn new() -> Self {
-        let stages = LatencyStage::ALL
+        let stages = Stage::ALL
             .iter()
             .map(|_| Histogram::new_with_bounds(1, MAX_TRACKABLE_NS, 3).expect("valid histogram bounds"))
             .collect();
@@ -33,34 +33,34 @@ impl LatencyHistograms {
 
     /// Records one latency (clamped into the trackable range; never allocates).
     #[inline]
-    pub fn record(&mut self, stage: LatencyStage, latency_ns: u64) {
+    pub fn record(&mut self, stage: Stage, latency_ns: u64) {
         self.stages[stage.index()].saturating_record(latency_ns.max(1));
     }
 
     /// The histogram of `stage`.
-    pub fn histogram(&self, stage: LatencyStage) -> &Histogram<u64> {
+    pub fn histogram(&self, stage: Stage) -> &Histogram<u64> {
         &self.stages[stage.index()]
     }
 
     /// The percentiles of `stage`.
-    pub fn summary(&self, stage: LatencyStage) -> StageLatency {
+    pub fn summary(&self, stage: Stage) -> StageLatency {
         summarise(stage.name(), self.histogram(stage))
     }
 
     /// Writes every stage's percentiles into `report.stages` (allocation-free).
     pub fn fill_report(&self, report: &mut LatencyReport) {
-        for stage in LatencyStage::ALL {
+        for stage in Stage::ALL {
             report.stages[stage.index()] = self.summary(stage);
         }
-        for slot in &mut report.stages[LatencyStage::COUNT..STAGE_CAPACITY] {
+        for slot in &mut report.stages[Stage::COUNT..STAGE_CAPACITY] {
             *slot = StageLatency::named("");
         }
-        report.stage_count = LatencyStage::COUNT as u32;
+        report.stage_count = Stage::COUNT as u32;
     }
 
     /// A text table of every stage with samples.
     pub fn table(&self) -> String {
-        let rows: Vec<StageLatency> = LatencyStage::ALL.iter().map(|&stage| self.summary(stage)).collect();
+        let rows: Vec<StageLatency> = Stage::ALL.iter().map(|&stage| self.summary(stage)).collect();
         format_table(&rows)
     }
 }
@@ -150,7 +150,7 @@ impl StageObserver for StageTimer<'_> {
     #[inline]
     fn stage_finished(&mut self, stage: Stage) {
         let now = super::clock::monotonic_ns();
-        self.histograms.record(LatencyStage::of_tracker_stage(stage), now.saturating_sub(self.last_ns));
+        self.histograms.record(stage, now.saturating_sub(self.last_ns));
         self.last_ns = now;
     }
 }
@@ -163,24 +163,24 @@ mod tests {
     fn percentiles_of_known_samples() {
         let mut histograms = LatencyHistograms::new();
         for value in 1..=1000u64 {
-            histograms.record(LatencyStage::Associate, value * 1000);
+            histograms.record(Stage::Associate, value * 1000);
         }
-        let summary = histograms.summary(LatencyStage::Associate);
+        let summary = histograms.summary(Stage::Associate);
         assert_eq!(summary.name_str(), "associate");
         assert_eq!(summary.count, 1000);
         // 3 significant digits: within 0.1 %.
         assert!((summary.p50_ns as f64 - 500_000.0).abs() <= 500.0, "{}", summary.p50_ns);
         assert!((summary.p99_ns as f64 - 990_000.0).abs() <= 990.0, "{}", summary.p99_ns);
         assert!((summary.max_ns as f64 - 1_000_000.0).abs() <= 1000.0, "{}", summary.max_ns);
-        assert_eq!(histograms.summary(LatencyStage::Validate).count, 0);
+        assert_eq!(histograms.summary(Stage::Validate).count, 0);
     }
 
     #[test]
     fn values_beyond_the_range_are_clamped_not_lost() {
         let mut histograms = LatencyHistograms::new();
-        histograms.record(LatencyStage::EndToEnd, u64::MAX);
-        histograms.record(LatencyStage::EndToEnd, 0);
-        let summary = histograms.summary(LatencyStage::EndToEnd);
+        histograms.record(Stage::EndToEnd, u64::MAX);
+        histograms.record(Stage::EndToEnd, 0);
+        let summary = histograms.summary(Stage::EndToEnd);
         assert_eq!(summary.count, 2);
         assert!(summary.max_ns >= MAX_TRACKABLE_NS);
     }
@@ -188,7 +188,7 @@ mod tests {
     #[test]
     fn the_table_lists_only_stages_with_samples() {
         let mut histograms = LatencyHistograms::new();
-        histograms.record(LatencyStage::Update, 2_500);
+        histograms.record(Stage::Update, 2_500);
         let table = histograms.table();
         assert!(table.contains("update"), "{table}");
         assert!(!table.contains("validate"), "{table}");

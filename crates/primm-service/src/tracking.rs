@@ -31,10 +31,11 @@ use iceoryx2::port::update_connections::ConnectionFailure;
 use iceoryx2::port::ReceiveError;
 use iceoryx2::sample::Sample;
 use primm_core::predictor::DisplacementPredictor;
+use primm_core::stage_timing::Stage;
 use primm_core::tracker::{StepError, Tracker};
 use primm_core::validation::FrameError;
 use primm_wire::{
-    FrameStatus, LatencyReport, LatencyStage, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
+    FrameStatus, LatencyReport, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
     TrackFrameWriter, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, STAGE_CAPACITY,
     TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
 };
@@ -330,10 +331,10 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 }
             }
             let done_ns = monotonic_ns();
-            self.histograms.record(LatencyStage::Publish, done_ns.saturating_sub(publish_start));
-            self.histograms.record(LatencyStage::ReceiveToPublish, done_ns.saturating_sub(receive_ns));
+            self.histograms.record(Stage::Publish, done_ns.saturating_sub(publish_start));
+            self.histograms.record(Stage::ReceiveToPublish, done_ns.saturating_sub(receive_ns));
             if header.input_publish_time_ns != 0 && header.input_publish_time_ns <= publish_start {
-                self.histograms.record(LatencyStage::EndToEnd, publish_start - header.input_publish_time_ns);
+                self.histograms.record(Stage::EndToEnd, publish_start - header.input_publish_time_ns);
             }
         }
 

@@ -9,80 +9,7 @@ pub const STAGE_NAME_LEN: usize = 24;
 /// Number of stage slots in a [`LatencyReport`].
 pub const STAGE_CAPACITY: usize = 12;
 
-/// The latencies the service measures, in report order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[repr(u8)]
-pub enum LatencyStage {
-    /// Tracker stage [`Stage::Validate`].
-    Validate = 0,
-    /// Tracker stage [`Stage::Predict`]: mixing and physics predictions.
-    Predict = 1,
-    /// Tracker stage [`Stage::LearnedWait`]: waiting for the learned predictor, prior fusion.
-    LearnedWait = 2,
-    /// Tracker stage [`Stage::Associate`].
-    Associate = 3,
-    /// Tracker stage [`Stage::Update`].
-    Update = 4,
-    /// Tracker stage [`Stage::Report`]: writing the tracks into the loaned sample.
-    Report = 5,
-    /// Sending the track frame and notifying its listeners.
-    Publish = 6,
-    /// From taking the input sample to the track frame sent.
-    ReceiveToPublish = 7,
-    /// From the publisher's send of the input frame to the tracker's send of its track frame
-    /// (same host, `CLOCK_MONOTONIC`).
-    EndToEnd = 8,
-}
-
-impl LatencyStage {
-    /// Number of measured stages.
-    pub const COUNT: usize = 9;
-    /// All stages in report order.
-    pub const ALL: [LatencyStage; Self::COUNT] = [
-        Self::Validate,
-        Self::Predict,
-        Self::LearnedWait,
-        Self::Associate,
-        Self::Update,
-        Self::Report,
-        Self::Publish,
-        Self::ReceiveToPublish,
-        Self::EndToEnd,
-    ];
-
-    /// Index in per-stage tables.
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    /// Name in reports and tables.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Validate => "validate",
-            Self::Predict => "predict",
-            Self::LearnedWait => "learned_wait",
-            Self::Associate => "associate",
-            Self::Update => "update",
-            Self::Report => "report",
-            Self::Publish => "publish",
-            Self::ReceiveToPublish => "receive_to_publish",
-            Self::EndToEnd => "end_to_end",
-        }
-    }
-
-    /// The service stage of a tracker stage.
-    pub fn of_tracker_stage(stage: Stage) -> Self {
-        match stage {
-            Stage::Validate => Self::Validate,
-            Stage::Predict => Self::Predict,
-            Stage::LearnedWait => Self::LearnedWait,
-            Stage::Associate => Self::Associate,
-            Stage::Update => Self::Update,
-            Stage::Report => Self::Report,
-        }
-    }
-}
-const _: () = assert!(LatencyStage::COUNT <= STAGE_CAPACITY);
+const _: () = assert!(Stage::COUNT <= STAGE_CAPACITY);
 
 /// Percentiles of one stage's latency: 80 bytes, alignment 8.
 #[repr(C)]
@@ -148,7 +75,7 @@ pub struct LatencyReport {
     pub stage_count: u32,
     /// Explicit padding, written as zero.
     pub _pad0: [u8; 4],
-    /// Per-stage latencies, in [`LatencyStage`] order.
+    /// Per-stage latencies, entry `i` for the [`Stage`] of index `i` (its name in the entry).
     pub stages: [StageLatency; STAGE_CAPACITY],
 }
 

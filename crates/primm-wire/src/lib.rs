@@ -57,7 +57,7 @@ mod latency_report;
 mod measurement_frame;
 mod track_frame;
 
-pub use latency_report::{LatencyReport, LatencyStage, StageLatency, STAGE_CAPACITY, STAGE_NAME_LEN};
+pub use latency_report::{LatencyReport, StageLatency, STAGE_CAPACITY, STAGE_NAME_LEN};
 pub use measurement_frame::{
     FrameFull, MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, WireMeasurement,
     FRAME_FLAG_EGO_VALID, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, GROUND_TRUTH_UNKNOWN,
