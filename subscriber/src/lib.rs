@@ -27,7 +27,7 @@ pub mod accuracy;
 pub mod track_csv;
 
 use crate::accuracy::{AccuracyMonitor, AccuracySummary};
-use crate::track_csv::TrackCsvWriter;
+use crate::track_csv::write_track_frame;
 use hdrhistogram::Histogram;
 use iceoryx2::port::ReceiveError;
 use iceoryx2::prelude::{CallbackProgression, SignalHandlingMode, WaitSetBuilder};
@@ -37,6 +37,7 @@ use primm_service::catalog::{self, Ipc, SERVICE_PREFIX_ENV};
 use primm_service::clock::monotonic_ns;
 use primm_service::latency::{format_table, summarise, MAX_TRACKABLE_NS};
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
+use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_wire::{
     FrameStatus, LatencyReport, StageLatency, TrackFrame, WireTrack, TRACK_FLAG_STREAM_END,
     TRACK_FLAG_TRACKER_RESET,
@@ -301,7 +302,7 @@ impl Viewer {
             accuracy.add_tracks(frame);
         }
         if let Some((path, csv)) = &mut self.csv {
-            csv.write_frame(frame)
+            write_track_frame(csv, frame)
                 .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
             self.summary.csv_rows = csv.rows();
         }

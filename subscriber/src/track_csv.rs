@@ -1,55 +1,99 @@
-//! Track frames received from the service written in the track file format of
-//! [`primm_sim::io::track_csv`].
+//! Track frames received from the service as rows of the track file format of
+//! [`primm_sim::io::track_csv`], written by its [`TrackCsvWriter`].
 
 use primm_core::measurement::ObjectClass;
-use primm_sim::io::track_csv::{TrackCsvWriter as RowWriter, TrackRow};
+use primm_sim::io::track_csv::{TrackCsvWriter, TrackRow};
 use primm_wire::{FrameStatus, TrackFrame};
 use std::io::Write;
 
-/// Writes received track frames as track CSV rows.
-#[derive(Debug)]
-pub struct TrackCsvWriter<W: Write> {
-    rows: RowWriter<W>,
+/// Writes the rows of one received track frame to `csv`: one per track updated by a measurement,
+/// none for a rejected frame.
+pub fn write_track_frame<W: Write>(csv: &mut TrackCsvWriter<W>, frame: &TrackFrame) -> std::io::Result<()> {
+    if frame.frame_status() != Some(FrameStatus::Tracked) {
+        return Ok(());
+    }
+    for track in frame.valid_tracks().iter().filter(|track| track.measurement_index().is_some()) {
+        let class_code = track.class_code.to_string();
+        let class = match ObjectClass::from_code(track.class_code) {
+            Some(class) => class.name(),
+            None => class_code.as_str(),
+        };
+        csv.write(&TrackRow {
+            frame: frame.source_frame,
+            timestamp_s: frame.sensor_timestamp_s,
+            track_id: track.id,
+            class,
+            position_m: [track.x_m, track.y_m],
+            prior_position_m: track.prior_m(),
+            ground_truth_id: u64::try_from(track.gt_id).ok(),
+            mode_probabilities: track.mode_probabilities,
+        })?;
+    }
+    Ok(())
 }
 
-impl<W: Write> TrackCsvWriter<W> {
-    /// A writer that has written the header.
-    pub fn new(output: W) -> std::io::Result<Self> {
-        Ok(Self { rows: RowWriter::new(output)? })
-    }
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use primm_core::config::Config;
+    use primm_core::measurement::{Frame, Measurement};
+    use primm_core::tracker::Tracker;
+    use primm_wire::{TrackFrameHeader, TrackFrameWriter};
+    use std::mem::MaybeUninit;
 
-    /// Writes the rows of one frame (none for a rejected frame).
-    pub fn write_frame(&mut self, frame: &TrackFrame) -> std::io::Result<()> {
-        if frame.frame_status() != Some(FrameStatus::Tracked) {
-            return Ok(());
+    fn header(frame: u64, timestamp_s: f64, status: FrameStatus) -> TrackFrameHeader {
+        TrackFrameHeader {
+            input_sequence: frame,
+            source_frame: frame,
+            sensor_timestamp_s: timestamp_s,
+            input_publish_time_ns: 0,
+            receive_time_ns: 0,
+            publish_time_ns: 0,
+            status,
+            flags: 0,
+            measurements_accepted: 0,
+            measurements_rejected: 0,
         }
-        for track in frame.valid_tracks().iter().filter(|track| track.measurement_index().is_some()) {
-            let class_code = track.class_code.to_string();
-            let class = match ObjectClass::from_code(track.class_code) {
-                Some(class) => class.name(),
-                None => class_code.as_str(),
-            };
-            self.rows.write(&TrackRow {
-                frame: frame.source_frame,
-                timestamp_s: frame.sensor_timestamp_s,
-                track_id: track.id,
-                class,
-                position_m: [track.x_m, track.y_m],
-                prior_position_m: track.prior_m(),
-                ground_truth_id: u64::try_from(track.gt_id).ok(),
-                mode_probabilities: track.mode_probabilities,
-            })?;
+    }
+
+    #[test]
+    fn a_received_frame_gives_the_bytes_of_the_offline_writer_and_a_rejected_one_none() {
+        let mut tracker = Tracker::new(Config::default()).unwrap();
+        let mut offline = TrackCsvWriter::new(Vec::new()).unwrap();
+        let mut received = TrackCsvWriter::new(Vec::new()).unwrap();
+        let mut sample: Box<MaybeUninit<TrackFrame>> = Box::new_zeroed();
+        for index in 0..30u64 {
+            let t = index as f64 * 0.05;
+            let mut frame = Frame::new(t);
+            for (j, class) in [ObjectClass::Car, ObjectClass::Pedestrian].into_iter().enumerate() {
+                // The pedestrian is missed every third frame, so its track coasts (no row).
+                if j == 1 && index % 3 == 2 {
+                    continue;
+                }
+                frame.measurements.push(Measurement {
+                    x_m: 10.0 + 20.0 * j as f64 + 8.0 * t,
+                    y_m: -2.0 + 4.0 * j as f64 + 0.3 * t * t,
+                    radial_velocity_mps: 7.5,
+                    rcs_dbsm: 3.0,
+                    class,
+                    sensor_id: Some(1),
+                    ground_truth_id: (j == 0).then_some(40),
+                });
+            }
+            let outputs = tracker.step(&frame).unwrap();
+            offline.write_frame(index, t, outputs).unwrap();
+            let mut writer = TrackFrameWriter::new(&mut sample);
+            outputs.iter().for_each(|output| writer.push(output));
+            writer.finish(&header(index, t, FrameStatus::Tracked));
+            // SAFETY: zeroed, then header and tracks written; every field is plain data.
+            write_track_frame(&mut received, unsafe { sample.assume_init_ref() }).unwrap();
         }
-        Ok(())
-    }
-
-    /// Rows written.
-    pub fn rows(&self) -> u64 {
-        self.rows.rows()
-    }
-
-    /// Flushes the output.
-    pub fn flush(&mut self) -> std::io::Result<()> {
-        self.rows.flush()
+        let rows = received.rows();
+        assert!(rows > 40, "{rows} rows");
+        TrackFrameWriter::new(&mut sample).finish(&header(99, 9.9, FrameStatus::RejectedNonFiniteTimestamp));
+        // SAFETY: as above.
+        write_track_frame(&mut received, unsafe { sample.assume_init_ref() }).unwrap();
+        assert_eq!(received.rows(), rows);
+        assert_eq!(received.finish().unwrap(), offline.finish().unwrap());
     }
 }
