@@ -154,52 +154,75 @@ pub fn run(args: Args) -> Result<(), DemoError> {
     let prefix = format!("primm-demo-{}", std::process::id());
     let names = ServiceNames::new(&prefix);
     let summary_path: PathBuf = std::env::temp_dir().join(format!("{prefix}-summary.json"));
-    let quiet_logs = |command: &mut Command| {
-        command.env("RUST_LOG", std::env::var("RUST_LOG").unwrap_or_else(|_| "warn".to_owned()));
-    };
 
     println!(
         "primm demo: {:.0} s scenario (seed {}) replayed at {}x; tracker method {}; services under '{prefix}/'",
         args.duration_s, args.seed, args.speed, args.method
     );
-    let mut serve_command = Command::new(&exe);
-    serve_command
-        .args(["serve", "--service-prefix", &prefix, "--method", args.method.id(), "--latency-every", "50"])
-        .stdout(Stdio::piped());
-    if args.busy_poll {
-        serve_command.arg("--busy-poll");
-    }
-    quiet_logs(&mut serve_command);
-    let mut tracker = Managed::spawn("the tracker (primm serve)", &mut serve_command)?;
-
-    let mut subscriber_command = companion(&exe, "primm-subscriber", "subscribe");
-    subscriber_command
-        .args(["--service-prefix", &prefix, "--until-end", "--quiet", "--idle-timeout-s", "60", "--json"])
-        .arg(&summary_path)
-        .stdout(Stdio::piped());
-    if args.busy_poll {
-        subscriber_command.arg("--busy-poll");
-    }
-    quiet_logs(&mut subscriber_command);
-    let mut subscriber = Managed::spawn("the subscriber", &mut subscriber_command)?;
-
+    let mut tracker = spawn_tracker(&exe, &prefix, &args)?;
+    let mut subscriber = spawn_subscriber(&exe, &prefix, &summary_path, &args)?;
     // Start the publisher once the tracker serves and the subscriber listens, so that no frame
     // and no answer is missed.
-    let node = catalog::create_node("primm-demo")?;
-    let tracks = catalog::tracks(&node, &names)?;
-    let ready_deadline = Instant::now() + Duration::from_secs(30);
-    while tracks.publisher_count() == 0 || tracks.subscriber_count() == 0 {
-        if !tracker.is_running() || !subscriber.is_running() || Instant::now() >= ready_deadline {
-            let what = if !tracker.is_running() { tracker.what } else { subscriber.what };
-            return Err(DemoError::Timeout { what, event: "come up", seconds: 30 });
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    wait_until_connected(&names, &mut tracker, &mut subscriber)?;
+    let publisher = spawn_publisher(&exe, &prefix, &args)?;
+    let replay_s = args.duration_s / args.speed.max(1e-3);
+    let (subscriber_output, tracker_output) = wait_for_the_end(publisher, subscriber, tracker, replay_s)?;
 
-    let mut publisher_command = companion(&exe, "primm-publisher", "publish");
-    publisher_command.args([
+    println!("\n== subscriber (primm-subscriber) ==\n{subscriber_output}");
+    println!("== tracker (primm serve) ==\n{tracker_output}");
+    let complete = stream_end_seen(&summary_path);
+    let _ = std::fs::remove_file(&summary_path);
+    if !complete {
+        return Err(DemoError::Incomplete);
+    }
+    println!("demo finished: every frame tracked and answered over shared memory");
+    Ok(())
+}
+
+/// Logs of the child processes: warnings only, unless `RUST_LOG` says otherwise.
+fn quiet_logs(command: &mut Command) {
+    command.env("RUST_LOG", std::env::var("RUST_LOG").unwrap_or_else(|_| "warn".to_owned()));
+}
+
+/// Starts `primm serve` under `prefix`, its output captured.
+fn spawn_tracker(exe: &Path, prefix: &str, args: &Args) -> Result<Managed, DemoError> {
+    let mut command = Command::new(exe);
+    command
+        .args(["serve", "--service-prefix", prefix, "--method", args.method.id(), "--latency-every", "50"])
+        .stdout(Stdio::piped());
+    if args.busy_poll {
+        command.arg("--busy-poll");
+    }
+    quiet_logs(&mut command);
+    Managed::spawn("the tracker (primm serve)", &mut command)
+}
+
+/// Starts the subscriber under `prefix` until the end of the replay, its output captured and
+/// its JSON summary written to `summary_path`.
+fn spawn_subscriber(
+    exe: &Path,
+    prefix: &str,
+    summary_path: &Path,
+    args: &Args,
+) -> Result<Managed, DemoError> {
+    let mut command = companion(exe, "primm-subscriber", "subscribe");
+    command
+        .args(["--service-prefix", prefix, "--until-end", "--quiet", "--idle-timeout-s", "60", "--json"])
+        .arg(summary_path)
+        .stdout(Stdio::piped());
+    if args.busy_poll {
+        command.arg("--busy-poll");
+    }
+    quiet_logs(&mut command);
+    Managed::spawn("the subscriber", &mut command)
+}
+
+/// Starts the publisher replaying the built-in scenario under `prefix`.
+fn spawn_publisher(exe: &Path, prefix: &str, args: &Args) -> Result<Managed, DemoError> {
+    let mut command = companion(exe, "primm-publisher", "publish");
+    command.args([
         "--service-prefix",
-        &prefix,
+        prefix,
         "--scenario",
         "--seed",
         &args.seed.to_string(),
@@ -208,9 +231,39 @@ pub fn run(args: Args) -> Result<(), DemoError> {
         "--speed",
         &args.speed.to_string(),
     ]);
-    quiet_logs(&mut publisher_command);
-    let publisher = Managed::spawn("the publisher", &mut publisher_command)?;
-    let replay_s = args.duration_s / args.speed.max(1e-3);
+    quiet_logs(&mut command);
+    Managed::spawn("the publisher", &mut command)
+}
+
+/// Waits up to 30 s until the tracker publishes and the subscriber subscribes to the tracks of
+/// `names`.
+fn wait_until_connected(
+    names: &ServiceNames,
+    tracker: &mut Managed,
+    subscriber: &mut Managed,
+) -> Result<(), DemoError> {
+    let node = catalog::create_node("primm-demo")?;
+    let tracks = catalog::tracks(&node, names)?;
+    let ready_deadline = Instant::now() + Duration::from_secs(30);
+    while tracks.publisher_count() == 0 || tracks.subscriber_count() == 0 {
+        if !tracker.is_running() || !subscriber.is_running() || Instant::now() >= ready_deadline {
+            let what = if !tracker.is_running() { tracker.what } else { subscriber.what };
+            return Err(DemoError::Timeout { what, event: "come up", seconds: 30 });
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Ok(())
+}
+
+/// Waits for the publisher to finish its replay (`replay_s` plus a minute), the subscriber to see
+/// its end, and the tracker to stop when interrupted. Returns the subscriber's and the tracker's
+/// output.
+fn wait_for_the_end(
+    publisher: Managed,
+    subscriber: Managed,
+    tracker: Managed,
+    replay_s: f64,
+) -> Result<(String, String), DemoError> {
     let (status, _) = publisher.wait(Duration::from_secs_f64(replay_s + 60.0))?;
     if !status.success() {
         return Err(DemoError::Failed { what: "the publisher", status, output: String::new() });
@@ -232,18 +285,14 @@ pub fn run(args: Args) -> Result<(), DemoError> {
             output: format!(":\n{tracker_output}"),
         });
     }
+    Ok((subscriber_output, tracker_output))
+}
 
-    println!("\n== subscriber (primm-subscriber) ==\n{subscriber_output}");
-    println!("== tracker (primm serve) ==\n{tracker_output}");
-    let complete = std::fs::read_to_string(&summary_path)
+/// Whether the subscriber's JSON summary at `path` says it saw the end of the stream.
+fn stream_end_seen(path: &Path) -> bool {
+    std::fs::read_to_string(path)
         .ok()
         .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
         .and_then(|json| json.get("stream_end_seen").and_then(serde_json::Value::as_bool))
-        .unwrap_or(false);
-    let _ = std::fs::remove_file(&summary_path);
-    if !complete {
-        return Err(DemoError::Incomplete);
-    }
-    println!("demo finished: every frame tracked and answered over shared memory");
-    Ok(())
+        .unwrap_or(false)
 }

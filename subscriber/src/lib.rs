@@ -29,9 +29,12 @@ pub mod track_csv;
 use crate::accuracy::{AccuracyMonitor, AccuracySummary};
 use crate::track_csv::write_track_frame;
 use hdrhistogram::Histogram;
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::ReceiveError;
 use iceoryx2::prelude::{CallbackProgression, SignalHandlingMode, WaitSetBuilder};
-use iceoryx2::waitset::{WaitSetAttachmentError, WaitSetCreateError, WaitSetRunError};
+use iceoryx2::waitset::{WaitSet, WaitSetAttachmentError, WaitSetCreateError, WaitSetGuard, WaitSetRunError};
 use primm_core::measurement::ObjectClass;
 use primm_service::catalog::{self, Ipc, SERVICE_PREFIX_ENV};
 use primm_service::clock::monotonic_ns;
@@ -39,7 +42,7 @@ use primm_service::latency::{format_table, summarise, MAX_TRACKABLE_NS};
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_wire::{
-    FrameStatus, LatencyReport, StageLatency, TrackFrame, WireTrack, TRACK_FLAG_STREAM_END,
+    FrameStatus, LatencyReport, MeasurementFrame, StageLatency, TrackFrame, WireTrack, TRACK_FLAG_STREAM_END,
     TRACK_FLAG_TRACKER_RESET,
 };
 use std::io::{IsTerminal, Write};
@@ -257,7 +260,7 @@ impl SubscriberSummary {
 struct Viewer {
     summary: SubscriberSummary,
     accuracy: Option<AccuracyMonitor>,
-    csv: Option<(PathBuf, TrackCsvWriter<std::io::BufWriter<std::fs::File>>)>,
+    csv: Option<CsvOutput>,
     delivery: Histogram<u64>,
     end_to_end: Histogram<u64>,
     last_sequence: Option<u64>,
@@ -268,6 +271,38 @@ struct Viewer {
 }
 
 impl Viewer {
+    fn new(args: &Args, truth: bool, csv: Option<CsvOutput>) -> Self {
+        Self {
+            summary: SubscriberSummary::default(),
+            accuracy: truth.then(AccuracyMonitor::new),
+            csv,
+            delivery: histogram(),
+            end_to_end: histogram(),
+            last_sequence: None,
+            last_report: None,
+            live: !args.quiet && std::io::stdout().is_terminal(),
+            last_draw: Instant::now(),
+            last_frame_at: Instant::now(),
+        }
+    }
+
+    /// Without the live view (and unless `--quiet`), a progress line on stderr every second.
+    fn report_progress(&mut self, args: &Args) {
+        if !self.live
+            && !args.quiet
+            && self.summary.track_frames > 0
+            && self.last_draw.elapsed() >= Duration::from_secs(1)
+        {
+            eprintln!(
+                "track frames {} (rejected {}), confirmed tracks {}",
+                self.summary.track_frames,
+                self.summary.frames_rejected,
+                self.summary.confirmed_tracks_last_frame
+            );
+            self.last_draw = Instant::now();
+        }
+    }
+
     fn on_tracks(&mut self, frame: &TrackFrame) -> Result<(), SubscribeError> {
         let now_ns = monotonic_ns();
         self.last_frame_at = Instant::now();
@@ -408,40 +443,8 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
     let shutdown = ShutdownFlag::on_signals().map_err(SubscribeError::Signals)?;
     let names = ServiceNames::new(&args.service_prefix);
     let node = catalog::create_node("primm-subscriber")?;
-    let tracks = catalog::tracks(&node, &names)?;
-    let latency = catalog::latency(&node, &names)?;
-    let track_subscriber = tracks.subscriber()?;
-    let track_listener = tracks.listener()?;
-    let latency_subscriber = latency.subscriber()?;
-    let latency_listener = latency.listener()?;
-    let truth = if args.no_truth {
-        None
-    } else {
-        let measurements = catalog::measurements(&node, &names)?;
-        Some((measurements.subscriber()?, measurements.listener()?))
-    };
-    let csv = match &args.csv {
-        Some(path) => {
-            let file = std::fs::File::create(path)
-                .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
-            let writer = TrackCsvWriter::new(std::io::BufWriter::new(file))
-                .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
-            Some((path.clone(), writer))
-        }
-        None => None,
-    };
-    let mut viewer = Viewer {
-        summary: SubscriberSummary::default(),
-        accuracy: truth.as_ref().map(|_| AccuracyMonitor::new()),
-        csv,
-        delivery: histogram(),
-        end_to_end: histogram(),
-        last_sequence: None,
-        last_report: None,
-        live: !args.quiet && std::io::stdout().is_terminal(),
-        last_draw: Instant::now(),
-        last_frame_at: Instant::now(),
-    };
+    let ports = Ports::open(&node, &names, !args.no_truth)?;
+    let mut viewer = Viewer::new(args, ports.truth.is_some(), open_csv(args)?);
     let waitset = WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<Ipc>()
@@ -449,11 +452,8 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
     let mut guards = Vec::new();
     let mut tick = None;
     if !args.busy_poll {
-        guards.push(waitset.attach_notification(&track_listener).map_err(SubscribeError::WaitSetAttach)?);
-        guards.push(waitset.attach_notification(&latency_listener).map_err(SubscribeError::WaitSetAttach)?);
-        if let Some((_, listener)) = &truth {
-            guards.push(waitset.attach_notification(listener).map_err(SubscribeError::WaitSetAttach)?);
-        }
+        guards = ports.attach(&waitset)?;
+        // For the view and time-outs.
         tick =
             Some(waitset.attach_interval(Duration::from_millis(200)).map_err(SubscribeError::WaitSetAttach)?);
     }
@@ -462,27 +462,111 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
         if args.busy_poll {
             std::hint::spin_loop();
         } else {
-            waitset
-                .wait_and_process_once_with_timeout(
-                    |_| CallbackProgression::Continue,
-                    Duration::from_millis(200),
-                )
-                .map_err(SubscribeError::WaitSetRun)?;
-            // Consume the notifications; the data is read below.
-            let _ = track_listener.try_wait(|_| {});
-            let _ = latency_listener.try_wait(|_| {});
-            if let Some((_, listener)) = &truth {
-                let _ = listener.try_wait(|_| {});
-            }
+            ports.wait(&waitset)?;
         }
-        // Measurements first: a track frame's measurement frame was sent before it.
-        if let (Some((subscriber, _)), Some(accuracy)) = (&truth, viewer.accuracy.as_mut()) {
+        let done = ports.receive(&mut viewer, args)?;
+        viewer.report_progress(args);
+        if done
+            || shutdown.is_requested()
+            || idle_timeout.is_some_and(|timeout| viewer.last_frame_at.elapsed() >= timeout)
+        {
+            break;
+        }
+    }
+    ports.take_late_latency_report(&mut viewer)?;
+    drop(tick);
+    drop(guards);
+    viewer.finish()
+}
+
+/// The track CSV file of `--csv` and its writer.
+type CsvOutput = (PathBuf, TrackCsvWriter<std::io::BufWriter<std::fs::File>>);
+
+/// Creates the track CSV file of `--csv`, header written.
+fn open_csv(args: &Args) -> Result<Option<CsvOutput>, SubscribeError> {
+    let Some(path) = &args.csv else { return Ok(None) };
+    let file = std::fs::File::create(path)
+        .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+    let writer = TrackCsvWriter::new(std::io::BufWriter::new(file))
+        .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+    Ok(Some((path.clone(), writer)))
+}
+
+/// The subscriber's ports: tracks, latency reports and (for the accuracy view) measurements.
+struct Ports {
+    tracks: Subscriber<Ipc, TrackFrame, ()>,
+    track_listener: Listener<Ipc>,
+    latency: Subscriber<Ipc, LatencyReport, ()>,
+    latency_listener: Listener<Ipc>,
+    truth: Option<(Subscriber<Ipc, MeasurementFrame, ()>, Listener<Ipc>)>,
+}
+
+impl Ports {
+    /// Opens the streams and their ports; the measurements' only when `truth`.
+    fn open(node: &Node<Ipc>, names: &ServiceNames, truth: bool) -> Result<Self, SubscribeError> {
+        let tracks = catalog::tracks(node, names)?;
+        let latency = catalog::latency(node, names)?;
+        let track_subscriber = tracks.subscriber()?;
+        let track_listener = tracks.listener()?;
+        let latency_subscriber = latency.subscriber()?;
+        let latency_listener = latency.listener()?;
+        let truth = if truth {
+            let measurements = catalog::measurements(node, names)?;
+            Some((measurements.subscriber()?, measurements.listener()?))
+        } else {
+            None
+        };
+        Ok(Self {
+            tracks: track_subscriber,
+            track_listener,
+            latency: latency_subscriber,
+            latency_listener,
+            truth,
+        })
+    }
+
+    /// Attaches every listener to `waitset`.
+    fn attach<'w, 'a>(
+        &'a self,
+        waitset: &'w WaitSet<Ipc>,
+    ) -> Result<Vec<WaitSetGuard<'w, 'a, Ipc>>, SubscribeError> {
+        let mut guards = Vec::new();
+        guards
+            .push(waitset.attach_notification(&self.track_listener).map_err(SubscribeError::WaitSetAttach)?);
+        guards.push(
+            waitset.attach_notification(&self.latency_listener).map_err(SubscribeError::WaitSetAttach)?,
+        );
+        if let Some((_, listener)) = &self.truth {
+            guards.push(waitset.attach_notification(listener).map_err(SubscribeError::WaitSetAttach)?);
+        }
+        Ok(guards)
+    }
+
+    /// Sleeps in `waitset` until a notification or the tick, then consumes the notifications
+    /// (the data is read by [`receive`](Self::receive)).
+    fn wait(&self, waitset: &WaitSet<Ipc>) -> Result<(), SubscribeError> {
+        waitset
+            .wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, Duration::from_millis(200))
+            .map_err(SubscribeError::WaitSetRun)?;
+        let _ = self.track_listener.try_wait(|_| {});
+        let _ = self.latency_listener.try_wait(|_| {});
+        if let Some((_, listener)) = &self.truth {
+            let _ = listener.try_wait(|_| {});
+        }
+        Ok(())
+    }
+
+    /// Hands every waiting sample to `viewer`: measurements first (a track frame's measurement
+    /// frame was sent before it), then track frames, then latency reports. Returns whether the
+    /// subscriber is done (`--frames` reached, or the end of the stream with `--until-end`).
+    fn receive(&self, viewer: &mut Viewer, args: &Args) -> Result<bool, SubscribeError> {
+        if let (Some((subscriber, _)), Some(accuracy)) = (&self.truth, viewer.accuracy.as_mut()) {
             while let Some(sample) = subscriber.receive().map_err(SubscribeError::Receive)? {
                 accuracy.add_measurements(&sample);
             }
         }
         let mut done = false;
-        while let Some(sample) = track_subscriber.receive().map_err(SubscribeError::Receive)? {
+        while let Some(sample) = self.tracks.receive().map_err(SubscribeError::Receive)? {
             viewer.on_tracks(&sample)?;
             if args.frames.is_some_and(|limit| viewer.summary.track_frames >= limit)
                 || (args.until_end && sample.flags & TRACK_FLAG_STREAM_END != 0)
@@ -491,38 +575,22 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
                 break;
             }
         }
-        while let Some(sample) = latency_subscriber.receive().map_err(SubscribeError::Receive)? {
+        while let Some(sample) = self.latency.receive().map_err(SubscribeError::Receive)? {
             viewer.last_report = Some(*sample);
         }
-        if !viewer.live
-            && !args.quiet
-            && viewer.summary.track_frames > 0
-            && viewer.last_draw.elapsed() >= Duration::from_secs(1)
-        {
-            eprintln!(
-                "track frames {} (rejected {}), confirmed tracks {}",
-                viewer.summary.track_frames,
-                viewer.summary.frames_rejected,
-                viewer.summary.confirmed_tracks_last_frame
-            );
-            viewer.last_draw = Instant::now();
-        }
-        if done
-            || shutdown.is_requested()
-            || idle_timeout.is_some_and(|timeout| viewer.last_frame_at.elapsed() >= timeout)
-        {
-            break;
-        }
+        Ok(done)
     }
-    // The tracker may send its latency report right after the last frame: take it if it comes.
-    let deadline = Instant::now() + Duration::from_millis(100);
-    while Instant::now() < deadline {
-        match latency_subscriber.receive().map_err(SubscribeError::Receive)? {
-            Some(sample) => viewer.last_report = Some(*sample),
-            None => std::thread::sleep(Duration::from_millis(5)),
+
+    /// The tracker may send its latency report right after the last frame: takes it if it comes
+    /// within 100 ms.
+    fn take_late_latency_report(&self, viewer: &mut Viewer) -> Result<(), SubscribeError> {
+        let deadline = Instant::now() + Duration::from_millis(100);
+        while Instant::now() < deadline {
+            match self.latency.receive().map_err(SubscribeError::Receive)? {
+                Some(sample) => viewer.last_report = Some(*sample),
+                None => std::thread::sleep(Duration::from_millis(5)),
+            }
         }
+        Ok(())
     }
-    drop(tick);
-    drop(guards);
-    viewer.finish()
 }

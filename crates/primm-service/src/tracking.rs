@@ -30,15 +30,18 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::ConnectionFailure;
 use iceoryx2::port::ReceiveError;
 use iceoryx2::sample::Sample;
+use iceoryx2::sample_mut::SampleMut;
+use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::stage_timing::Stage;
-use primm_core::tracker::{StepError, Tracker};
+use primm_core::tracker::{StepError, StepSummary, Tracker};
 use primm_core::validation::FrameError;
 use primm_wire::{
     FrameStatus, LatencyReport, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
     TrackFrameWriter, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, STAGE_CAPACITY,
     TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
 };
+use std::mem::MaybeUninit;
 use std::time::{Duration, Instant};
 
 /// How the tracking loop waits for measurement frames.
@@ -236,7 +239,39 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         let frame: &MeasurementFrame = &sample;
         let mut flags = self.follow_stream(origin, frame);
 
-        let mut loan = match self.output.loan_uninit() {
+        let mut loan = self.loan_track_sample();
+        let mut writer = loan.as_mut().map(|loan| TrackFrameWriter::new(loan.payload_mut()));
+        let result = self.track(frame, receive_ns, &mut writer, &mut flags);
+        let (status, step) = self.count_outcome(frame, &result);
+        if frame.flags & FRAME_FLAG_STREAM_END != 0 {
+            flags |= TRACK_FLAG_STREAM_END;
+        }
+        let mut header = track_frame_header(frame, receive_ns, status, flags, &step);
+        // The input sample goes back to its publisher before the answer is sent.
+        drop(sample);
+
+        let publish_start = monotonic_ns();
+        header.publish_time_ns = publish_start;
+        let written = writer.map(|writer| writer.finish(&header));
+        if let (Some(loan), Some(_)) = (loan, written) {
+            // SAFETY: the writer initialised the header and the first `count` tracks; the
+            // remaining slots hold bytes left in the shared-memory chunk by earlier samples (or
+            // the zeroes the OS mapped), and every field of `WireTrack` is a plain integer or
+            // float for which any bit pattern is a valid value.
+            self.send_track_frame(unsafe { loan.assume_init() });
+            self.record_publish_latencies(receive_ns, publish_start, header.input_publish_time_ns);
+        }
+
+        let interval = self.options.latency_report_interval_frames;
+        if interval > 0 && self.counters.frames_received % interval == 0 {
+            self.publish_latency_report();
+        }
+    }
+
+    /// Loans the sample of the answer; `None` (counted and logged) when none is available: the
+    /// frame is then tracked but not answered.
+    fn loan_track_sample(&mut self) -> Option<SampleMutUninit<Ipc, MaybeUninit<TrackFrame>, ()>> {
+        match self.output.loan_uninit() {
             Ok(loan) => Some(loan),
             Err(error) => {
                 self.counters.publish_failures += 1;
@@ -245,8 +280,18 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 }
                 None
             }
-        };
-        let mut writer = loan.as_mut().map(|loan| TrackFrameWriter::new(loan.payload_mut()));
+        }
+    }
+
+    /// Tracks `frame`, its tracks written by `writer` and its stages timed from `receive_ns`. A
+    /// frame after too long a gap is tracked again after a reset, which `flags` then records.
+    fn track(
+        &mut self,
+        frame: &MeasurementFrame,
+        receive_ns: u64,
+        writer: &mut Option<TrackFrameWriter<'_>>,
+        flags: &mut u8,
+    ) -> Result<StepSummary, StepError> {
         let mut timer = StageTimer::new(&mut self.histograms, receive_ns);
         let mut result = self.tracker.step_observed(frame, &mut timer, |output| {
             if let Some(writer) = writer.as_mut() {
@@ -257,7 +302,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             // Tracks cannot be bridged over the gap: start afresh with this frame.
             self.tracker.reset();
             self.counters.resets_interval_too_long += 1;
-            flags |= TRACK_FLAG_TRACKER_RESET;
+            *flags |= TRACK_FLAG_TRACKER_RESET;
             if let Some(writer) = writer.as_mut() {
                 writer.clear();
             }
@@ -267,7 +312,17 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 }
             });
         }
-        let (status, step) = match &result {
+        result
+    }
+
+    /// Counts (and logs, for a rejected frame) the outcome of tracking `frame`; returns the
+    /// answer's status and the step's summary.
+    fn count_outcome(
+        &mut self,
+        frame: &MeasurementFrame,
+        result: &Result<StepSummary, StepError>,
+    ) -> (FrameStatus, StepSummary) {
+        match result {
             Ok(step) => {
                 self.counters.frames_tracked += 1;
                 self.stream.tracker_dirty = true;
@@ -286,61 +341,37 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 // What the failed step counted before it failed.
                 (FrameStatus::of_error(error), *self.tracker.last_step())
             }
-        };
-        let saturating_u16 = |count: usize| u16::try_from(count).unwrap_or(u16::MAX);
-        if frame.flags & FRAME_FLAG_STREAM_END != 0 {
-            flags |= TRACK_FLAG_STREAM_END;
         }
-        let mut header = TrackFrameHeader {
-            input_sequence: frame.sequence,
-            source_frame: frame.source_frame,
-            sensor_timestamp_s: frame.sensor_timestamp_s,
-            input_publish_time_ns: frame.publish_time_ns,
-            receive_time_ns: receive_ns,
-            publish_time_ns: 0,
-            status,
-            flags,
-            measurements_accepted: saturating_u16(step.measurements_accepted),
-            measurements_rejected: saturating_u16(step.measurements_rejected),
-        };
-        // The input sample goes back to its publisher before the answer is sent.
-        drop(sample);
+    }
 
-        let publish_start = monotonic_ns();
-        header.publish_time_ns = publish_start;
-        let written = writer.map(|writer| writer.finish(&header));
-        if let (Some(loan), Some(_)) = (loan, written) {
-            // SAFETY: the writer initialised the header and the first `count` tracks; the
-            // remaining slots hold bytes left in the shared-memory chunk by earlier samples (or
-            // the zeroes the OS mapped), and every field of `WireTrack` is a plain integer or
-            // float for which any bit pattern is a valid value.
-            let sample = unsafe { loan.assume_init() };
-            match sample.send() {
-                Ok(_) => {
-                    if let Err(error) = self.output_notifier.notify() {
-                        if self.logs.notify.occur() {
-                            tracing::warn!(%error, "cannot notify track listeners");
-                        }
-                    }
-                }
-                Err(error) => {
-                    self.counters.publish_failures += 1;
-                    if self.logs.publish.occur() {
-                        tracing::warn!(%error, occurrences = self.logs.publish.occurrences(), "cannot send a track frame");
+    /// Sends the answer and notifies its listeners; counts and logs failures.
+    fn send_track_frame(&mut self, sample: SampleMut<Ipc, TrackFrame, ()>) {
+        match sample.send() {
+            Ok(_) => {
+                if let Err(error) = self.output_notifier.notify() {
+                    if self.logs.notify.occur() {
+                        tracing::warn!(%error, "cannot notify track listeners");
                     }
                 }
             }
-            let done_ns = monotonic_ns();
-            self.histograms.record(Stage::Publish, done_ns.saturating_sub(publish_start));
-            self.histograms.record(Stage::ReceiveToPublish, done_ns.saturating_sub(receive_ns));
-            if header.input_publish_time_ns != 0 && header.input_publish_time_ns <= publish_start {
-                self.histograms.record(Stage::EndToEnd, publish_start - header.input_publish_time_ns);
+            Err(error) => {
+                self.counters.publish_failures += 1;
+                if self.logs.publish.occur() {
+                    tracing::warn!(%error, occurrences = self.logs.publish.occurrences(), "cannot send a track frame");
+                }
             }
         }
+    }
 
-        let interval = self.options.latency_report_interval_frames;
-        if interval > 0 && self.counters.frames_received % interval == 0 {
-            self.publish_latency_report();
+    /// Records the host's stages of an answer sent now: [`Stage::Publish`] from `publish_start`,
+    /// [`Stage::ReceiveToPublish`] from `receive_ns`, and [`Stage::EndToEnd`] from the input's
+    /// publish time to `publish_start` (when the publisher stamped one that is not later).
+    fn record_publish_latencies(&mut self, receive_ns: u64, publish_start: u64, input_publish_time_ns: u64) {
+        let done_ns = monotonic_ns();
+        self.histograms.record(Stage::Publish, done_ns.saturating_sub(publish_start));
+        self.histograms.record(Stage::ReceiveToPublish, done_ns.saturating_sub(receive_ns));
+        if input_publish_time_ns != 0 && input_publish_time_ns <= publish_start {
+            self.histograms.record(Stage::EndToEnd, publish_start - input_publish_time_ns);
         }
     }
 
@@ -482,5 +513,28 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             c.publish_failures,
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
+    }
+}
+
+/// The header of the answer to `frame` (its publish time is stamped when it is sent).
+fn track_frame_header(
+    frame: &MeasurementFrame,
+    receive_ns: u64,
+    status: FrameStatus,
+    flags: u8,
+    step: &StepSummary,
+) -> TrackFrameHeader {
+    let saturating_u16 = |count: usize| u16::try_from(count).unwrap_or(u16::MAX);
+    TrackFrameHeader {
+        input_sequence: frame.sequence,
+        source_frame: frame.source_frame,
+        sensor_timestamp_s: frame.sensor_timestamp_s,
+        input_publish_time_ns: frame.publish_time_ns,
+        receive_time_ns: receive_ns,
+        publish_time_ns: 0,
+        status,
+        flags,
+        measurements_accepted: saturating_u16(step.measurements_accepted),
+        measurements_rejected: saturating_u16(step.measurements_rejected),
     }
 }

@@ -387,33 +387,49 @@ impl RowParser<'_> {
     }
 
     fn parse(&self, columns: &Columns) -> Result<Row, CsvError> {
-        let [c_frame, c_t, c_gt, c_class, c_x, c_y, c_vr, c_rcs, c_tx, c_ty] = columns.required;
-        let frame_text = self.field(c_frame);
+        let frame = self.frame_index(columns.required[0])?;
+        let t = self.req_f64(columns.required[1], "t")?;
+        let sensor_id = self.sensor_id(columns.sensor_id)?;
+        let ego = self.ego(columns.ego)?;
+        let measurement = self.measurement(columns, sensor_id)?;
+        Ok(Row { frame, t, sensor_id, ego, measurement })
+    }
+
+    /// The `frame` column (required).
+    fn frame_index(&self, index: usize) -> Result<u64, CsvError> {
+        let frame_text = self.field(index);
         if frame_text.is_empty() {
             return Err(self.error("frame", CsvErrorKind::MissingValue));
         }
-        let frame = frame_text
+        frame_text
             .parse::<u64>()
-            .map_err(|_| self.error("frame", CsvErrorKind::BadInteger(frame_text.to_owned())))?;
-        let t = self.req_f64(c_t, "t")?;
-        let sensor_id = match columns.sensor_id {
+            .map_err(|_| self.error("frame", CsvErrorKind::BadInteger(frame_text.to_owned())))
+    }
+
+    /// The optional `sensor_id` column.
+    fn sensor_id(&self, index: Option<usize>) -> Result<Option<u16>, CsvError> {
+        match index {
             Some(index) if !self.field(index).is_empty() => {
                 let text = self.field(index);
-                Some(
+                Ok(Some(
                     text.parse::<u16>()
                         .map_err(|_| self.error("sensor_id", CsvErrorKind::BadInteger(text.to_owned())))?,
-                )
+                ))
             }
-            _ => None,
-        };
+            _ => Ok(None),
+        }
+    }
+
+    /// The optional `ego_x, ego_y, ego_yaw` group: all three or none.
+    fn ego(&self, indices: [Option<usize>; 3]) -> Result<Option<EgoPose>, CsvError> {
         let ego_values = [
-            columns.ego[0].map(|i| self.opt_f64(i, "ego_x")).transpose()?.flatten(),
-            columns.ego[1].map(|i| self.opt_f64(i, "ego_y")).transpose()?.flatten(),
-            columns.ego[2].map(|i| self.opt_f64(i, "ego_yaw")).transpose()?.flatten(),
+            indices[0].map(|i| self.opt_f64(i, "ego_x")).transpose()?.flatten(),
+            indices[1].map(|i| self.opt_f64(i, "ego_y")).transpose()?.flatten(),
+            indices[2].map(|i| self.opt_f64(i, "ego_yaw")).transpose()?.flatten(),
         ];
-        let ego = match ego_values {
-            [Some(x_m), Some(y_m), Some(yaw_rad)] => Some(EgoPose { x_m, y_m, yaw_rad }),
-            [None, None, None] => None,
+        match ego_values {
+            [Some(x_m), Some(y_m), Some(yaw_rad)] => Ok(Some(EgoPose { x_m, y_m, yaw_rad })),
+            [None, None, None] => Ok(None),
             _ => {
                 let column = if ego_values[0].is_none() {
                     "ego_x"
@@ -422,10 +438,18 @@ impl RowParser<'_> {
                 } else {
                     "ego_yaw"
                 };
-                return Err(self.error(column, CsvErrorKind::IncompleteGroup("ego_x, ego_y, ego_yaw")));
+                Err(self.error(column, CsvErrorKind::IncompleteGroup("ego_x, ego_y, ego_yaw")))
             }
-        };
+        }
+    }
 
+    /// The measurement columns; `None` for an empty-frame row (every measurement column empty).
+    fn measurement(
+        &self,
+        columns: &Columns,
+        sensor_id: Option<u16>,
+    ) -> Result<Option<RecordedMeasurement>, CsvError> {
+        let [_, _, c_gt, c_class, c_x, c_y, c_vr, c_rcs, c_tx, c_ty] = columns.required;
         let class_text = self.field(c_class);
         if class_text.is_empty() {
             // An empty-frame row: every measurement column must be empty.
@@ -433,7 +457,7 @@ impl RowParser<'_> {
             if indices.iter().any(|&index| !self.field(index).is_empty()) {
                 return Err(self.error("class", CsvErrorKind::MissingValue));
             }
-            return Ok(Row { frame, t, sensor_id, ego, measurement: None });
+            return Ok(None);
         }
         let class = ObjectClass::from_name(class_text)
             .ok_or_else(|| self.error("class", CsvErrorKind::UnknownClass(class_text.to_owned())))?;
@@ -463,13 +487,7 @@ impl RowParser<'_> {
         };
         let measurement =
             Measurement { x_m, y_m, radial_velocity_mps, rcs_dbsm, class, sensor_id, ground_truth_id };
-        Ok(Row {
-            frame,
-            t,
-            sensor_id,
-            ego,
-            measurement: Some(RecordedMeasurement { measurement, true_position }),
-        })
+        Ok(Some(RecordedMeasurement { measurement, true_position }))
     }
 }
 
@@ -477,6 +495,84 @@ impl RowParser<'_> {
 struct OpenFrame {
     frame: RecordedFrame,
     placeholder: bool,
+}
+
+impl OpenFrame {
+    /// A frame started by its first row.
+    fn start(row: Row) -> Self {
+        let mut frame = RecordedFrame::new(row.frame, row.t);
+        frame.sensor_id = row.sensor_id;
+        frame.ego_pose = row.ego;
+        let placeholder = row.measurement.is_none();
+        frame.measurements.extend(row.measurement);
+        Self { frame, placeholder }
+    }
+
+    /// Adds a further row of this frame: its frame fields must repeat the first row's, and it
+    /// must carry a measurement (an empty-frame placeholder row stands alone).
+    fn add_row(&mut self, parser: &RowParser<'_>, row: Row) -> Result<(), CsvError> {
+        let frame = &mut self.frame;
+        if row.t.to_bits() != frame.timestamp_s.to_bits() {
+            return Err(parser.error(
+                "t",
+                CsvErrorKind::TimeMismatch { frame: row.frame, expected: frame.timestamp_s, found: row.t },
+            ));
+        }
+        if row.sensor_id != frame.sensor_id {
+            return Err(parser.error(
+                "sensor_id",
+                CsvErrorKind::FrameFieldMismatch {
+                    frame: row.frame,
+                    expected: fmt_opt(&frame.sensor_id),
+                    found: fmt_opt(&row.sensor_id),
+                },
+            ));
+        }
+        if row.ego != frame.ego_pose {
+            return Err(parser.error(
+                "ego_x",
+                CsvErrorKind::FrameFieldMismatch {
+                    frame: row.frame,
+                    expected: fmt_opt(&frame.ego_pose),
+                    found: fmt_opt(&row.ego),
+                },
+            ));
+        }
+        match row.measurement {
+            None => Err(parser.error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame })),
+            Some(_) if self.placeholder => {
+                Err(parser.error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame }))
+            }
+            Some(m) => {
+                if frame.measurements.len() >= MAX_MEASUREMENTS_PER_FRAME {
+                    return Err(parser.error("frame", CsvErrorKind::TooManyMeasurements { frame: row.frame }));
+                }
+                frame.measurements.push(m);
+                Ok(())
+            }
+        }
+    }
+
+    /// Checks that `row`, the first of the next frame, does not go back in frame index or time.
+    fn check_followed_by(&self, parser: &RowParser<'_>, row: &Row) -> Result<(), CsvError> {
+        if row.frame < self.frame.index {
+            return Err(parser.error(
+                "frame",
+                CsvErrorKind::FrameDecreasing { previous: self.frame.index, found: row.frame },
+            ));
+        }
+        if row.t < self.frame.timestamp_s {
+            return Err(parser.error(
+                "t",
+                CsvErrorKind::TimeDecreasing {
+                    frame: row.frame,
+                    previous: self.frame.timestamp_s,
+                    found: row.t,
+                },
+            ));
+        }
+        Ok(())
+    }
 }
 
 fn fmt_opt<T: std::fmt::Debug>(value: &Option<T>) -> String {
@@ -507,84 +603,13 @@ pub fn read_sequence<R: Read>(reader: R, name: &str) -> Result<Sequence, CsvErro
         let parser = RowParser { record: &record, line };
         let row = parser.parse(&columns)?;
         match &mut open {
-            Some(current) if current.frame.index == row.frame => {
-                let frame = &mut current.frame;
-                if row.t.to_bits() != frame.timestamp_s.to_bits() {
-                    return Err(parser.error(
-                        "t",
-                        CsvErrorKind::TimeMismatch {
-                            frame: row.frame,
-                            expected: frame.timestamp_s,
-                            found: row.t,
-                        },
-                    ));
-                }
-                if row.sensor_id != frame.sensor_id {
-                    return Err(parser.error(
-                        "sensor_id",
-                        CsvErrorKind::FrameFieldMismatch {
-                            frame: row.frame,
-                            expected: fmt_opt(&frame.sensor_id),
-                            found: fmt_opt(&row.sensor_id),
-                        },
-                    ));
-                }
-                if row.ego != frame.ego_pose {
-                    return Err(parser.error(
-                        "ego_x",
-                        CsvErrorKind::FrameFieldMismatch {
-                            frame: row.frame,
-                            expected: fmt_opt(&frame.ego_pose),
-                            found: fmt_opt(&row.ego),
-                        },
-                    ));
-                }
-                match row.measurement {
-                    None => {
-                        return Err(parser.error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame }))
-                    }
-                    Some(_) if current.placeholder => {
-                        return Err(parser.error("class", CsvErrorKind::PlaceholderMixed { frame: row.frame }))
-                    }
-                    Some(m) => {
-                        if frame.measurements.len() >= MAX_MEASUREMENTS_PER_FRAME {
-                            return Err(
-                                parser.error("frame", CsvErrorKind::TooManyMeasurements { frame: row.frame })
-                            );
-                        }
-                        frame.measurements.push(m);
-                    }
-                }
-            }
+            Some(current) if current.frame.index == row.frame => current.add_row(&parser, row)?,
             _ => {
                 if let Some(previous) = open.take() {
-                    if row.frame < previous.frame.index {
-                        return Err(parser.error(
-                            "frame",
-                            CsvErrorKind::FrameDecreasing {
-                                previous: previous.frame.index,
-                                found: row.frame,
-                            },
-                        ));
-                    }
-                    if row.t < previous.frame.timestamp_s {
-                        return Err(parser.error(
-                            "t",
-                            CsvErrorKind::TimeDecreasing {
-                                frame: row.frame,
-                                previous: previous.frame.timestamp_s,
-                                found: row.t,
-                            },
-                        ));
-                    }
+                    previous.check_followed_by(&parser, &row)?;
                     sequence.frames.push(previous.frame);
                 }
-                let mut frame = RecordedFrame::new(row.frame, row.t);
-                frame.sensor_id = row.sensor_id;
-                frame.ego_pose = row.ego;
-                let placeholder = row.measurement.is_none();
-                frame.measurements.extend(row.measurement);
-                open = Some(OpenFrame { frame, placeholder });
+                open = Some(OpenFrame::start(row));
             }
         }
     }

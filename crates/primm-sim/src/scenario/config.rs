@@ -699,6 +699,19 @@ impl ScenarioConfig {
 
     /// Checks every value; the first problem found is returned.
     pub fn validate(&self) -> Result<(), ConfigError> {
+        self.validate_sequence()?;
+        self.validate_road()?;
+        self.validate_traffic()?;
+        self.validate_car()?;
+        self.validate_turn_radii()?;
+        self.validate_ego()?;
+        self.validate_pedestrian()?;
+        self.validate_radar()?;
+        self.validate_reflections()
+    }
+
+    /// `sequence.*`.
+    fn validate_sequence(&self) -> Result<(), ConfigError> {
         let s = &self.sequence;
         positive("sequence.duration_s", s.duration_s)?;
         non_negative("sequence.warmup_s", s.warmup_s)?;
@@ -706,7 +719,11 @@ impl ScenarioConfig {
         if s.max_step_s > 0.1 {
             return Err(ConfigError::new("sequence.max_step_s", "must be at most 0.1 s"));
         }
+        Ok(())
+    }
 
+    /// `road.*`, including a block long enough for the lanes and turn radii.
+    fn validate_road(&self) -> Result<(), ConfigError> {
         let r = &self.road;
         positive("road.lane_width_m", r.lane_width_m)?;
         if r.lanes_per_direction == 0 || r.lanes_per_direction > 4 {
@@ -735,7 +752,11 @@ impl ScenarioConfig {
                 format!("must be at least {needed:.1} m for these lanes and turn radii"),
             ));
         }
+        Ok(())
+    }
 
+    /// `traffic.*`.
+    fn validate_traffic(&self) -> Result<(), ConfigError> {
         let t = &self.traffic;
         probability("traffic.pedestrian_group_probability", t.pedestrian_group_probability)?;
         probability("traffic.pedestrian_corner_spawn_probability", t.pedestrian_corner_spawn_probability)?;
@@ -760,7 +781,11 @@ impl ScenarioConfig {
         }
         non_negative("traffic.spawn_fov_margin_deg", t.spawn_fov_margin_deg)?;
         non_negative("traffic.spawn_range_margin_m", t.spawn_range_margin_m)?;
+        Ok(())
+    }
 
+    /// `car.*`.
+    fn validate_car(&self) -> Result<(), ConfigError> {
         let c = &self.car;
         interval("car.length_m", c.length_m, true)?;
         interval("car.width_m", c.width_m, true)?;
@@ -813,9 +838,16 @@ impl ScenarioConfig {
         probability("car.lane_change_probability", c.lane_change_probability)?;
         positive("car.lane_change_duration_s", c.lane_change_duration_s)?;
         interval("car.speed_change_interval_s", c.speed_change_interval_s, true)?;
+        Ok(())
+    }
+
+    /// The turn radii against the car limits: a car driving a turn at its planned speed must not
+    /// need a yaw rate above `car.max_yaw_rate_radps`.
+    fn validate_turn_radii(&self) -> Result<(), ConfigError> {
+        let (c, road) = (&self.car, &self.road);
         for (name, r) in [
-            ("road.right_turn_radius_m", r.right_turn_radius_m),
-            ("road.left_turn_radius_m", r.left_turn_radius_m),
+            ("road.right_turn_radius_m", road.right_turn_radius_m),
+            ("road.left_turn_radius_m", road.left_turn_radius_m),
         ] {
             let v = (c.curve_lateral_acceleration_mps2 * r).sqrt();
             if v / r > c.max_yaw_rate_radps {
@@ -825,7 +857,11 @@ impl ScenarioConfig {
                 ));
             }
         }
+        Ok(())
+    }
 
+    /// `ego.*`.
+    fn validate_ego(&self) -> Result<(), ConfigError> {
         let e = &self.ego;
         positive("ego.length_m", e.length_m)?;
         positive("ego.width_m", e.width_m)?;
@@ -838,7 +874,11 @@ impl ScenarioConfig {
         }
         probability("ego.initial_standstill_probability", e.initial_standstill_probability)?;
         interval("ego.start_distance_to_junction_m", e.start_distance_to_junction_m, false)?;
+        Ok(())
+    }
 
+    /// `pedestrian.*`.
+    fn validate_pedestrian(&self) -> Result<(), ConfigError> {
         let p = &self.pedestrian;
         interval("pedestrian.length_m", p.length_m, true)?;
         interval("pedestrian.width_m", p.width_m, true)?;
@@ -871,26 +911,13 @@ impl ScenarioConfig {
             ));
         }
         probability("pedestrian.crosswalk_probability", p.crosswalk_probability)?;
+        Ok(())
+    }
 
+    /// `radar.*`: the sensors, then the scan timing and the measurement model.
+    fn validate_radar(&self) -> Result<(), ConfigError> {
         let radar = &self.radar;
-        if radar.sensors.is_empty() {
-            return Err(ConfigError::new("radar.sensors", "must list at least one sensor"));
-        }
-        for (i, sensor) in radar.sensors.iter().enumerate() {
-            let field = |name: &str| format!("radar.sensors[{i}].{name}");
-            if radar.sensors[..i].iter().any(|other| other.id == sensor.id) {
-                return Err(ConfigError::new(field("id"), "is used by another sensor"));
-            }
-            finite(&field("x_m"), sensor.x_m)?;
-            finite(&field("y_m"), sensor.y_m)?;
-            finite(&field("yaw_deg"), sensor.yaw_deg)?;
-            if !(sensor.half_fov_deg > 0.0 && sensor.half_fov_deg < 90.0) {
-                return Err(ConfigError::new(field("half_fov_deg"), "must lie in (0, 90) degrees"));
-            }
-            positive(&field("max_range_m"), sensor.max_range_m)?;
-            finite(&field("azimuth_bias_deg"), sensor.azimuth_bias_deg)?;
-            positive(&field("azimuth_noise_scale"), sensor.azimuth_noise_scale)?;
-        }
+        validate_sensors(&radar.sensors)?;
         positive("radar.scan_period_s", radar.scan_period_s)?;
         non_negative("radar.phase_jitter_s", radar.phase_jitter_s)?;
         non_negative("radar.scan_jitter_s", radar.scan_jitter_s)?;
@@ -914,7 +941,11 @@ impl ScenarioConfig {
         }
         probability("radar.occluded_point_probability", radar.occluded_point_probability)?;
         probability("radar.fade_start_fraction", radar.fade_start_fraction)?;
+        Ok(())
+    }
 
+    /// `car_reflection.*` and `pedestrian_reflection.*`.
+    fn validate_reflections(&self) -> Result<(), ConfigError> {
         for (prefix, refl) in
             [("car_reflection", &self.car_reflection), ("pedestrian_reflection", &self.pedestrian_reflection)]
         {
@@ -939,6 +970,29 @@ impl ScenarioConfig {
     pub fn half_road_width_m(&self) -> f64 {
         self.road.lane_width_m * f64::from(self.road.lanes_per_direction)
     }
+}
+
+/// `radar.sensors`: at least one, unique ids, finite mounts, fields of view within (0, 90)°.
+fn validate_sensors(sensors: &[RadarMount]) -> Result<(), ConfigError> {
+    if sensors.is_empty() {
+        return Err(ConfigError::new("radar.sensors", "must list at least one sensor"));
+    }
+    for (i, sensor) in sensors.iter().enumerate() {
+        let field = |name: &str| format!("radar.sensors[{i}].{name}");
+        if sensors[..i].iter().any(|other| other.id == sensor.id) {
+            return Err(ConfigError::new(field("id"), "is used by another sensor"));
+        }
+        finite(&field("x_m"), sensor.x_m)?;
+        finite(&field("y_m"), sensor.y_m)?;
+        finite(&field("yaw_deg"), sensor.yaw_deg)?;
+        if !(sensor.half_fov_deg > 0.0 && sensor.half_fov_deg < 90.0) {
+            return Err(ConfigError::new(field("half_fov_deg"), "must lie in (0, 90) degrees"));
+        }
+        positive(&field("max_range_m"), sensor.max_range_m)?;
+        finite(&field("azimuth_bias_deg"), sensor.azimuth_bias_deg)?;
+        positive(&field("azimuth_noise_scale"), sensor.azimuth_noise_scale)?;
+    }
+    Ok(())
 }
 
 fn finite(field: &str, value: f64) -> Result<(), ConfigError> {

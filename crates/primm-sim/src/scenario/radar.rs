@@ -105,6 +105,33 @@ fn segment_hits_box(a: DVec2, b: DVec2, agent: &Agent) -> bool {
     true
 }
 
+/// One scan's sensor: its mount, pose and field of view, and the unit normal its noise is drawn
+/// from.
+struct ScanSensor<'a> {
+    radar: &'a RadarConfig,
+    mount: &'a RadarMount,
+    origin: DVec2,
+    boresight: f64,
+    half_fov: f64,
+    unit: Normal<f64>,
+}
+
+/// The box faces of an object turned towards the sensor, weighted by their apparent width.
+struct VisibleFaces {
+    corners: [DVec2; 4],
+    faces: [(usize, f64); 4],
+    total: f64,
+}
+
+/// The sums of the detected reflection points of one object in one scan.
+#[derive(Default)]
+struct Echo {
+    sum_position: DVec2,
+    sum_vr: f64,
+    sum_rcs: f64,
+    count: u32,
+}
+
 /// Produces the object measurements of one scan of sensor `sensor_index`.
 pub(crate) fn scan(
     world: &World<'_>,
@@ -116,9 +143,15 @@ pub(crate) fn scan(
     let mount = &radar.sensors[sensor_index];
     let ego = world.ego_pose();
     let (origin, boresight) = sensor_pose(&ego, mount);
-    let half_fov = mount.half_fov_deg.to_radians();
-    let unit = Normal::new(0.0, 1.0).expect("unit normal");
-    let scan_bias = radar.scan_doppler_bias_mps * unit.sample(rng);
+    let sensor = ScanSensor {
+        radar,
+        mount,
+        origin,
+        boresight,
+        half_fov: mount.half_fov_deg.to_radians(),
+        unit: Normal::new(0.0, 1.0).expect("unit normal"),
+    };
+    let scan_bias = radar.scan_doppler_bias_mps * sensor.unit.sample(rng);
     let mut out = Vec::new();
 
     for (index, object) in world.agents.iter().enumerate() {
@@ -129,149 +162,209 @@ pub(crate) fn scan(
             ObjectClass::Pedestrian => &cfg.pedestrian_reflection,
             _ => &cfg.car_reflection,
         };
-        let centre = object.kin.position;
-        let radius = 0.5 * object.length.hypot(object.width);
-        let rel = centre - origin;
-        let range = rel.length();
         let max_range = mount.max_range_m.min(refl.detection_range_m);
-        if range - radius > max_range || range < 0.5 {
+        let Some(range) = range_if_in_view(&sensor, object, max_range) else { continue };
+        let Some(faces) = visible_faces(object, origin) else { continue };
+        let echo = object_echo(world, &sensor, refl, index, &faces, range, max_range, rng);
+        if echo.count == 0 || rng.random_bool(radar.miss_probability) {
             continue;
         }
-        let bearing = wrap_angle(rel.to_angle() - boresight);
-        if bearing.abs() - (radius / range).min(1.0).asin() > half_fov {
-            continue;
-        }
-
-        let heading = object.kin.direction();
-        // Faces of the box turned towards the sensor, weighted by their apparent width.
-        let corners = object.corners();
-        let mut faces: [(usize, f64); 4] = [(0, 0.0); 4];
-        let mut total = 0.0;
-        for k in 0..4 {
-            let a = corners[k];
-            let b = corners[(k + 1) % 4];
-            let edge = b - a;
-            let outward = DVec2::new(edge.y, -edge.x).normalize_or_zero();
-            let mid = 0.5 * (a + b);
-            let to_sensor = (origin - mid).normalize_or_zero();
-            let facing = outward.dot(to_sensor);
-            let weight = if facing > 0.0 { edge.length() * facing } else { 0.0 };
-            faces[k] = (k, weight);
-            total += weight;
-        }
-        if total <= 0.0 {
-            continue;
-        }
-
-        // Number of candidate points: more for near objects.
-        let scale = (refl.reference_range_m / range.max(1.0)).clamp(0.3, 3.0);
-        let mean = (refl.mean_points_at_reference * scale - 1.0).max(0.0);
-        let extra =
-            if mean > 0.0 { Poisson::new(mean).map(|d| d.sample(rng) as u32).unwrap_or(0) } else { 0 };
-        let candidates = (1 + extra).min(refl.max_points);
-
-        let velocity = object.kin.velocity();
-        let mut sum_position = DVec2::ZERO;
-        let mut sum_vr = 0.0;
-        let mut sum_rcs = 0.0;
-        let mut count = 0u32;
-        for _ in 0..candidates {
-            // Pick a face, then a point on it (sometimes a corner).
-            let mut pick = rng.random::<f64>() * total;
-            let mut face = faces[3].0;
-            for &(k, w) in &faces {
-                if pick < w {
-                    face = k;
-                    break;
-                }
-                pick -= w;
-            }
-            let a = corners[face];
-            let b = corners[(face + 1) % 4];
-            let point = if rng.random_bool(refl.interior_probability) {
-                let along = (rng.random::<f64>() - 0.5) * object.length;
-                let across = (rng.random::<f64>() - 0.5) * object.width;
-                centre + heading * along + heading.perp() * across
-            } else {
-                let u = if rng.random_bool(refl.corner_probability) {
-                    if rng.random_bool(0.5) {
-                        0.0
-                    } else {
-                        1.0
-                    }
-                } else {
-                    rng.random::<f64>()
-                };
-                a + (b - a) * u
-            };
-            let point_rel = point - origin;
-            let point_range = point_rel.length();
-            let azimuth = wrap_angle(point_rel.to_angle() - boresight);
-            if point_range > max_range || azimuth.abs() > half_fov {
-                continue;
-            }
-            let fade_start = radar.fade_start_fraction * max_range;
-            if point_range > fade_start {
-                let keep = 1.0 - (point_range - fade_start) / (max_range - fade_start).max(1e-6);
-                if !rng.random_bool(keep.clamp(0.0, 1.0)) {
-                    continue;
-                }
-            }
-            let hidden = world
-                .agents
-                .iter()
-                .enumerate()
-                .any(|(j, other)| j != index && !other.is_ego && segment_hits_box(origin, point, other));
-            if hidden && !rng.random_bool(radar.occluded_point_probability) {
-                continue;
-            }
-
-            // Measured point: range and azimuth noise in the sensor's polar frame.
-            let sigma_az =
-                radar.azimuth_noise_deg.to_radians() * mount.azimuth_noise_scale / azimuth.cos().max(0.5);
-            let measured_range = point_range + radar.range_noise_m * unit.sample(rng);
-            let measured_az = azimuth + mount.azimuth_bias_deg.to_radians() + sigma_az * unit.sample(rng);
-            let measured = origin + DVec2::from_angle(boresight + measured_az) * measured_range;
-
-            // Doppler: velocity of the reflecting point along the line of sight.
-            let line_of_sight = point_rel / point_range;
-            let lever = point - centre;
-            let point_velocity = velocity + DVec2::new(-lever.y, lever.x) * object.kin.yaw_rate;
-            let micro = refl.micro_doppler_fraction * object.kin.speed * unit.sample(rng);
-            let vr = point_velocity.dot(line_of_sight) + radar.doppler_noise_mps * unit.sample(rng) + micro;
-
-            // RCS: side views reflect more than head-on views; each point fluctuates.
-            let aspect = heading.perp_dot(-line_of_sight).abs();
-            let rcs = refl.rcs_front_dbsm
-                + (refl.rcs_side_dbsm - refl.rcs_front_dbsm) * aspect
-                + refl.rcs_fluctuation_db * unit.sample(rng);
-
-            sum_position += measured;
-            sum_vr += vr;
-            sum_rcs += rcs;
-            count += 1;
-        }
-        if count == 0 || rng.random_bool(radar.miss_probability) {
-            continue;
-        }
-        let n = f64::from(count);
-        let position = ego.world_to_car(sum_position / n);
+        let n = f64::from(echo.count);
+        let position = ego.world_to_car(echo.sum_position / n);
         out.push(RecordedMeasurement {
             measurement: Measurement {
                 x_m: position.x,
                 y_m: position.y,
-                radial_velocity_mps: sum_vr / n + scan_bias,
-                rcs_dbsm: sum_rcs / n,
+                radial_velocity_mps: echo.sum_vr / n + scan_bias,
+                rcs_dbsm: echo.sum_rcs / n,
                 class: object.class,
                 sensor_id: Some(mount.id),
                 ground_truth_id: Some(object.id),
             },
-            true_position: Some(ego.world_to_car(centre)),
+            true_position: Some(ego.world_to_car(object.kin.position)),
         });
     }
     // Detection lists carry no meaningful order.
     out.shuffle(rng);
     out
+}
+
+/// The range to `object`'s centre when some of its box may lie within `max_range` and the field
+/// of view; `None` otherwise (also for an object closer than 0.5 m).
+fn range_if_in_view(sensor: &ScanSensor<'_>, object: &Agent, max_range: f64) -> Option<f64> {
+    let radius = 0.5 * object.length.hypot(object.width);
+    let rel = object.kin.position - sensor.origin;
+    let range = rel.length();
+    if range - radius > max_range || range < 0.5 {
+        return None;
+    }
+    let bearing = wrap_angle(rel.to_angle() - sensor.boresight);
+    if bearing.abs() - (radius / range).min(1.0).asin() > sensor.half_fov {
+        return None;
+    }
+    Some(range)
+}
+
+/// The faces of `object`'s box turned towards `origin`; `None` when none is.
+fn visible_faces(object: &Agent, origin: DVec2) -> Option<VisibleFaces> {
+    let corners = object.corners();
+    let mut faces: [(usize, f64); 4] = [(0, 0.0); 4];
+    let mut total = 0.0;
+    for k in 0..4 {
+        let a = corners[k];
+        let b = corners[(k + 1) % 4];
+        let edge = b - a;
+        let outward = DVec2::new(edge.y, -edge.x).normalize_or_zero();
+        let mid = 0.5 * (a + b);
+        let to_sensor = (origin - mid).normalize_or_zero();
+        let facing = outward.dot(to_sensor);
+        let weight = if facing > 0.0 { edge.length() * facing } else { 0.0 };
+        faces[k] = (k, weight);
+        total += weight;
+    }
+    (total > 0.0).then_some(VisibleFaces { corners, faces, total })
+}
+
+/// Draws the candidate reflection points of object `index` (more for near objects) and sums
+/// the measured ones.
+fn object_echo(
+    world: &World<'_>,
+    sensor: &ScanSensor<'_>,
+    refl: &ReflectionConfig,
+    index: usize,
+    faces: &VisibleFaces,
+    range: f64,
+    max_range: f64,
+    rng: &mut ChaCha12Rng,
+) -> Echo {
+    let object = &world.agents[index];
+    let scale = (refl.reference_range_m / range.max(1.0)).clamp(0.3, 3.0);
+    let mean = (refl.mean_points_at_reference * scale - 1.0).max(0.0);
+    let extra = if mean > 0.0 { Poisson::new(mean).map(|d| d.sample(rng) as u32).unwrap_or(0) } else { 0 };
+    let candidates = (1 + extra).min(refl.max_points);
+
+    let mut echo = Echo::default();
+    for _ in 0..candidates {
+        let point = reflection_point(object, faces, refl, rng);
+        let Some((point_rel, point_range, azimuth)) = detected(world, sensor, index, point, max_range, rng)
+        else {
+            continue;
+        };
+        let (measured, vr, rcs) =
+            measure_point(sensor, object, refl, point, point_rel, point_range, azimuth, rng);
+        echo.sum_position += measured;
+        echo.sum_vr += vr;
+        echo.sum_rcs += rcs;
+        echo.count += 1;
+    }
+    echo
+}
+
+/// A reflection point: on a visible face (sometimes a corner), or sometimes inside the box.
+fn reflection_point(
+    object: &Agent,
+    faces: &VisibleFaces,
+    refl: &ReflectionConfig,
+    rng: &mut ChaCha12Rng,
+) -> DVec2 {
+    // Pick a face, then a point on it (sometimes a corner).
+    let mut pick = rng.random::<f64>() * faces.total;
+    let mut face = faces.faces[3].0;
+    for &(k, w) in &faces.faces {
+        if pick < w {
+            face = k;
+            break;
+        }
+        pick -= w;
+    }
+    let a = faces.corners[face];
+    let b = faces.corners[(face + 1) % 4];
+    if rng.random_bool(refl.interior_probability) {
+        let heading = object.kin.direction();
+        let along = (rng.random::<f64>() - 0.5) * object.length;
+        let across = (rng.random::<f64>() - 0.5) * object.width;
+        object.kin.position + heading * along + heading.perp() * across
+    } else {
+        let u = if rng.random_bool(refl.corner_probability) {
+            if rng.random_bool(0.5) {
+                0.0
+            } else {
+                1.0
+            }
+        } else {
+            rng.random::<f64>()
+        };
+        a + (b - a) * u
+    }
+}
+
+/// Whether the sensor sees `point` of object `index`: within range and field of view, not
+/// faded out at long range, and not hidden behind another object (or seen despite it). Returns
+/// the point relative to the sensor, its range and its azimuth.
+fn detected(
+    world: &World<'_>,
+    sensor: &ScanSensor<'_>,
+    index: usize,
+    point: DVec2,
+    max_range: f64,
+    rng: &mut ChaCha12Rng,
+) -> Option<(DVec2, f64, f64)> {
+    let radar = sensor.radar;
+    let point_rel = point - sensor.origin;
+    let point_range = point_rel.length();
+    let azimuth = wrap_angle(point_rel.to_angle() - sensor.boresight);
+    if point_range > max_range || azimuth.abs() > sensor.half_fov {
+        return None;
+    }
+    let fade_start = radar.fade_start_fraction * max_range;
+    if point_range > fade_start {
+        let keep = 1.0 - (point_range - fade_start) / (max_range - fade_start).max(1e-6);
+        if !rng.random_bool(keep.clamp(0.0, 1.0)) {
+            return None;
+        }
+    }
+    let hidden = world
+        .agents
+        .iter()
+        .enumerate()
+        .any(|(j, other)| j != index && !other.is_ego && segment_hits_box(sensor.origin, point, other));
+    if hidden && !rng.random_bool(radar.occluded_point_probability) {
+        return None;
+    }
+    Some((point_rel, point_range, azimuth))
+}
+
+/// The measured position, radial velocity and RCS of a detected reflection point.
+fn measure_point(
+    sensor: &ScanSensor<'_>,
+    object: &Agent,
+    refl: &ReflectionConfig,
+    point: DVec2,
+    point_rel: DVec2,
+    point_range: f64,
+    azimuth: f64,
+    rng: &mut ChaCha12Rng,
+) -> (DVec2, f64, f64) {
+    let (radar, mount, unit) = (sensor.radar, sensor.mount, &sensor.unit);
+    // Measured point: range and azimuth noise in the sensor's polar frame.
+    let sigma_az = radar.azimuth_noise_deg.to_radians() * mount.azimuth_noise_scale / azimuth.cos().max(0.5);
+    let measured_range = point_range + radar.range_noise_m * unit.sample(rng);
+    let measured_az = azimuth + mount.azimuth_bias_deg.to_radians() + sigma_az * unit.sample(rng);
+    let measured = sensor.origin + DVec2::from_angle(sensor.boresight + measured_az) * measured_range;
+
+    // Doppler: velocity of the reflecting point along the line of sight.
+    let line_of_sight = point_rel / point_range;
+    let lever = point - object.kin.position;
+    let point_velocity = object.kin.velocity() + DVec2::new(-lever.y, lever.x) * object.kin.yaw_rate;
+    let micro = refl.micro_doppler_fraction * object.kin.speed * unit.sample(rng);
+    let vr = point_velocity.dot(line_of_sight) + radar.doppler_noise_mps * unit.sample(rng) + micro;
+
+    // RCS: side views reflect more than head-on views; each point fluctuates.
+    let aspect = object.kin.direction().perp_dot(-line_of_sight).abs();
+    let rcs = refl.rcs_front_dbsm
+        + (refl.rcs_side_dbsm - refl.rcs_front_dbsm) * aspect
+        + refl.rcs_fluctuation_db * unit.sample(rng);
+    (measured, vr, rcs)
 }
 
 #[cfg(test)]

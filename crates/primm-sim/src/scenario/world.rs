@@ -15,7 +15,7 @@ use rand::Rng;
 use rand_chacha::ChaCha12Rng;
 use rand_distr::{Distribution, Normal};
 
-use super::config::{Interval, ScenarioConfig};
+use super::config::{CarConfig, Interval, PedestrianConfig, ScenarioConfig};
 use super::kinematics::{wrap_angle, Kinematics, Limits};
 use super::path::{Leg, Mark, MarkKind, Path};
 use super::road::{right_of, Axis, JunctionId, RoadGrid};
@@ -766,37 +766,73 @@ fn plan_car(
     brain: &mut CarBrain,
     path: &mut Path,
 ) {
-    let c = &cfg.car;
     let cursor = brain.cursor;
+    let d = cursor.dir;
+    let junction = junction_ahead(grid, &cursor);
+    let lane_change_m = (cfg.car.lane_change_duration_s * brain.desired_speed.max(5.0)).clamp(15.0, 60.0);
+    let (manoeuvre, target_lane) =
+        choose_manoeuvre(grid, &cfg.car, rng, &cursor, junction.distance_m, lane_change_m);
+    let current = push_lane_change(grid, path, &cursor, target_lane, lane_change_m);
+    let stop_point = junction.centre - d * grid.stop_distance_m;
+    let stop_ahead = (stop_point - cursor.pos).dot(d);
+    let stop_s = path.end_s() + (stop_point - current).dot(d);
+    brain.cursor = push_manoeuvre(grid, path, junction.centre, d, current, manoeuvre, target_lane);
+    if stop_ahead > 0.0 {
+        path.add_mark(Mark {
+            s: stop_s,
+            kind: MarkKind::StopLine { junction: junction.id, axis: Axis::of(d) },
+        });
+    }
+}
+
+/// The next junction on a car's road.
+struct JunctionAhead {
+    /// Distance from the cursor to the junction centre along the travel direction, m.
+    distance_m: f64,
+    /// The junction centre.
+    centre: DVec2,
+    id: JunctionId,
+}
+
+/// The junction ahead of `cursor` on its road.
+fn junction_ahead(grid: &RoadGrid, cursor: &LaneCursor) -> JunctionAhead {
     let d = cursor.dir;
     let r = right_of(d);
     let b = grid.block_m;
-    let hw = grid.half_road_m;
-    let outer = grid.lanes - 1;
-
-    // The junction ahead on this road.
     let coord = cursor.pos.dot(d.abs());
     let sign = d.x + d.y;
     let next = if sign > 0.0 { (coord / b).floor() + 1.0 } else { (coord / b).ceil() - 1.0 } * b;
-    let dist_j = (next - coord) * sign;
+    let distance_m = (next - coord) * sign;
     let centre_line = cursor.pos - r * grid.lane_offset(cursor.lane);
-    let junction = centre_line + d * dist_j;
-    let junction_id = grid.nearest_junction(junction);
+    let centre = centre_line + d * distance_m;
+    JunctionAhead { distance_m, centre, id: grid.nearest_junction(centre) }
+}
 
-    let lane_change_m = (c.lane_change_duration_s * brain.desired_speed.max(5.0)).clamp(15.0, 60.0);
+/// What a car does at the next junction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Manoeuvre {
+    Straight,
+    Right,
+    Left,
+}
+
+/// Draws the manoeuvre at the junction `dist_j` metres ahead (straight on when the turn lane
+/// cannot be reached in time) and the lane to take: the outer lane for a right turn, the inner
+/// one for a left turn, and sometimes another lane when going straight on.
+fn choose_manoeuvre(
+    grid: &RoadGrid,
+    c: &CarConfig,
+    rng: &mut ChaCha12Rng,
+    cursor: &LaneCursor,
+    dist_j: f64,
+    lane_change_m: f64,
+) -> (Manoeuvre, u32) {
+    let outer = grid.lanes - 1;
     let lane_change_room = 8.0 + lane_change_m + 5.0;
-    let r_right = grid.right_turn_radius_m;
-    let r_left = grid.left_turn_radius_m;
-    let right_entry = dist_j - (grid.lane_offset(outer) + r_right);
-    let left_entry = dist_j + grid.lane_offset(0) - r_left;
+    let right_entry = dist_j - (grid.lane_offset(outer) + grid.right_turn_radius_m);
+    let left_entry = dist_j + grid.lane_offset(0) - grid.left_turn_radius_m;
     let feasible = |entry: f64, lane: u32| entry >= if lane == cursor.lane { 1.0 } else { lane_change_room };
 
-    #[derive(PartialEq)]
-    enum Manoeuvre {
-        Straight,
-        Right,
-        Left,
-    }
     let u: f64 = rng.random();
     let mut manoeuvre = if u < c.turn_left_probability {
         Manoeuvre::Left
@@ -827,30 +863,53 @@ fn plan_car(
             }
         }
     };
+    (manoeuvre, target_lane)
+}
 
-    let mut current = cursor.pos;
-    if target_lane != cursor.lane {
-        let start = current + d * 8.0;
-        let shift = grid.lane_offset(target_lane) - grid.lane_offset(cursor.lane);
-        let end = current + d * (8.0 + lane_change_m) + r * shift;
-        path.push(Leg::Line { a: current, b: start });
-        path.push(Leg::Line { a: start, b: end });
-        current = end;
+/// Appends the change from the cursor's lane to `target_lane` (8 m ahead, over
+/// `lane_change_m`), if they differ. Returns where the route continues.
+fn push_lane_change(
+    grid: &RoadGrid,
+    path: &mut Path,
+    cursor: &LaneCursor,
+    target_lane: u32,
+    lane_change_m: f64,
+) -> DVec2 {
+    let current = cursor.pos;
+    if target_lane == cursor.lane {
+        return current;
     }
-    let stop_point = junction - d * grid.stop_distance_m;
-    let stop_ahead = (stop_point - cursor.pos).dot(d);
-    let s_current = path.end_s();
-    let stop_s = s_current + (stop_point - current).dot(d);
-    let axis = Axis::of(d);
+    let d = cursor.dir;
+    let start = current + d * 8.0;
+    let shift = grid.lane_offset(target_lane) - grid.lane_offset(cursor.lane);
+    let end = current + d * (8.0 + lane_change_m) + right_of(d) * shift;
+    path.push(Leg::Line { a: current, b: start });
+    path.push(Leg::Line { a: start, b: end });
+    end
+}
 
+/// Appends the approach from `current` (travelling along `d` in `target_lane`) and the
+/// manoeuvre through the junction centred at `junction`. Returns the cursor after it.
+fn push_manoeuvre(
+    grid: &RoadGrid,
+    path: &mut Path,
+    junction: DVec2,
+    d: DVec2,
+    current: DVec2,
+    manoeuvre: Manoeuvre,
+    target_lane: u32,
+) -> LaneCursor {
+    let r = right_of(d);
+    let outer = grid.lanes - 1;
     let o_in = grid.lane_offset(target_lane);
     match manoeuvre {
         Manoeuvre::Straight => {
-            let exit = junction + d * (hw + 1.0) + r * o_in;
+            let exit = junction + d * (grid.half_road_m + 1.0) + r * o_in;
             path.push(Leg::Line { a: current, b: exit });
-            brain.cursor = LaneCursor { pos: exit, dir: d, lane: target_lane };
+            LaneCursor { pos: exit, dir: d, lane: target_lane }
         }
         Manoeuvre::Right => {
+            let r_right = grid.right_turn_radius_m;
             let o_out = grid.lane_offset(outer);
             let corner = junction - d * o_out + r * o_in;
             let entry = corner - d * r_right;
@@ -863,9 +922,10 @@ fn plan_car(
                 start: (entry - centre).to_angle(),
                 sweep: -PI / 2.0,
             });
-            brain.cursor = LaneCursor { pos: exit, dir: r, lane: outer };
+            LaneCursor { pos: exit, dir: r, lane: outer }
         }
         Manoeuvre::Left => {
+            let r_left = grid.left_turn_radius_m;
             let o_out = grid.lane_offset(0);
             let corner = junction + d * o_out + r * o_in;
             let entry = corner - d * r_left;
@@ -878,11 +938,8 @@ fn plan_car(
                 start: (entry - centre).to_angle(),
                 sweep: PI / 2.0,
             });
-            brain.cursor = LaneCursor { pos: exit, dir: -r, lane: 0 };
+            LaneCursor { pos: exit, dir: -r, lane: 0 }
         }
-    }
-    if stop_ahead > 0.0 {
-        path.add_mark(Mark { s: stop_s, kind: MarkKind::StopLine { junction: junction_id, axis } });
     }
 }
 
@@ -896,8 +953,6 @@ fn plan_pedestrian(
 ) {
     let p_cfg = &cfg.pedestrian;
     let side = grid.ring_side_m();
-    let ring = grid.ring_length_m();
-    let jitter_width = 0.7 * grid.sidewalk_half_width_m;
     let start = path.end_point().unwrap_or_else(|| grid.ring_point(brain.cursor.block, brain.cursor.p));
     let cursor = &mut brain.cursor;
     let p = cursor.p;
@@ -919,37 +974,70 @@ fn plan_pedestrian(
 
     let leg = uniform(rng, p_cfg.leg_length_m);
     if leg < to_corner - 1.0 {
-        cursor.p = (p + cursor.dir * leg).rem_euclid(ring);
-        let waypoint = grid.ring_point(cursor.block, cursor.p)
-            + grid.ring_outward(cursor.p) * rng.random_range(-jitter_width..=jitter_width);
-        path.push(Leg::Line { a: start, b: waypoint });
-        let u: f64 = rng.random();
-        let stop = p_cfg.stop_probability;
-        let turn = stop + p_cfg.turn_around_probability;
-        let cross = turn + p_cfg.mid_block_crossing_probability;
-        if u < stop {
-            let duration_s = uniform(rng, p_cfg.stop_duration_s);
-            path.add_mark(Mark { s: path.end_s(), kind: MarkKind::Wait { duration_s } });
-        } else if u < turn {
-            cursor.dir = -cursor.dir;
-        } else if u < cross {
-            // Cross the adjacent road straight over to the facing block.
-            let out = grid.ring_outward(cursor.p);
-            let here = grid.ring_point(cursor.block, cursor.p);
-            let across = here + out * (2.0 * grid.sidewalk_m) + out.perp() * rng.random_range(-1.0..=1.0);
-            if rng.random_bool(0.5) {
-                let duration_s = rng.random_range(0.5..=2.0);
-                path.add_mark(Mark { s: path.end_s(), kind: MarkKind::Wait { duration_s } });
-            }
-            path.push(Leg::Line { a: waypoint, b: across });
-            cursor.block = grid.block_of(across);
-            cursor.p = grid.ring_project(cursor.block, across);
-            cursor.dir = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-        }
-        return;
+        walk_along_block(grid, p_cfg, rng, cursor, path, start, leg);
+    } else {
+        walk_to_corner(grid, p_cfg, rng, cursor, path, start, to_corner);
     }
+}
 
-    // Walk to the corner and decide there.
+/// Appends a leg of `leg` metres along the block's sidewalk from `start` (ending off the centre
+/// of the sidewalk) and what the pedestrian does at its end: wait, turn around, cross the road
+/// mid-block, or walk on.
+fn walk_along_block(
+    grid: &RoadGrid,
+    p_cfg: &PedestrianConfig,
+    rng: &mut ChaCha12Rng,
+    cursor: &mut WalkCursor,
+    path: &mut Path,
+    start: DVec2,
+    leg: f64,
+) {
+    let jitter_width = 0.7 * grid.sidewalk_half_width_m;
+    let p = cursor.p;
+    cursor.p = (p + cursor.dir * leg).rem_euclid(grid.ring_length_m());
+    let waypoint = grid.ring_point(cursor.block, cursor.p)
+        + grid.ring_outward(cursor.p) * rng.random_range(-jitter_width..=jitter_width);
+    path.push(Leg::Line { a: start, b: waypoint });
+    let u: f64 = rng.random();
+    let stop = p_cfg.stop_probability;
+    let turn = stop + p_cfg.turn_around_probability;
+    let cross = turn + p_cfg.mid_block_crossing_probability;
+    if u < stop {
+        let duration_s = uniform(rng, p_cfg.stop_duration_s);
+        path.add_mark(Mark { s: path.end_s(), kind: MarkKind::Wait { duration_s } });
+    } else if u < turn {
+        cursor.dir = -cursor.dir;
+    } else if u < cross {
+        // Cross the adjacent road straight over to the facing block.
+        let out = grid.ring_outward(cursor.p);
+        let here = grid.ring_point(cursor.block, cursor.p);
+        let across = here + out * (2.0 * grid.sidewalk_m) + out.perp() * rng.random_range(-1.0..=1.0);
+        if rng.random_bool(0.5) {
+            let duration_s = rng.random_range(0.5..=2.0);
+            path.add_mark(Mark { s: path.end_s(), kind: MarkKind::Wait { duration_s } });
+        }
+        path.push(Leg::Line { a: waypoint, b: across });
+        cursor.block = grid.block_of(across);
+        cursor.p = grid.ring_project(cursor.block, across);
+        cursor.dir = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    }
+}
+
+/// Appends the walk from `start` to the corner `to_corner` metres ahead and what the pedestrian
+/// does there: cross on the crosswalk of one of the two roads, turn around, or walk on round the
+/// corner.
+fn walk_to_corner(
+    grid: &RoadGrid,
+    p_cfg: &PedestrianConfig,
+    rng: &mut ChaCha12Rng,
+    cursor: &mut WalkCursor,
+    path: &mut Path,
+    start: DVec2,
+    to_corner: f64,
+) {
+    let side = grid.ring_side_m();
+    let ring = grid.ring_length_m();
+    let p = cursor.p;
     cursor.p = (((p + cursor.dir * to_corner) / side).round() * side).rem_euclid(ring);
     let corner = grid.ring_point(cursor.block, cursor.p);
     let waypoint = corner + DVec2::new(rng.random_range(-0.3..=0.3), rng.random_range(-0.3..=0.3));
