@@ -33,18 +33,47 @@ enum Command {
     Score(cli::score::Args),
 }
 
+/// Why a subcommand failed: its own error.
+#[derive(Debug, thiserror::Error)]
+enum CommandError {
+    /// `primm demo` failed.
+    #[error(transparent)]
+    Demo(#[from] cli::demo::DemoError),
+    /// `primm serve` failed.
+    #[error(transparent)]
+    Serve(#[from] cli::serve::ServeError),
+    /// `primm publish` failed.
+    #[error(transparent)]
+    Publish(#[from] primm_publisher::PublishError),
+    /// `primm subscribe` failed.
+    #[error(transparent)]
+    Subscribe(#[from] primm_subscriber::SubscribeError),
+    /// `primm generate` failed.
+    #[error(transparent)]
+    Generate(#[from] cli::generate::GenerateError),
+    /// `primm track` failed.
+    #[error(transparent)]
+    Track(#[from] cli::track::TrackError),
+    /// `primm eval` failed.
+    #[error(transparent)]
+    Eval(#[from] cli::eval::EvaluateError),
+    /// `primm score` failed.
+    #[error(transparent)]
+    Score(#[from] cli::score::ScoreError),
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     primm_service::logging::init_logging();
-    let result: Result<(), Box<dyn std::error::Error>> = match cli.command {
+    let result: Result<(), CommandError> = match cli.command {
         Command::Demo(args) => cli::demo::run(args).map_err(Into::into),
         Command::Serve(args) => cli::serve::run(args).map_err(Into::into),
         Command::Publish(args) => primm_publisher::run(args).map_err(Into::into),
         Command::Subscribe(args) => primm_subscriber::run(args).map_err(Into::into),
-        Command::Generate(args) => cli::generate::run(&args),
-        Command::Track(args) => cli::track::run(&args),
-        Command::Eval(args) => cli::eval::run(&args),
-        Command::Score(args) => cli::score::run(&args),
+        Command::Generate(args) => cli::generate::run(&args).map_err(Into::into),
+        Command::Track(args) => cli::track::run(&args).map_err(Into::into),
+        Command::Eval(args) => cli::eval::run(&args).map_err(Into::into),
+        Command::Score(args) => cli::score::run(&args).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

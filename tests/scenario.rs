@@ -9,7 +9,7 @@ use primm_core::measurement::ObjectClass;
 use primm_sim::io::{read_sequence, write_sequence, RecordedFrame, Sequence};
 use primm_sim::scenario::{
     count_events, GeneratedSequence, ObjectState, Preset, RadarMount, ScenarioConfig, ScenarioGenerator,
-    Split, SplitSummary, TruthFrame, SPLIT_SEED_STRIDE,
+    ScenarioTomlError, Split, SplitSummary, TruthFrame, SPLIT_SEED_STRIDE,
 };
 
 /// The default evaluation split, generated once and shared by the tests that inspect it.
@@ -518,7 +518,11 @@ fn configuration_is_validated_and_serialisable() {
     bad.road.block_length_m = 40.0;
     assert_eq!(bad.validate().unwrap_err().field, "road.block_length_m");
     assert!(ScenarioGenerator::new(bad).is_err());
-    assert!(ScenarioConfig::from_toml_str("[car]\nwheels = 4\n").is_err());
+    assert!(matches!(ScenarioConfig::from_toml_str("[car]\nwheels = 4\n"), Err(ScenarioTomlError::Parse(_))));
+    match ScenarioConfig::from_toml_str("[road]\nblock_length_m = 40.0\n") {
+        Err(ScenarioTomlError::Invalid(error)) => assert_eq!(error.field, "road.block_length_m"),
+        other => panic!("expected an invalid configuration, got {other:?}"),
+    }
 }
 
 #[test]

@@ -11,10 +11,10 @@ use primm_sim::eval::plots::{
     ground_truth_points, majority_ground_truth, write_mode_probability_svg, write_trajectory_svg,
     TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint,
 };
-use primm_sim::eval::record::AssociationRecord;
+use primm_sim::eval::record::{AssociationRecord, EvalError};
 use primm_sim::eval::report::{EvaluationReport, MethodEvaluator, DEFAULT_MISS_PERCENTS};
-use primm_sim::io::{read_dataset_dir, Sequence};
-use primm_sim::offline::{association_records, track_sequence};
+use primm_sim::io::{read_dataset_dir, CsvError, Sequence};
+use primm_sim::offline::{association_records, track_sequence, OfflineError};
 use std::path::{Path, PathBuf};
 
 /// Seed of the measurement removal for the missed-detection rows of Table V.
@@ -53,21 +53,57 @@ pub struct Args {
     pub miss_seed: u64,
 }
 
+/// Why `primm eval` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum EvaluateError {
+    /// The configuration file could not be read or is invalid.
+    #[error(transparent)]
+    Config(#[from] primm_config::ConfigError),
+    /// The configuration is invalid for the tracker.
+    #[error(transparent)]
+    Tracker(#[from] primm_core::config::ConfigError),
+    /// The data set could not be read.
+    #[error(transparent)]
+    Data(#[from] CsvError),
+    /// The data directory holds no measurement CSV file.
+    #[error("no measurement CSV files in {}", dir.display())]
+    NoData {
+        /// The data directory.
+        dir: PathBuf,
+    },
+    /// `--plot-sequence` names no sequence of the data set.
+    #[error("no sequence named {0}")]
+    NoSequence(String),
+    /// Tracking a sequence failed.
+    #[error(transparent)]
+    Tracking(#[from] OfflineError),
+    /// The evaluation library failed (measurement removal, JSON or figures).
+    #[error(transparent)]
+    Evaluation(#[from] EvalError),
+    /// The directory of the figures could not be created.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// The tracked rows of a sequence with measurements removed did not match the measurements
+    /// kept (an internal error).
+    #[error("missed-detection rows out of step")]
+    MissedDetectionRows,
+}
+
 /// Runs `primm eval`.
-pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+pub fn run(args: &Args) -> Result<(), EvaluateError> {
     let base_config = match &args.config {
         Some(path) => primm_config::from_file(path)?,
         None => Config::default(),
     };
     let sequences = read_dataset_dir(&args.data)?;
     if sequences.is_empty() {
-        return Err(format!("no measurement CSV files in {}", args.data.display()).into());
+        return Err(EvaluateError::NoData { dir: args.data.clone() });
     }
     let measurements: usize = sequences.iter().map(Sequence::measurement_count).sum();
     eprintln!("{} sequences, {} measurements from {}", sequences.len(), measurements, args.data.display());
     let plot_sequence = match &args.plot_sequence {
         Some(name) => {
-            sequences.iter().position(|s| &s.name == name).ok_or(format!("no sequence named {name}"))?
+            sequences.iter().position(|s| &s.name == name).ok_or(EvaluateError::NoSequence(name.clone()))?
         }
         None => 0,
     };
@@ -137,7 +173,7 @@ fn missed_detection_records<P: DisplacementPredictor>(
     method: Method,
     percent: u32,
     seed: u64,
-) -> Result<Vec<AssociationRecord>, Box<dyn std::error::Error>> {
+) -> Result<Vec<AssociationRecord>, EvaluateError> {
     let mask = DropoutMask::new(
         sequence.measurement_count(),
         f64::from(percent) / 100.0,
@@ -174,7 +210,7 @@ fn missed_detection_records<P: DisplacementPredictor>(
                     mode_probabilities: None,
                 });
             } else {
-                records.push(kept.next().ok_or("missed-detection rows out of step")?);
+                records.push(kept.next().ok_or(EvaluateError::MissedDetectionRows)?);
             }
             flat += 1;
         }
@@ -188,7 +224,7 @@ fn write_plots(
     ground_truth: &[TrajectoryPoint],
     panels: &[TrajectoryPanel],
     sequence: &str,
-) -> Result<(), Box<dyn std::error::Error>> {
+) -> Result<(), EvaluateError> {
     std::fs::create_dir_all(dir)?;
     if !panels.is_empty() {
         let path = dir.join("trajectories.svg");

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Args as ClapArgs, ValueEnum};
 
-use primm_sim::io::write_sequence_file;
-use primm_sim::scenario::{format_table, Preset, ScenarioGenerator, Split, SplitSummary};
+use primm_sim::io::{write_sequence_file, CsvError};
+use primm_sim::scenario::{format_table, ConfigError, Preset, ScenarioGenerator, Split, SplitSummary};
 
 /// Which splits to generate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -74,8 +74,27 @@ pub struct Args {
     pub duration_s: Option<f64>,
 }
 
+/// Why `primm generate` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum GenerateError {
+    /// The options make an invalid scenario configuration.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// A split's output directory could not be created.
+    #[error("cannot create {}: {source}", path.display())]
+    CreateDir {
+        /// The directory.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// A sequence could not be written.
+    #[error(transparent)]
+    Write(#[from] CsvError),
+}
+
 /// Runs `primm generate`: writes the CSV files and prints the per-split counts.
-pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+pub fn run(args: &Args) -> Result<(), GenerateError> {
     let mut config = Preset::from(args.preset).config();
     if let Some(seed_base) = args.seed_base {
         config.splits.seed_base = seed_base;
@@ -97,7 +116,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let mut summaries = Vec::new();
     for split in splits {
         let dir = args.output.join(split.name());
-        std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(&dir)
+            .map_err(|source| GenerateError::CreateDir { path: dir.clone(), source })?;
         let mut summary = SplitSummary::new(split);
         for generated in generator.split_sequences(split) {
             let path = dir.join(format!("{}.csv", generated.sequence.name));

@@ -9,8 +9,10 @@
 use clap::Args as ClapArgs;
 use primm_core::mode::Method;
 use primm_sim::eval::{MethodEvaluator, MethodResult};
-use primm_sim::io::association_csv::{association_records_from_rows, read_association_rows};
-use primm_sim::io::{dataset_files, read_sequence_file};
+use primm_sim::io::association_csv::{
+    association_records_from_rows, read_association_rows, AssociationCsvError,
+};
+use primm_sim::io::{dataset_files, read_sequence_file, CsvError};
 use std::path::PathBuf;
 
 /// Arguments of `primm score`.
@@ -46,27 +48,59 @@ pub fn summary_json(name: &str, result: &MethodResult) -> serde_json::Value {
     })
 }
 
+/// Why `primm score` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ScoreError {
+    /// A measurement CSV file (or the data directory) could not be read.
+    #[error(transparent)]
+    Data(#[from] CsvError),
+    /// The data directory holds no measurement CSV file.
+    #[error("no measurement CSV files in {}", dir.display())]
+    NoData {
+        /// The data directory.
+        dir: PathBuf,
+    },
+    /// A data file path without a file name.
+    #[error("a data file without a name")]
+    Unnamed,
+    /// An association CSV file could not be opened.
+    #[error("cannot open {}: {source}", path.display())]
+    Open {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// An association CSV file is malformed or does not fit its sequence.
+    #[error("{}: {source}", path.display())]
+    Associations {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        source: AssociationCsvError,
+    },
+}
+
 /// Runs `primm score`: prints one JSON line.
-pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+pub fn run(args: &Args) -> Result<(), ScoreError> {
     let mut files = dataset_files(&args.data)?;
     if let Some(limit) = args.sequences {
         files.truncate(limit);
     }
     if files.is_empty() {
-        return Err(format!("no measurement CSV files in {}", args.data.display()).into());
+        return Err(ScoreError::NoData { dir: args.data.clone() });
     }
     // The method only labels the result; association rows carry no mode probabilities.
     let mut evaluator = MethodEvaluator::new(Method::Imm);
     for file in &files {
         let sequence = read_sequence_file(file)?;
-        let name = file.file_name().ok_or("a data file without a name")?;
+        let name = file.file_name().ok_or(ScoreError::Unnamed)?;
         let path = args.associations.join(name);
         let reader =
-            std::fs::File::open(&path).map_err(|e| format!("cannot open {}: {e}", path.display()))?;
-        let rows = read_association_rows(std::io::BufReader::new(reader))
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        let records = association_records_from_rows(&sequence, &rows)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+            std::fs::File::open(&path).map_err(|source| ScoreError::Open { path: path.clone(), source })?;
+        let associations = |source| ScoreError::Associations { path: path.clone(), source };
+        let rows = read_association_rows(std::io::BufReader::new(reader)).map_err(associations)?;
+        let records = association_records_from_rows(&sequence, &rows).map_err(associations)?;
         evaluator.add_sequence(&records);
     }
     println!("{}", summary_json(&args.name, evaluator.result()));

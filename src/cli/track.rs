@@ -3,12 +3,13 @@
 use clap::Args as ClapArgs;
 use primm_core::config::Config;
 use primm_core::mode::Method;
-use primm_core::tracker::Tracker;
+use primm_core::tracker::{StepError, Tracker};
+use primm_predictor::onnx::ModelError;
 use primm_predictor::predictor_for;
 use primm_sim::io::association_csv::AssociationCsvWriter;
-use primm_sim::io::read_sequence_file;
 use primm_sim::io::track_csv::TrackCsvWriter;
-use std::path::PathBuf;
+use primm_sim::io::{read_sequence_file, CsvError, TooManyMeasurements};
+use std::path::{Path, PathBuf};
 
 /// Arguments of `primm track`.
 #[derive(Debug, Clone, ClapArgs)]
@@ -41,8 +42,60 @@ pub struct Args {
     pub timing: Option<PathBuf>,
 }
 
+/// Why `primm track` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum TrackError {
+    /// The configuration file could not be read or is invalid.
+    #[error(transparent)]
+    Config(#[from] primm_config::ConfigError),
+    /// The learned predictor's model could not be loaded.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The configuration is invalid for the tracker.
+    #[error(transparent)]
+    Tracker(#[from] primm_core::config::ConfigError),
+    /// The measurement CSV file could not be read.
+    #[error(transparent)]
+    Input(#[from] CsvError),
+    /// A recorded frame carries more measurements than a frame may.
+    #[error(transparent)]
+    TooManyMeasurements(#[from] TooManyMeasurements),
+    /// An output file (tracks or associations) could not be created.
+    #[error("cannot create {}: {source}", path.display())]
+    Create {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The timing file could not be opened for appending.
+    #[error("cannot open {}: {source}", path.display())]
+    Open {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Writing an output file failed.
+    #[error(transparent)]
+    Write(#[from] std::io::Error),
+    /// The tracker rejected a frame.
+    #[error("frame {frame}: {source}")]
+    Step {
+        /// The frame's index in the recording.
+        frame: u64,
+        /// The tracker's error.
+        source: StepError,
+    },
+}
+
+/// Creates the output file `path`.
+fn create(path: &Path) -> Result<std::fs::File, TrackError> {
+    std::fs::File::create(path).map_err(|source| TrackError::Create { path: path.to_owned(), source })
+}
+
 /// Runs `primm track`.
-pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+pub fn run(args: &Args) -> Result<(), TrackError> {
     let config = match &args.config {
         Some(path) => primm_config::from_file(path)?,
         None => Config::default(),
@@ -51,13 +104,11 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let predictor = predictor_for(args.method, args.model.as_deref())?;
     let mut tracker = Tracker::with_predictor(config, predictor)?;
     let sequence = read_sequence_file(&args.input)?;
-    let file = std::fs::File::create(&args.output)
-        .map_err(|e| format!("cannot create {}: {e}", args.output.display()))?;
+    let file = create(&args.output)?;
     let mut writer = TrackCsvWriter::new(std::io::BufWriter::new(file))?;
     let mut associations = match &args.associations {
         Some(path) => {
-            let file =
-                std::fs::File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+            let file = create(path)?;
             Some(AssociationCsvWriter::new(std::io::BufWriter::new(file))?)
         }
         None => None,
@@ -67,7 +118,8 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     tracker.reset();
     for (recorded, frame) in sequence.frames.iter().zip(&frames) {
         let start = std::time::Instant::now();
-        let outputs = tracker.step(frame).map_err(|e| format!("frame {}: {e}", recorded.index))?;
+        let outputs =
+            tracker.step(frame).map_err(|source| TrackError::Step { frame: recorded.index, source })?;
         step_ns.push(start.elapsed().as_nanos() as u64);
         writer.write_frame(recorded.index, recorded.timestamp_s, outputs)?;
         if let Some(associations) = associations.as_mut() {
@@ -84,7 +136,7 @@ pub fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
             .create(true)
             .append(true)
             .open(path)
-            .map_err(|e| format!("cannot open {}: {e}", path.display()))?;
+            .map_err(|source| TrackError::Open { path: path.clone(), source })?;
         let mut out = std::io::BufWriter::new(file);
         for ns in &step_ns {
             writeln!(out, "{ns}")?;

@@ -105,12 +105,12 @@ pub enum SubscribeError {
     #[error("cannot receive: {0}")]
     Receive(ReceiveError),
     /// The CSV or JSON output could not be written.
-    #[error("cannot write {path}: {message}")]
+    #[error("cannot write {path}: {source}")]
     Output {
         /// The file.
         path: PathBuf,
-        /// What failed.
-        message: String,
+        /// The OS error.
+        source: std::io::Error,
     },
 }
 
@@ -338,7 +338,7 @@ impl Viewer {
         }
         if let Some((path, csv)) = &mut self.csv {
             write_track_frame(csv, frame)
-                .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+                .map_err(|source| SubscribeError::Output { path: path.clone(), source })?;
             self.summary.csv_rows = csv.rows();
         }
         if self.live && self.last_draw.elapsed() >= Duration::from_millis(200) {
@@ -403,8 +403,7 @@ impl Viewer {
 
     fn finish(mut self) -> Result<SubscriberSummary, SubscribeError> {
         if let Some((path, csv)) = &mut self.csv {
-            csv.flush()
-                .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+            csv.flush().map_err(|source| SubscribeError::Output { path: path.clone(), source })?;
         }
         let mut summary = self.summary;
         summary.accuracy = self.accuracy.as_mut().map(AccuracyMonitor::summary);
@@ -432,8 +431,7 @@ pub fn run(args: Args) -> Result<(), SubscribeError> {
     print!("{}", summary.text());
     if let Some(path) = &args.json {
         let json = serde_json::to_string_pretty(&summary).expect("the summary serialises");
-        std::fs::write(path, json)
-            .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+        std::fs::write(path, json).map_err(|source| SubscribeError::Output { path: path.clone(), source })?;
     }
     Ok(())
 }
@@ -486,9 +484,9 @@ type CsvOutput = (PathBuf, TrackCsvWriter<std::io::BufWriter<std::fs::File>>);
 fn open_csv(args: &Args) -> Result<Option<CsvOutput>, SubscribeError> {
     let Some(path) = &args.csv else { return Ok(None) };
     let file = std::fs::File::create(path)
-        .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+        .map_err(|source| SubscribeError::Output { path: path.clone(), source })?;
     let writer = TrackCsvWriter::new(std::io::BufWriter::new(file))
-        .map_err(|error| SubscribeError::Output { path: path.clone(), message: error.to_string() })?;
+        .map_err(|source| SubscribeError::Output { path: path.clone(), source })?;
     Ok(Some((path.clone(), writer)))
 }
 

@@ -26,6 +26,17 @@ impl ConfigError {
     }
 }
 
+/// Why [`ScenarioConfig::from_toml_str`] failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScenarioTomlError {
+    /// The text is not TOML, or does not describe a configuration (unknown field, wrong type).
+    #[error(transparent)]
+    Parse(#[from] toml::de::Error),
+    /// The configuration parsed but is inconsistent.
+    #[error(transparent)]
+    Invalid(#[from] ConfigError),
+}
+
 /// Complete generator configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -691,7 +702,7 @@ impl ScenarioConfig {
 
     /// Parses a configuration from TOML; missing fields take their default values. The result
     /// is validated.
-    pub fn from_toml_str(text: &str) -> Result<Self, Box<dyn std::error::Error + Send + Sync>> {
+    pub fn from_toml_str(text: &str) -> Result<Self, ScenarioTomlError> {
         let config: Self = toml::from_str(text)?;
         config.validate()?;
         Ok(config)

@@ -44,7 +44,8 @@ use serde::{Deserialize, Serialize};
 
 pub use config::{
     CarConfig, ConfigError, EgoConfig, Interval, PedestrianConfig, Preset, RadarConfig, RadarMount,
-    ReflectionConfig, RoadConfig, ScenarioConfig, SequenceConfig, SplitConfig, TrafficConfig,
+    ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig,
+    TrafficConfig,
 };
 pub use events::{
     count_events, EventCounts, CLOSE_PROXIMITY_DISTANCE_M, CROSSING_DISTANCE_M,
