@@ -105,10 +105,10 @@ impl PrimmTracker {
 
     /// Tracks one frame and keeps its tracks.
     fn step(&mut self, frame: &CallerFrame) -> Result<PrimmStepSummary, Failure> {
-        let before = *self.tracker.stats();
         let tracks = &mut self.tracks;
         let mut count = 0;
-        self.tracker
+        let summary = self
+            .tracker
             .step_into(frame, |output| {
                 if let Some(slot) = tracks.get_mut(count) {
                     *slot = PrimmTrack::from(output);
@@ -117,7 +117,7 @@ impl PrimmTracker {
             })
             .map_err(Failure::Step)?;
         self.track_count = count;
-        Ok(PrimmStepSummary::from_stats(&before, self.tracker.stats(), &self.tracks[..count]))
+        Ok(PrimmStepSummary::new(&summary, &self.tracks[..count]))
     }
 }
 

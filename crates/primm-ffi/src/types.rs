@@ -8,7 +8,7 @@ use primm_core::limits::{MAX_MEASUREMENTS_PER_FRAME, MAX_TRACKS};
 use primm_core::measurement::{Measurement, ObjectClass, UnknownClass};
 use primm_core::mode::{Method, MODE_COUNT};
 use primm_core::track::{TrackOutput, TrackStatus};
-use primm_core::tracker::TrackerStats;
+use primm_core::tracker::{StepSummary, TrackerStats};
 
 /// Most live tracks a tracker holds (the size of a buffer that always fits
 /// `primm_tracker_tracks`).
@@ -270,23 +270,18 @@ pub struct PrimmStepSummary {
 }
 
 impl PrimmStepSummary {
-    /// The summary of a step from the counters before and after it.
-    pub(crate) fn from_stats(before: &TrackerStats, after: &TrackerStats, tracks: &[PrimmTrack]) -> Self {
-        let delta = |f: fn(&TrackerStats) -> u64| (f(after) - f(before)) as usize;
+    /// The C form of the tracker's summary of a step whose tracks are `tracks`.
+    pub(crate) fn new(summary: &StepSummary, tracks: &[PrimmTrack]) -> Self {
         PrimmStepSummary {
             track_count: tracks.len(),
             updated_track_count: tracks
                 .iter()
                 .filter(|t| t.measurement_index != PRIMM_NO_MEASUREMENT_INDEX)
                 .count(),
-            measurements_accepted: delta(|s| s.measurements_accepted),
-            measurements_rejected: delta(|s| {
-                s.measurements_rejected_unknown_class
-                    + s.measurements_rejected_non_finite
-                    + s.measurements_rejected_out_of_range
-            }),
-            tracks_initiated: delta(|s| s.tracks_initiated),
-            tracks_deleted: delta(|s| s.tracks_deleted),
+            measurements_accepted: summary.measurements_accepted,
+            measurements_rejected: summary.measurements_rejected,
+            tracks_initiated: summary.initiated,
+            tracks_deleted: summary.deleted,
         }
     }
 }

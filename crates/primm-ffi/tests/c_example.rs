@@ -2,11 +2,11 @@
 //! `libprimm_ffi.a`, writes the same track CSV file as `primm track --method imm`, byte for
 //! byte.
 //!
-//! The static library is the one cargo built for this test run: `cargo build --lib -p
-//! primm-ffi` in the profile of the test (`test` for `cargo test`, `release` for `cargo test
-//! --release`), whose artifacts are already up to date, so the call only checks fingerprints.
-//! Its JSON messages name the `.a` file. Cargo releases the build-directory lock before it runs
-//! the test binaries, so the nested call does not wait for the outer one.
+//! The static library is the one cargo built for this test run: cargo builds every crate type of
+//! primm-ffi's library (`staticlib`, `cdylib`, `rlib`) before it links this test against it,
+//! into the directory of this test's executable. A nested `cargo build -p primm-ffi` would
+//! resolve features for primm-ffi alone, and since these library files carry no hash in their
+//! names, it would overwrite them and rebuild the dependency graph on every run.
 
 use primm_core::config::Config;
 use primm_core::mode::Method;
@@ -21,30 +21,12 @@ use std::time::Instant;
 
 const WORKSPACE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
-/// The path of `libprimm_ffi.a` of this test's profile, built (or found up to date) by cargo.
+/// The path of `libprimm_ffi.a` that cargo built with this test's executable.
 fn static_library() -> PathBuf {
-    let profile: &[&str] = if cfg!(debug_assertions) { &["--profile", "test"] } else { &["--release"] };
-    let output = Command::new(env!("CARGO"))
-        .current_dir(WORKSPACE)
-        .args(["build", "--offline", "--locked", "--lib", "-p", "primm-ffi", "--message-format=json"])
-        .args(profile)
-        .output()
-        .expect("cargo runs");
-    assert!(
-        output.status.success(),
-        "cargo build -p primm-ffi failed:\n{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let messages = String::from_utf8(output.stdout).expect("cargo's JSON is UTF-8");
-    messages
-        .lines()
-        .filter(|line| {
-            line.contains(r#""reason":"compiler-artifact""#) && line.contains(r#""name":"primm_ffi""#)
-        })
-        .flat_map(|line| line.split('"'))
-        .find(|part| part.ends_with("libprimm_ffi.a"))
-        .map(PathBuf::from)
-        .unwrap_or_else(|| panic!("cargo named no libprimm_ffi.a:\n{messages}"))
+    let executable = std::env::current_exe().expect("the test knows its executable");
+    let library = executable.with_file_name("libprimm_ffi.a");
+    assert!(library.is_file(), "cargo built no {} beside the test", library.display());
+    library
 }
 
 /// Compiles the example into `dir` and returns the executable.
