@@ -55,6 +55,7 @@ pub mod association;
 pub mod config;
 pub mod gaussian;
 pub mod imm;
+pub mod invariants;
 pub mod limits;
 mod math;
 pub mod measurement;
