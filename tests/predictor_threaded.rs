@@ -208,6 +208,25 @@ fn with_both_buffers_held_by_a_stalled_inference_frames_go_without_and_recover()
 }
 
 #[test]
+fn the_first_collect_that_has_to_wait_allocates_nothing() {
+    // Frame 0's batch (index 1) is held, so its collect blocks until the deadline: the first
+    // blocking wait of this thread on the return channel, whose one-off allocations the
+    // predictor made while it was built.
+    let (echo, gate) = Echo::gated(vec![1]);
+    let mut predictor = ThreadedPredictor::new(echo, Duration::from_millis(20)).unwrap();
+    let gate = gate;
+    let batch = requests(0, 3);
+    let mut out = vec![None; 3];
+    let allocations = crate::common::counting_allocator::count_allocations(|| {
+        predictor.submit(&batch);
+        predictor.collect(&mut out);
+    });
+    assert_eq!(predictor.stats().deadline_misses, 1);
+    assert_eq!(allocations, 0);
+    gate.release();
+}
+
+#[test]
 fn a_panicking_inference_costs_one_frame() {
     let mut echo = Echo::new();
     echo.panic_batches = vec![2];
