@@ -60,7 +60,7 @@ fn cpu_runs_the_wide_loops() -> bool {
 fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit() {
     let selected = track_loops::selected_version();
     assert!(
-        !track_loops::BASELINE_BUILT_WITH_AVX2,
+        !track_loops::baseline_built_with_avx2(),
         "primm-core's baseline was compiled with AVX2: the comparison would compare a build with itself"
     );
     if !cpu_runs_the_wide_loops() {

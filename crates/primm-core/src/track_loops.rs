@@ -126,7 +126,9 @@ pub enum LoopVersion {
 /// Whether the crate's baseline code was itself compiled with AVX2 (a build with
 /// `-C target-cpu=native` or `-C target-feature=+avx2`): then [`baseline`] is not the baseline
 /// and comparing it with the dispatched loops compares a build with itself.
-pub const BASELINE_BUILT_WITH_AVX2: bool = cfg!(target_feature = "avx2");
+pub fn baseline_built_with_avx2() -> bool {
+    cfg!(target_feature = "avx2")
+}
 
 /// The version of the loops the run-time dispatch picks on this CPU. It is dispatched over the
 /// same targets as the loops, so it picks what they pick.
