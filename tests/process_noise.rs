@@ -60,7 +60,7 @@ fn first_difference<const N: usize>(actual: &SMatrix<f64, N, N>, expected: &[[f6
 fn constant_velocity_closed_form(q: f64, dt: f64) -> [[f64; 4]; 4] {
     let (p, c, v) = (q * dt.powi(3) / 3.0, q * dt.powi(2) / 2.0, q * dt);
     [
-        // x     y    vx   vy
+        // Columns x, y, vx, vy.
         [p, 0.0, c, 0.0], // x
         [0.0, p, 0.0, c], // y
         [c, 0.0, v, 0.0], // vx
@@ -78,7 +78,7 @@ fn constant_acceleration_closed_form(q: f64, dt: f64) -> [[f64; 6]; 6] {
     let va = q * dt.powi(2) / 2.0;
     let aa = q * dt;
     [
-        // x    y    vx   vy   ax   ay
+        // Columns x, y, vx, vy, ax, ay.
         [pp, 0.0, pv, 0.0, pa, 0.0], // x
         [0.0, pp, 0.0, pv, 0.0, pa], // y
         [pv, 0.0, vv, 0.0, va, 0.0], // vx
@@ -94,7 +94,7 @@ fn constant_acceleration_closed_form(q: f64, dt: f64) -> [[f64; 6]; 6] {
 fn coordinated_turn_closed_form(q: f64, q_omega: f64, dt: f64) -> [[f64; 5]; 5] {
     let (p, c, v) = (q * dt.powi(3) / 3.0, q * dt.powi(2) / 2.0, q * dt);
     [
-        // x     y    vx   vy   ω
+        // Columns x, y, vx, vy, ω.
         [p, 0.0, c, 0.0, 0.0],              // x
         [0.0, p, 0.0, c, 0.0],              // y
         [c, 0.0, v, 0.0, 0.0],              // vx
