@@ -20,6 +20,7 @@
 pub mod replay;
 
 use crate::replay::{Pacing, ReplayError, ReplayOptions, Replayer};
+use primm_core::readable_number::readable;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::{read_dataset_dir, read_sequence_file, CsvError, Sequence};
@@ -90,7 +91,10 @@ pub enum PublishError {
     #[error(transparent)]
     Connect(#[from] ConnectError),
     /// No tracker served within the wait.
-    #[error("no tracker is serving '{service}' after {waited_s} s (start `primm serve` first)")]
+    #[error(
+        "no tracker is serving '{service}' after {} s (start `primm serve` first)",
+        readable(.waited_s)
+    )]
     NoTracker {
         /// The track service waited for.
         service: String,
@@ -161,6 +165,8 @@ pub fn run(args: Args) -> Result<(), PublishError> {
     }
     tracing::info!(
         frames_sent = summary.frames_sent,
+        frames_dropped = summary.frames_dropped,
+        frames_without_receiver = summary.frames_without_receiver,
         measurements_sent = summary.measurements_sent,
         passes = summary.passes,
         interrupted = summary.interrupted,
