@@ -194,11 +194,14 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         })
     }
 
-    /// Runs until `shutdown` is raised, then publishes a last latency report.
+    /// Runs until `shutdown` is raised, then tracks the frames already in the input buffer (at
+    /// most its 64, so that every frame delivered is either tracked or counted as lost) and
+    /// publishes a last latency report.
     pub fn run(&mut self, shutdown: &ShutdownFlag) -> Result<(), TrackingLoopError> {
         while !shutdown.is_requested() {
             self.poll(self.options.poll_timeout)?;
         }
+        self.drain()?;
         self.publish_latency_report();
         Ok(())
     }
