@@ -67,6 +67,11 @@ pub struct Args {
     /// Wait this long for a tracker to serve before sending (0: send at once).
     #[arg(long, default_value_t = 30.0, value_name = "S")]
     pub wait_for_tracker_s: f64,
+    /// Stay connected this long after the last frame (or until SIGINT/SIGTERM), s. iceoryx2
+    /// discards the frames of a publisher that disconnects before a subscriber took them, so a
+    /// tracker that is behind loses the replay's last frames unless the publisher lingers.
+    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    pub linger_s: f64,
     /// Prefix of the service names (`PREFIX/primm/...`).
     #[arg(long, env = SERVICE_PREFIX_ENV, default_value = "")]
     pub service_prefix: String,
@@ -172,5 +177,11 @@ pub fn run(args: Args) -> Result<(), PublishError> {
         interrupted = summary.interrupted,
         "replay finished"
     );
+    if args.linger_s > 0.0 && !summary.interrupted {
+        let until = std::time::Instant::now() + Duration::from_secs_f64(args.linger_s);
+        while std::time::Instant::now() < until && !shutdown.is_requested() {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
     Ok(())
 }
