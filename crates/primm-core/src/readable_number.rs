@@ -162,6 +162,7 @@ mod tests {
     #[test]
     fn a_reference_formats_like_the_value() {
         let interval_s = 1.0e300;
-        assert_eq!(readable(&interval_s), readable(interval_s));
+        let field: &f64 = &interval_s;
+        assert_eq!(readable(field), readable(interval_s));
     }
 }

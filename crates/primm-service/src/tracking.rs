@@ -392,18 +392,16 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         let first_from_publisher = self.stream.origin != Some(origin);
         let new_publisher = self.stream.origin.is_some() && first_from_publisher;
         let stream_start = frame.flags & FRAME_FLAG_STREAM_START != 0;
-        if stream_start || new_publisher {
-            if self.stream.tracker_dirty {
-                self.tracker.reset();
-                self.stream.tracker_dirty = false;
-                flags |= TRACK_FLAG_TRACKER_RESET;
-                if new_publisher {
-                    self.counters.resets_new_publisher += 1;
-                    tracing::info!(sequence = frame.sequence, "frames from a new publisher: tracker reset");
-                } else {
-                    self.counters.resets_stream_start += 1;
-                    tracing::info!(sequence = frame.sequence, "new stream: tracker reset");
-                }
+        if (stream_start || new_publisher) && self.stream.tracker_dirty {
+            self.tracker.reset();
+            self.stream.tracker_dirty = false;
+            flags |= TRACK_FLAG_TRACKER_RESET;
+            if new_publisher {
+                self.counters.resets_new_publisher += 1;
+                tracing::info!(sequence = frame.sequence, "frames from a new publisher: tracker reset");
+            } else {
+                self.counters.resets_stream_start += 1;
+                tracing::info!(sequence = frame.sequence, "new stream: tracker reset");
             }
         }
         if first_from_publisher {
