@@ -7,7 +7,7 @@
 
 use crate::common;
 
-use common::service::{spawn_collecting_stderr, unique_prefix, ChildGuard, Iceoryx2Domain};
+use common::service::{spawn_collecting_stderr, unique_prefix, wait_until, ChildGuard, Iceoryx2Domain};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::process::Stdio;
@@ -174,4 +174,37 @@ fn the_demo_reports_a_tracker_that_cannot_start_with_its_error_and_exit_status()
     assert!(!log.contains("did not come up"), "{log}");
     let leftovers = domain.resources();
     assert!(leftovers.is_empty(), "the failed demo left {leftovers:?}");
+}
+
+#[test]
+fn a_demo_killed_with_sigkill_leaves_no_processes_and_the_next_start_cleans_up() {
+    let domain = Iceoryx2Domain::new("demo_killed");
+    let demo = ChildGuard(
+        domain
+            .primm("warn")
+            .args(["demo", "--duration-s", "60", "--speed", "1"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    wait_until("the demo's processes come up", HANG_GUARD, || domain.processes() >= 3);
+    demo.signal(libc::SIGKILL);
+    let (status, _) = demo.wait(HANG_GUARD);
+    assert!(!status.success());
+    // The kernel sends each child SIGTERM when the demo dies; they stop on their own.
+    wait_until("the demo's children stop", HANG_GUARD, || domain.processes() == 0);
+
+    // Whatever the demo itself held (its node, if it was killed while watching the services)
+    // is removed by the next start.
+    let (serve, serve_log) = spawn_collecting_stderr(
+        domain.primm("info").args(["serve", "--service-prefix", "after-demo"]).stdout(Stdio::null()),
+    );
+    serve_log.wait_for("tracker serving", HANG_GUARD);
+    serve.signal(libc::SIGINT);
+    let (status, _) = serve.wait(HANG_GUARD);
+    assert!(status.success());
+    assert!(!serve_log.text().contains("could not remove"), "{}", serve_log.text());
+    let leftovers = domain.resources();
+    assert!(leftovers.is_empty(), "left: {leftovers:?}");
 }

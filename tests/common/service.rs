@@ -258,6 +258,20 @@ impl Iceoryx2Domain {
         found
     }
 
+    /// Processes running in this domain (by their environment), other than this one.
+    pub fn processes(&self) -> usize {
+        let marker = format!("PRIMM_ICEORYX2_DOMAIN={}", self.name);
+        let Ok(entries) = std::fs::read_dir("/proc") else { return 0 };
+        entries
+            .flatten()
+            .filter(|entry| entry.file_name().to_string_lossy().chars().all(|c| c.is_ascii_digit()))
+            .filter_map(|entry| std::fs::read(entry.path().join("environ")).ok())
+            .filter(|environment| {
+                environment.split(|&byte| byte == 0).any(|variable| variable == marker.as_bytes())
+            })
+            .count()
+    }
+
     /// A `primm` command in this domain, its logs at `log_level`.
     pub fn primm(&self, log_level: &str) -> Command {
         let mut command = Command::new(env!("CARGO_BIN_EXE_primm"));
