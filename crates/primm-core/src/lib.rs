@@ -62,6 +62,7 @@ pub mod measurement;
 pub mod mode;
 pub mod motion;
 pub mod predictor;
+pub mod readable_number;
 pub mod stage_timing;
 pub mod track;
 pub mod track_loops;
