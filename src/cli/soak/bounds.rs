@@ -111,3 +111,62 @@ pub fn check_bounds(tracks: &[Track], modes: ModeSet, max_tracks: usize) -> Resu
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use primm_core::imm::ImmState;
+    use primm_core::measurement::{Measurement, ObjectClass};
+    use primm_core::mode::Method;
+
+    /// A car track at (20 m, 1 m) moving 10 m/s in every mode, unit covariances.
+    fn track() -> Track {
+        let measurement = Measurement {
+            x_m: 20.0,
+            y_m: 1.0,
+            radial_velocity_mps: 3.0,
+            rcs_dbsm: 5.0,
+            class: ObjectClass::Car,
+            sensor_id: Some(0),
+            ground_truth_id: None,
+        };
+        let mut state = ImmState::default();
+        state.constant_velocity.mean[0] = 20.0;
+        state.constant_velocity.mean[2] = 10.0;
+        for i in 0..4 {
+            state.constant_velocity.covariance[(i, i)] = 1.0;
+        }
+        Track::new(1, &measurement, 0.0, state)
+    }
+
+    fn modes() -> ModeSet {
+        Method::ConstantVelocity.modes()
+    }
+
+    #[test]
+    fn a_sane_track_is_within_bounds() {
+        assert_eq!(check_bounds(&[track()], modes(), 1), Ok(()));
+    }
+
+    #[test]
+    fn a_runaway_position_velocity_or_covariance_is_named() {
+        let mut far = track();
+        far.estimate.constant_velocity.mean[1] = 2.0 * MAX_POSITION_M;
+        assert!(matches!(check_bounds(&[far], modes(), 1), Err(BoundViolation::Position { track_id: 1, .. })));
+        let mut fast = track();
+        fast.estimate.constant_velocity.mean[3] = f64::NAN;
+        assert!(matches!(check_bounds(&[fast], modes(), 1), Err(BoundViolation::Velocity { track_id: 1, .. })));
+        let mut uncertain = track();
+        uncertain.estimate.constant_velocity.covariance[(2, 2)] = 2.0 * MAX_COVARIANCE_TRACE;
+        assert!(matches!(
+            check_bounds(&[uncertain], modes(), 1),
+            Err(BoundViolation::CovarianceTrace { track_id: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn more_tracks_than_the_bound_is_a_violation() {
+        let tracks = [track(), track()];
+        assert_eq!(check_bounds(&tracks, modes(), 1), Err(BoundViolation::TrackCount { count: 2, bound: 1 }));
+    }
+}
