@@ -98,18 +98,23 @@ pub fn check_bounds(tracks: &[Track], modes: ModeSet, max_tracks: usize) -> Resu
                     ([m[0], m[1]], [m[2], m[3]], state.coordinated_turn.covariance.trace())
                 }
             };
-            if position.iter().any(|v| !(v.abs() <= MAX_POSITION_M)) {
+            if position.iter().any(|v| !within(*v, MAX_POSITION_M)) {
                 return Err(BoundViolation::Position { track_id, mode });
             }
-            if velocity.iter().any(|v| !(v.abs() <= MAX_VELOCITY_MPS)) {
+            if velocity.iter().any(|v| !within(*v, MAX_VELOCITY_MPS)) {
                 return Err(BoundViolation::Velocity { track_id, mode });
             }
-            if !(trace <= MAX_COVARIANCE_TRACE) {
+            if !within(trace, MAX_COVARIANCE_TRACE) {
                 return Err(BoundViolation::CovarianceTrace { track_id, mode, trace });
             }
         }
     }
     Ok(())
+}
+
+/// Whether `value` is a number of magnitude at most `bound` (NaN is not).
+fn within(value: f64, bound: f64) -> bool {
+    value.abs() <= bound
 }
 
 #[cfg(test)]
@@ -152,10 +157,16 @@ mod tests {
     fn a_runaway_position_velocity_or_covariance_is_named() {
         let mut far = track();
         far.estimate.constant_velocity.mean[1] = 2.0 * MAX_POSITION_M;
-        assert!(matches!(check_bounds(&[far], modes(), 1), Err(BoundViolation::Position { track_id: 1, .. })));
+        assert!(matches!(
+            check_bounds(&[far], modes(), 1),
+            Err(BoundViolation::Position { track_id: 1, .. })
+        ));
         let mut fast = track();
         fast.estimate.constant_velocity.mean[3] = f64::NAN;
-        assert!(matches!(check_bounds(&[fast], modes(), 1), Err(BoundViolation::Velocity { track_id: 1, .. })));
+        assert!(matches!(
+            check_bounds(&[fast], modes(), 1),
+            Err(BoundViolation::Velocity { track_id: 1, .. })
+        ));
         let mut uncertain = track();
         uncertain.estimate.constant_velocity.covariance[(2, 2)] = 2.0 * MAX_COVARIANCE_TRACE;
         assert!(matches!(
