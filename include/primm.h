@@ -224,10 +224,17 @@ typedef struct PrimmStats {
   uint64_t tracks_deleted;
   // Unassigned measurements that could not start a track because the table was full.
   uint64_t initiations_refused_table_full;
-  // Track-frames in which the learned predictor gave no displacement (PR sat out).
+  // Track-frames in which the PR mode had no usable learned displacement and sat out (none
+  // given, or rejected).
   uint64_t learned_predictions_missing;
-  // Frames in which at least one track had no learned displacement.
+  // Frames in which at least one track had no usable learned displacement.
   uint64_t frames_with_learned_predictions_missing;
+  // Learned displacements rejected for a NaN or infinite component (included in
+  // `learned_predictions_missing`).
+  uint64_t learned_predictions_rejected_non_finite;
+  // Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
+  // (included in `learned_predictions_missing`).
+  uint64_t learned_predictions_rejected_implausible;
   // Kalman updates refused for numerical reasons (the track coasted instead).
   uint64_t update_failures;
   // Calls to `primm_tracker_reset`.

@@ -31,6 +31,8 @@ enum Command {
     Eval(cli::eval::Args),
     /// Score association CSV files written by any tracker with the metrics of `eval`.
     Score(cli::score::Args),
+    /// Run the tracker over a long synthetic scene, checking it after every frame.
+    Soak(cli::soak::Args),
 }
 
 /// Why a subcommand failed: its own error.
@@ -60,6 +62,9 @@ enum CommandError {
     /// `primm score` failed.
     #[error(transparent)]
     Score(#[from] cli::score::ScoreError),
+    /// `primm soak` failed.
+    #[error(transparent)]
+    Soak(#[from] cli::soak::SoakError),
 }
 
 fn main() -> ExitCode {
@@ -74,6 +79,7 @@ fn main() -> ExitCode {
         Command::Track(args) => cli::track::run(&args).map_err(Into::into),
         Command::Eval(args) => cli::eval::run(&args).map_err(Into::into),
         Command::Score(args) => cli::score::run(&args).map_err(Into::into),
+        Command::Soak(args) => cli::soak::run(&args).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

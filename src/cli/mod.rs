@@ -7,4 +7,5 @@ pub mod eval;
 pub mod generate;
 pub mod score;
 pub mod serve;
+pub mod soak;
 pub mod track;

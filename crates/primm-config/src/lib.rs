@@ -129,6 +129,15 @@ mod tests {
     }
 
     #[test]
+    fn a_predictor_section_without_the_speed_bound_takes_its_default_and_a_bad_bound_is_named() {
+        let without = DEFAULT_CONFIG_TOML.replace("max_displacement_speed_mps = 100.0", "");
+        assert_eq!(from_toml_str(&without).unwrap().predictor, PredictorConfig::default());
+        let text = DEFAULT_CONFIG_TOML
+            .replace("max_displacement_speed_mps = 100.0", "max_displacement_speed_mps = -3.0");
+        assert_eq!(invalid_key(&text), "predictor.max_displacement_speed_mps");
+    }
+
+    #[test]
     fn a_missing_file_names_the_file() {
         let error = from_file(Path::new("/nonexistent/primm.toml")).unwrap_err();
         assert!(error.to_string().contains("/nonexistent/primm.toml"), "{error}");

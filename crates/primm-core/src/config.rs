@@ -33,24 +33,33 @@ pub struct Config {
     pub predictor: PredictorConfig,
 }
 
-/// Runtime of the learned predictor in the tracking service (`primm serve`): the model runs on
-/// a dedicated inference thread while the tracker predicts the physics modes, and the tracker
-/// waits for its batch at most this long. Offline tracking (`primm track`, `primm eval`) runs
-/// the model synchronously and ignores the deadline, so that its results do not depend on
-/// timing.
+/// The learned predictor's runtime and the check of its answers.
+///
+/// * `deadline_ms` applies in the tracking service (`primm serve`): the model runs on a
+///   dedicated inference thread while the tracker predicts the physics modes, and the tracker
+///   waits for its batch at most this long. Offline tracking (`primm track`, `primm eval`) runs
+///   the model synchronously and ignores the deadline, so that its results do not depend on
+///   timing.
+/// * `max_displacement_speed_mps` applies wherever the tracker runs: every displacement a
+///   predictor returns is checked against it before the PR mode uses it
+///   (`crates/primm-core/src/displacement_check.rs`).
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
 pub struct PredictorConfig {
     /// Longest wait for a frame's learned displacements, measured from the moment the batch is
     /// handed to the inference thread, ms. A frame whose batch is late is tracked without the
     /// PR mode (it sits the frame out; see `src/imm.rs`).
     pub deadline_ms: f64,
+    /// Fastest motion a learned displacement may imply, m/s: a displacement longer than this
+    /// speed times the step's duration (`prediction_time_s − step_start_s` of its request) is
+    /// rejected as implausible and counted, and the PR mode sits the frame out for that track.
+    pub max_displacement_speed_mps: f64,
 }
 
 impl Default for PredictorConfig {
     fn default() -> Self {
-        Self { deadline_ms: 5.0 }
+        Self { deadline_ms: 5.0, max_displacement_speed_mps: 100.0 }
     }
 }
 
@@ -445,6 +454,7 @@ fn validate_tracker_and_predictor(
     if predictor.deadline_ms > 1000.0 {
         return Err(invalid("predictor.deadline_ms", "must be at most 1000 ms (one second)"));
     }
+    positive("predictor.max_displacement_speed_mps", predictor.max_displacement_speed_mps)?;
     positive("tracker.max_coast_s", tracker.max_coast_s)?;
     positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
     if tracker.confirmation_hits == 0 {
@@ -564,5 +574,14 @@ mod tests {
             assert_eq!(invalid_key(&config), "predictor.deadline_ms", "deadline {bad}");
         }
         assert_eq!(Config::default().predictor.deadline(), core::time::Duration::from_millis(5));
+    }
+
+    #[test]
+    fn a_non_positive_or_non_finite_displacement_speed_bound_is_rejected() {
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            let mut config = Config::default();
+            config.predictor.max_displacement_speed_mps = bad;
+            assert_eq!(invalid_key(&config), "predictor.max_displacement_speed_mps", "bound {bad}");
+        }
     }
 }

@@ -53,6 +53,7 @@ extern crate alloc;
 
 pub mod association;
 pub mod config;
+pub mod displacement_check;
 pub mod gaussian;
 pub mod imm;
 pub mod invariants;

@@ -11,6 +11,7 @@
 use crate::association::assignment::AssignmentError;
 use crate::association::associator::{AssociationStats, Associator};
 use crate::config::{Config, ConfigError};
+use crate::displacement_check::{check_displacement, DisplacementRejection};
 use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
@@ -69,10 +70,18 @@ pub struct TrackerStats {
     pub tracks_deleted: u64,
     /// Unassigned measurements that could not start a track because the table was full.
     pub initiations_refused_table_full: u64,
-    /// Track-frames in which the learned predictor gave no displacement (PR sat out).
+    /// Track-frames in which the PR mode had no usable learned displacement and sat out: the
+    /// predictor gave none (missed deadline, failed or hung inference) or its answer was
+    /// rejected (the next two counters).
     pub learned_predictions_missing: u64,
-    /// Frames in which at least one track had no learned displacement.
+    /// Frames in which at least one track had no usable learned displacement.
     pub frames_with_learned_predictions_missing: u64,
+    /// Learned displacements rejected for a NaN or infinite component (included in
+    /// `learned_predictions_missing`).
+    pub learned_predictions_rejected_non_finite: u64,
+    /// Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
+    /// (included in `learned_predictions_missing`).
+    pub learned_predictions_rejected_implausible: u64,
     /// Kalman updates refused for numerical reasons (the track coasted instead).
     pub update_failures: u64,
     /// Calls to [`Tracker::reset`].
@@ -102,8 +111,13 @@ pub struct StepSummary {
     pub update_failures: usize,
     /// Tracks deleted.
     pub deleted: usize,
-    /// Tracks for which the learned predictor gave no displacement (PR sat out).
+    /// Tracks for which the PR mode had no usable learned displacement and sat out (none given,
+    /// or rejected: the next two counts).
     pub predictions_missing: usize,
+    /// Learned displacements rejected for a NaN or infinite component.
+    pub predictions_rejected_non_finite: usize,
+    /// Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`.
+    pub predictions_rejected_implausible: usize,
     /// Live tracks after the step: the number of outputs reported.
     pub live_tracks: usize,
     /// Confirmed tracks among the live ones.
@@ -122,6 +136,8 @@ impl TrackerStats {
         self.initiations_refused_table_full += count(step.initiations_refused_table_full);
         self.learned_predictions_missing += count(step.predictions_missing);
         self.frames_with_learned_predictions_missing += u64::from(step.predictions_missing > 0);
+        self.learned_predictions_rejected_non_finite += count(step.predictions_rejected_non_finite);
+        self.learned_predictions_rejected_implausible += count(step.predictions_rejected_implausible);
         self.update_failures += count(step.update_failures);
     }
 }
@@ -361,7 +377,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
         );
     }
 
-    /// Collects the displacements; the PR priors and the fused priors (`eq:prior_fusion`).
+    /// Collects and checks the displacements (`displacement_check.rs`); the PR priors and the
+    /// fused priors (`eq:prior_fusion`).
     fn fuse_priors(&mut self) {
         let count = self.table.len();
         let displacements = &mut self.displacements[..count];
@@ -369,6 +386,21 @@ impl<P: DisplacementPredictor> Tracker<P> {
             displacements.fill(None);
         } else {
             self.predictor.collect(displacements);
+            let max_speed_mps = self.config.predictor.max_displacement_speed_mps;
+            for (displacement, request) in displacements.iter_mut().zip(self.requests.iter()) {
+                let Some(value) = *displacement else { continue };
+                match check_displacement(request, value, max_speed_mps) {
+                    Ok(_) => {}
+                    Err(DisplacementRejection::NonFinite) => {
+                        self.last_step.predictions_rejected_non_finite += 1;
+                        *displacement = None;
+                    }
+                    Err(DisplacementRejection::Implausible) => {
+                        self.last_step.predictions_rejected_implausible += 1;
+                        *displacement = None;
+                    }
+                }
+            }
             self.last_step.predictions_missing = displacements.iter().filter(|d| d.is_none()).count();
         }
         track_loops::complete_priors(

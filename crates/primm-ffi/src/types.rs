@@ -334,10 +334,17 @@ pub struct PrimmStats {
     pub tracks_deleted: u64,
     /// Unassigned measurements that could not start a track because the table was full.
     pub initiations_refused_table_full: u64,
-    /// Track-frames in which the learned predictor gave no displacement (PR sat out).
+    /// Track-frames in which the PR mode had no usable learned displacement and sat out (none
+    /// given, or rejected).
     pub learned_predictions_missing: u64,
-    /// Frames in which at least one track had no learned displacement.
+    /// Frames in which at least one track had no usable learned displacement.
     pub frames_with_learned_predictions_missing: u64,
+    /// Learned displacements rejected for a NaN or infinite component (included in
+    /// `learned_predictions_missing`).
+    pub learned_predictions_rejected_non_finite: u64,
+    /// Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
+    /// (included in `learned_predictions_missing`).
+    pub learned_predictions_rejected_implausible: u64,
     /// Kalman updates refused for numerical reasons (the track coasted instead).
     pub update_failures: u64,
     /// Calls to `primm_tracker_reset`.
@@ -363,6 +370,8 @@ impl From<&TrackerStats> for PrimmStats {
             initiations_refused_table_full,
             learned_predictions_missing,
             frames_with_learned_predictions_missing,
+            learned_predictions_rejected_non_finite,
+            learned_predictions_rejected_implausible,
             update_failures,
             resets,
         } = *stats;
@@ -382,6 +391,8 @@ impl From<&TrackerStats> for PrimmStats {
             initiations_refused_table_full,
             learned_predictions_missing,
             frames_with_learned_predictions_missing,
+            learned_predictions_rejected_non_finite,
+            learned_predictions_rejected_implausible,
             update_failures,
             resets,
         }

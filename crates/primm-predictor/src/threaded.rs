@@ -17,9 +17,33 @@
 //!
 //! * A buffer that comes back with an older sequence number (a batch that missed its deadline)
 //!   is stale: its results are discarded and the buffer is reused.
-//! * A missed deadline, a failed or panicking inference, more requests than a buffer holds, or
-//!   no free buffer (both still with a slow inference thread) give `None` for every track of
-//!   that frame only: the PR mode sits the frame out and the next frame starts afresh.
+//! * A missed deadline, more requests than a buffer holds, or no free buffer (both still with a
+//!   slow inference thread) give `None` for every track of that frame only: the PR mode sits the
+//!   frame out and the next frame starts afresh.
+//!
+//! # Faults of the wrapped predictor
+//!
+//! * **Panic.** The inference thread catches it, returns the batch without results and stops:
+//!   after an unwinding panic the predictor's state is unknown, and a predictor that answers
+//!   wrongly is worse than none. Every later frame goes without learned displacements, counted
+//!   in [`ThreadedPredictorStats::frames_without_inference_thread`]; the panic is counted in
+//!   [`ThreadedPredictorStats::inference_panics`] and logged. The process carries on.
+//! * **Hang.** A batch that stays with the inference thread for the hang threshold or longer
+//!   ([`DEFAULT_HANG_THRESHOLD`], [`set_hang_threshold`](ThreadedPredictor::set_hang_threshold))
+//!   marks the thread hung: counted once per episode in
+//!   [`ThreadedPredictorStats::inference_hangs_detected`], logged, and visible in
+//!   [`is_inference_thread_hung`](ThreadedPredictor::is_inference_thread_hung). Meanwhile frames
+//!   go without learned displacements (deadline misses, then no free buffer) and never wait
+//!   longer than the deadline. Should the batch come back after all, the episode ends
+//!   ([`ThreadedPredictorStats::inference_hang_recoveries`]) and the next frames use the model
+//!   again.
+//! * **Shutdown.** Dropping the predictor (or [`shutdown`](ThreadedPredictor::shutdown)) closes
+//!   the work channel and waits at most the shutdown wait ([`DEFAULT_SHUTDOWN_WAIT`],
+//!   [`set_shutdown_wait`](ThreadedPredictor::set_shutdown_wait)) for the thread to finish. A
+//!   thread still busy then is detached and logged: it ends by itself if its batch ever
+//!   finishes, and with the process otherwise; the wrapped predictor is then never dropped.
+//! * Wrong answers (NaN, infinite, absurd displacements) pass through unchanged: the tracker
+//!   checks every displacement (`primm_core::displacement_check`).
 //!
 //! This is the one part of primm that reads a clock (for the deadline): with it, whether a
 //! frame gets its learned displacements depends on timing. Offline tracking and evaluation use
@@ -43,6 +67,18 @@ const BUFFERS: usize = 2;
 /// that the wait really blocks (it returns at once only if the thread was descheduled for
 /// longer than this between starting the wait and checking its deadline).
 const WAIT_PRIMING: Duration = Duration::from_millis(50);
+
+/// Sequence number of the warm-up batch.
+const WARM_UP_SEQUENCE: u64 = u64::MAX;
+
+/// How long a batch may stay with the inference thread before the thread is reported hung,
+/// unless [`ThreadedPredictor::set_hang_threshold`] says otherwise. Also the longest wait for
+/// the warm-up round trip in [`ThreadedPredictor::new`].
+pub const DEFAULT_HANG_THRESHOLD: Duration = Duration::from_secs(1);
+
+/// How long dropping a [`ThreadedPredictor`] waits for its inference thread to finish before
+/// detaching it, unless [`ThreadedPredictor::set_shutdown_wait`] says otherwise.
+pub const DEFAULT_SHUTDOWN_WAIT: Duration = Duration::from_secs(1);
 
 /// One batch in flight: requests in, displacements out.
 struct Batch {
@@ -81,10 +117,26 @@ pub struct ThreadedPredictorStats {
     pub frames_without_free_buffer: u64,
     /// Frames not submitted because they had more requests than a buffer holds.
     pub frames_too_large: u64,
-    /// Batches in which the wrapped predictor panicked.
+    /// Batches in which the wrapped predictor panicked (the thread stops after the first).
     pub inference_panics: u64,
-    /// Frames not submitted because the inference thread is gone.
+    /// Frames not submitted because the inference thread is gone (after a panic).
     pub frames_without_inference_thread: u64,
+    /// Times the inference thread was found hung: a batch with it for at least the hang
+    /// threshold (one count per episode).
+    pub inference_hangs_detected: u64,
+    /// Hang episodes that ended because the batch came back after all.
+    pub inference_hang_recoveries: u64,
+}
+
+/// How [`ThreadedPredictor::shutdown`] ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShutdownOutcome {
+    /// The inference thread finished within the shutdown wait and was joined.
+    Joined,
+    /// The inference thread was still busy after the shutdown wait and was detached.
+    Detached,
+    /// There was no inference thread left to stop (already shut down).
+    AlreadyStopped,
 }
 
 /// Runs a [`DisplacementPredictor`] on a dedicated inference thread, with a deadline per frame.
@@ -98,6 +150,14 @@ pub struct ThreadedPredictor {
     next_sequence: u64,
     /// The batch of the current frame: its sequence number and deadline.
     awaited: Option<(u64, Instant)>,
+    /// Batches with the inference thread: sequence number and when each was handed over.
+    in_flight: [Option<(u64, Instant)>; BUFFERS],
+    hang_threshold: Duration,
+    shutdown_wait: Duration,
+    /// Whether a hang episode is going on.
+    hung: bool,
+    /// Whether the inference thread has stopped (after a panic) or is unreachable.
+    thread_gone: bool,
     stats: ThreadedPredictorStats,
 }
 
@@ -144,39 +204,141 @@ impl ThreadedPredictor {
             capacity,
             next_sequence: 0,
             awaited: None,
+            in_flight: [None; BUFFERS],
+            hang_threshold: DEFAULT_HANG_THRESHOLD,
+            shutdown_wait: DEFAULT_SHUTDOWN_WAIT,
+            hung: false,
+            thread_gone: false,
             stats: ThreadedPredictorStats::default(),
         };
         threaded.warm_up();
         Ok(threaded)
     }
 
-    /// One empty round trip (not counted in the statistics), waiting as long as it takes; then
-    /// one wait on the empty return channel.
+    /// One empty round trip (not counted in the statistics), waiting at most
+    /// [`DEFAULT_HANG_THRESHOLD`] (a predictor that does not answer even an empty batch leaves
+    /// the buffer with its thread, which is then reported hung); then one wait on the empty
+    /// return channel.
     ///
     /// The first time a thread blocks on a channel, std allocates (the thread's wait context
     /// and the channel's list of waiters). The round trip blocks only if the answer is not back
     /// yet, which depends on scheduling, so a wait on the empty channel makes sure those
     /// allocations happen here, on the thread that builds the predictor, instead of in the
-    /// first `collect` that has to wait.
+    /// first `collect` that has to wait. A late warm-up answer arriving meanwhile is reclaimed.
     fn warm_up(&mut self) {
         self.round_trip();
-        let _ = self.from_worker.recv_timeout(WAIT_PRIMING);
+        if let Ok(batch) = self.from_worker.recv_timeout(WAIT_PRIMING) {
+            self.reclaim(batch);
+        }
     }
 
     /// See [`warm_up`](Self::warm_up).
     fn round_trip(&mut self) {
         let Some(mut batch) = self.free[0].take() else { return };
         batch.len = 0;
-        batch.sequence = u64::MAX;
+        batch.sequence = WARM_UP_SEQUENCE;
+        let started = Instant::now();
         let sent = self.to_worker.as_ref().map(|tx| tx.send(batch));
         match sent {
             Some(Ok(())) => {
-                if let Ok(batch) = self.from_worker.recv_timeout(Duration::from_secs(3600)) {
-                    self.free[0] = Some(batch);
+                self.in_flight[0] = Some((WARM_UP_SEQUENCE, started));
+                match self.from_worker.recv_timeout(DEFAULT_HANG_THRESHOLD) {
+                    Ok(batch) => self.reclaim(batch),
+                    Err(RecvTimeoutError::Timeout) => self.check_hang(Instant::now()),
+                    Err(RecvTimeoutError::Disconnected) => self.thread_gone = true,
                 }
             }
-            Some(Err(returned)) => self.free[0] = Some(returned.0),
+            Some(Err(returned)) => {
+                self.free[0] = Some(returned.0);
+                self.thread_gone = true;
+            }
             None => {}
+        }
+    }
+
+    /// Whether a batch has been with the inference thread for at least the hang threshold
+    /// (as of the latest `submit` or `collect`).
+    pub fn is_inference_thread_hung(&self) -> bool {
+        self.hung
+    }
+
+    /// How long a batch may stay with the inference thread before the thread is reported hung.
+    pub fn hang_threshold(&self) -> Duration {
+        self.hang_threshold
+    }
+
+    /// Changes the hang threshold (applies from the next `submit` or `collect`).
+    pub fn set_hang_threshold(&mut self, threshold: Duration) {
+        self.hang_threshold = threshold;
+    }
+
+    /// Changes how long dropping the predictor waits for the inference thread before detaching
+    /// it.
+    pub fn set_shutdown_wait(&mut self, wait: Duration) {
+        self.shutdown_wait = wait;
+    }
+
+    /// Stops the inference thread: closes its work channel and waits at most the shutdown wait
+    /// for it to finish; a thread still busy then is detached (and logged). Dropping the
+    /// predictor does the same.
+    pub fn shutdown(mut self) -> ShutdownOutcome {
+        self.stop()
+    }
+
+    /// The work of [`shutdown`](Self::shutdown) and `drop`.
+    fn stop(&mut self) -> ShutdownOutcome {
+        // Closing the work channel ends the inference loop once its current batch is done; its
+        // end drops the result channel's sender, which `recv_timeout` reports as disconnected.
+        self.to_worker = None;
+        let Some(worker) = self.worker.take() else { return ShutdownOutcome::AlreadyStopped };
+        let until = Instant::now() + self.shutdown_wait;
+        loop {
+            let now = Instant::now();
+            let received = if now >= until {
+                self.from_worker.try_recv().map_err(|error| match error {
+                    TryRecvError::Empty => RecvTimeoutError::Timeout,
+                    TryRecvError::Disconnected => RecvTimeoutError::Disconnected,
+                })
+            } else {
+                self.from_worker.recv_timeout(until - now)
+            };
+            match received {
+                Ok(_returned) => {}
+                Err(RecvTimeoutError::Disconnected) => {
+                    let _ = worker.join();
+                    return ShutdownOutcome::Joined;
+                }
+                Err(RecvTimeoutError::Timeout) => {
+                    tracing::error!(
+                        thread = INFERENCE_THREAD_NAME,
+                        waited_ms = self.shutdown_wait.as_secs_f64() * 1000.0,
+                        "inference thread still busy at shutdown; detached"
+                    );
+                    drop(worker);
+                    return ShutdownOutcome::Detached;
+                }
+            }
+        }
+    }
+
+    /// Starts a hang episode when a batch has been with the inference thread for at least
+    /// the hang threshold at `now`.
+    fn check_hang(&mut self, now: Instant) {
+        if self.hung {
+            return;
+        }
+        let oldest = self.in_flight.iter().flatten().map(|&(_, handed_over)| handed_over).min();
+        let Some(oldest) = oldest else { return };
+        let held = now.saturating_duration_since(oldest);
+        if held >= self.hang_threshold {
+            self.hung = true;
+            self.stats.inference_hangs_detected += 1;
+            tracing::error!(
+                thread = INFERENCE_THREAD_NAME,
+                held_ms = held.as_secs_f64() * 1000.0,
+                threshold_ms = self.hang_threshold.as_secs_f64() * 1000.0,
+                "inference thread hung: a batch is overdue; frames go without learned displacements"
+            );
         }
     }
 
@@ -205,11 +367,31 @@ impl ThreadedPredictor {
         }
     }
 
-    /// Puts a returned buffer back into the free pool; counts it stale if nobody awaits it.
+    /// Puts a returned buffer back into the free pool; counts it stale if nobody awaits it,
+    /// and a panic if the inference did not complete; ends a hang episode once no batch is
+    /// overdue any more.
     fn reclaim(&mut self, batch: Box<Batch>) {
         let awaited = self.awaited.map(|(sequence, _)| sequence);
-        if awaited != Some(batch.sequence) && batch.sequence != u64::MAX {
+        if awaited != Some(batch.sequence) && batch.sequence != WARM_UP_SEQUENCE {
             self.stats.stale_batches_discarded += 1;
+        }
+        if !batch.completed {
+            self.stats.inference_panics += 1;
+            self.thread_gone = true;
+            tracing::error!(
+                thread = INFERENCE_THREAD_NAME,
+                "learned predictor panicked; it is retired and later frames go without learned displacements"
+            );
+        }
+        if let Some(entry) =
+            self.in_flight.iter_mut().find(|entry| entry.is_some_and(|(s, _)| s == batch.sequence))
+        {
+            *entry = None;
+        }
+        if self.hung && self.in_flight.iter().all(Option::is_none) {
+            self.hung = false;
+            self.stats.inference_hang_recoveries += 1;
+            tracing::warn!(thread = INFERENCE_THREAD_NAME, "inference thread answered again after a hang");
         }
         if let Some(slot) = self.free.iter_mut().find(|slot| slot.is_none()) {
             *slot = Some(batch);
@@ -222,6 +404,12 @@ impl DisplacementPredictor for ThreadedPredictor {
         self.awaited = None;
         self.reclaim_returned();
         if requests.is_empty() {
+            return;
+        }
+        let now = Instant::now();
+        self.check_hang(now);
+        if self.thread_gone {
+            self.stats.frames_without_inference_thread += 1;
             return;
         }
         if requests.len() > self.capacity {
@@ -242,7 +430,10 @@ impl DisplacementPredictor for ThreadedPredictor {
         match to_worker.try_send(batch) {
             Ok(()) => {
                 self.stats.batches_submitted += 1;
-                self.awaited = Some((self.next_sequence, Instant::now() + self.deadline));
+                self.awaited = Some((self.next_sequence, now + self.deadline));
+                if let Some(entry) = self.in_flight.iter_mut().find(|entry| entry.is_none()) {
+                    *entry = Some((self.next_sequence, now));
+                }
             }
             Err(TrySendError::Full(batch)) => {
                 // Cannot happen with one channel slot per buffer; keep the buffer regardless.
@@ -251,6 +442,7 @@ impl DisplacementPredictor for ThreadedPredictor {
             }
             Err(TrySendError::Disconnected(batch)) => {
                 self.reclaim(batch);
+                self.thread_gone = true;
                 self.stats.frames_without_inference_thread += 1;
             }
         }
@@ -276,8 +468,6 @@ impl DisplacementPredictor for ThreadedPredictor {
                         let n = batch.len.min(displacements.len());
                         displacements[..n].copy_from_slice(&batch.displacements[..n]);
                         self.stats.batches_on_time += 1;
-                    } else {
-                        self.stats.inference_panics += 1;
                     }
                     self.reclaim(batch);
                     self.awaited = None;
@@ -287,10 +477,12 @@ impl DisplacementPredictor for ThreadedPredictor {
                 Err(RecvTimeoutError::Timeout) => {
                     self.stats.deadline_misses += 1;
                     self.awaited = None;
+                    self.check_hang(Instant::now());
                     return;
                 }
                 Err(RecvTimeoutError::Disconnected) => {
                     self.stats.frames_without_inference_thread += 1;
+                    self.thread_gone = true;
                     self.awaited = None;
                     return;
                 }
@@ -302,7 +494,8 @@ impl DisplacementPredictor for ThreadedPredictor {
         let s = &self.stats;
         Some(format!(
             "learned predictor (inference thread, deadline {:.1} ms): {} batches, {} on time, {} deadline misses, \
-             {} stale discarded, {} without a free buffer, {} too large, {} inference panics",
+             {} stale discarded, {} without a free buffer, {} too large, {} inference panics, \
+             {} without inference thread, {} hangs detected, {} hang recoveries{}",
             self.deadline.as_secs_f64() * 1000.0,
             s.batches_submitted,
             s.batches_on_time,
@@ -310,22 +503,25 @@ impl DisplacementPredictor for ThreadedPredictor {
             s.stale_batches_discarded,
             s.frames_without_free_buffer,
             s.frames_too_large,
-            s.inference_panics
+            s.inference_panics,
+            s.frames_without_inference_thread,
+            s.inference_hangs_detected,
+            s.inference_hang_recoveries,
+            if self.hung { " (hung now)" } else { "" }
         ))
     }
 }
 
 impl Drop for ThreadedPredictor {
+    /// Stops the inference thread, waiting at most the shutdown wait (see
+    /// [`shutdown`](ThreadedPredictor::shutdown)).
     fn drop(&mut self) {
-        // Closing the work channel ends the inference loop once its current batch is done.
-        self.to_worker = None;
-        if let Some(worker) = self.worker.take() {
-            let _ = worker.join();
-        }
+        self.stop();
     }
 }
 
-/// The inference thread: predicts every batch it receives and sends it back.
+/// The inference thread: predicts every batch it receives and sends it back; after a panic of
+/// the predictor it returns that batch without results and stops.
 fn inference_loop<P: DisplacementPredictor>(
     mut predictor: P,
     work: Receiver<Box<Batch>>,
@@ -339,6 +535,10 @@ fn inference_loop<P: DisplacementPredictor>(
         batch.completed = outcome.is_ok();
         if !batch.completed {
             batch.displacements[..len].fill(None);
+            let _ = done.send(batch);
+            // The predictor's state is unknown after the panic; dropping it may panic as well.
+            let _ = catch_unwind(AssertUnwindSafe(move || drop(predictor)));
+            return;
         }
         if done.send(batch).is_err() {
             return;

@@ -136,6 +136,8 @@ struct LogLimits {
     publish: LogLimiter,
     latency: LogLimiter,
     notify: LogLimiter,
+    /// Frames in which learned displacements were rejected (NaN, infinite or implausible).
+    learned_rejected: LogLimiter,
 }
 
 /// Where the current input stream stands.
@@ -330,6 +332,16 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             Ok(step) => {
                 self.counters.frames_tracked += 1;
                 self.stream.tracker_dirty = true;
+                let rejected = step.predictions_rejected_non_finite + step.predictions_rejected_implausible;
+                if rejected > 0 && self.logs.learned_rejected.occur() {
+                    tracing::warn!(
+                        sequence = frame.sequence,
+                        non_finite = step.predictions_rejected_non_finite,
+                        implausible = step.predictions_rejected_implausible,
+                        occurrences = self.logs.learned_rejected.occurrences(),
+                        "learned displacements rejected; the PR mode sat out for those tracks"
+                    );
+                }
                 (FrameStatus::Tracked, *step)
             }
             Err(error) => {
@@ -507,7 +519,8 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         let s = self.tracker.stats();
         format!(
             "frames: {} received, {} tracked, {} rejected, {} lost; resets: {} (stream start {}, new publisher {}, interval too long {}); \
-             measurements: {} accepted, {} rejected; tracks: {} started, {} confirmed, {} deleted; publish failures: {}\n{}",
+             measurements: {} accepted, {} rejected; tracks: {} started, {} confirmed, {} deleted; \
+             learned predictions: {} missing ({} rejected non-finite, {} rejected implausible); publish failures: {}\n{}",
             c.frames_received,
             c.frames_tracked,
             c.frames_rejected,
@@ -521,6 +534,9 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             s.tracks_initiated,
             s.tracks_confirmed,
             s.tracks_deleted,
+            s.learned_predictions_missing,
+            s.learned_predictions_rejected_non_finite,
+            s.learned_predictions_rejected_implausible,
             c.publish_failures,
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
