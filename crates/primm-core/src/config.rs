@@ -7,6 +7,7 @@
 
 use crate::measurement::ObjectClass;
 use crate::mode::{ModeSet, MODE_COUNT};
+pub use crate::tracking_frame::{FrameConfig, TrackingFrame};
 use alloc::format;
 use alloc::string::String;
 use nalgebra::Matrix2;
@@ -30,6 +31,9 @@ pub struct Config {
     /// How the service runs the learned predictor (absent: the defaults).
     #[cfg_attr(feature = "serde", serde(default))]
     pub predictor: PredictorConfig,
+    /// The tracking frame and the sensors' mounting poses (absent: the defaults).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub frame: FrameConfig,
 }
 
 /// Runtime of the learned predictor in the tracking service (`primm serve`): the model runs on
@@ -301,6 +305,7 @@ impl Default for Config {
                 },
             },
             predictor: PredictorConfig::default(),
+            frame: FrameConfig::default(),
         }
     }
 }
@@ -354,6 +359,9 @@ impl Config {
         validate_imm(&self.imm)?;
         validate_association(&self.association)?;
         validate_tracker_and_predictor(&self.tracker, &self.predictor)?;
+        if let Some((key, reason)) = self.frame.problem() {
+            return Err(invalid(key, reason));
+        }
         for class in ObjectClass::ALL {
             validate_class(class, self.classes.get(class))?;
         }

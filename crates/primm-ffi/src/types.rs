@@ -300,6 +300,17 @@ pub struct PrimmStats {
     pub frames_rejected_interval_too_long: u64,
     /// Frames rejected because they carried too many measurements.
     pub frames_rejected_too_many_measurements: u64,
+    /// Frames rejected because their ego pose was not finite or absurdly far out.
+    pub frames_rejected_invalid_ego_pose: u64,
+    /// Frames tracked in the world frame.
+    pub frames_in_world_frame: u64,
+    /// Frames tracked in the vehicle frame although the configuration asks for the world frame
+    /// (they carried no ego pose).
+    pub frames_without_ego_pose: u64,
+    /// Times the live tracks were moved between the world and the vehicle frame.
+    pub tracking_frame_changes: u64,
+    /// Tracks started in the world frame by a measurement of a sensor without configured mount.
+    pub initiations_from_unknown_sensor: u64,
     /// Measurements tracked (accepted by validation).
     pub measurements_accepted: u64,
     /// Measurements rejected for an unknown class code.
@@ -335,6 +346,11 @@ impl From<&TrackerStats> for PrimmStats {
             frames_rejected_timestamp_not_increasing,
             frames_rejected_interval_too_long,
             frames_rejected_too_many_measurements,
+            frames_rejected_invalid_ego_pose,
+            frames_in_world_frame,
+            frames_without_ego_pose,
+            tracking_frame_changes,
+            initiations_from_unknown_sensor,
             measurements_accepted,
             measurements_rejected_unknown_class,
             measurements_rejected_non_finite,
@@ -354,6 +370,11 @@ impl From<&TrackerStats> for PrimmStats {
             frames_rejected_timestamp_not_increasing,
             frames_rejected_interval_too_long,
             frames_rejected_too_many_measurements,
+            frames_rejected_invalid_ego_pose,
+            frames_in_world_frame,
+            frames_without_ego_pose,
+            tracking_frame_changes,
+            initiations_from_unknown_sensor,
             measurements_accepted,
             measurements_rejected_unknown_class,
             measurements_rejected_non_finite,
