@@ -105,7 +105,8 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
     let mut tracker = Tracker::with_predictor(config, predictor)?;
     let sequence = read_sequence_file(&args.input)?;
     let file = create(&args.output)?;
-    let mut writer = TrackCsvWriter::new(std::io::BufWriter::new(file))?;
+    let tracking_frame = tracker.config().frame.tracking_frame;
+    let mut writer = TrackCsvWriter::for_sequence(std::io::BufWriter::new(file), &sequence, tracking_frame)?;
     let mut associations = match &args.associations {
         Some(path) => {
             let file = create(path)?;

@@ -96,6 +96,11 @@ pub struct Sequence {
 }
 
 impl Sequence {
+    /// Whether any frame carries an ego pose.
+    pub fn has_ego_pose(&self) -> bool {
+        self.frames.iter().any(|frame| frame.ego_pose.is_some())
+    }
+
     /// An empty sequence called `name`.
     pub fn new(name: impl Into<String>) -> Self {
         Self { name: name.into(), frames: Vec::new() }
