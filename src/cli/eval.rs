@@ -1,7 +1,7 @@
 //! `primm eval`: every method on every sequence of a data set, printed as the paper's tables.
 
 use clap::Args as ClapArgs;
-use primm_core::config::Config;
+use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::tracker::Tracker;
@@ -44,6 +44,10 @@ pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults otherwise.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
+    /// Overrides the configuration's `frame.tracking_frame`: `world` (tracks in the world
+    /// frame when frames carry an ego pose) or `vehicle` (always the vehicle frame).
+    #[arg(long, value_name = "FRAME", value_parser = super::parse_tracking_frame)]
+    pub tracking_frame: Option<TrackingFrame>,
     /// ONNX model of the learned predictor (default: the model built into primm,
     /// models/pr.onnx).
     #[arg(long, value_name = "FILE")]
@@ -91,10 +95,13 @@ pub enum EvaluateError {
 
 /// Runs `primm eval`.
 pub fn run(args: &Args) -> Result<(), EvaluateError> {
-    let base_config = match &args.config {
-        Some(path) => primm_config::from_file(path)?,
-        None => Config::default(),
-    };
+    let base_config = super::with_tracking_frame(
+        match &args.config {
+            Some(path) => primm_config::from_file(path)?,
+            None => Config::default(),
+        },
+        args.tracking_frame,
+    );
     let sequences = read_dataset_dir(&args.data)?;
     if sequences.is_empty() {
         return Err(EvaluateError::NoData { dir: args.data.clone() });

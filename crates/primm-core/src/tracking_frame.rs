@@ -42,6 +42,11 @@ impl TrackingFrame {
             TrackingFrame::Vehicle => "vehicle",
         }
     }
+
+    /// Parses the short name; `None` for anything else.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [TrackingFrame::World, TrackingFrame::Vehicle].into_iter().find(|frame| frame.name() == name)
+    }
 }
 
 /// The `frame` section: the tracking frame and the sensors' mounting poses.
