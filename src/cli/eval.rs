@@ -7,6 +7,7 @@ use primm_core::predictor::DisplacementPredictor;
 use primm_core::tracker::Tracker;
 use primm_predictor::predictor_for;
 use primm_sim::eval::dropout::{sequence_seed, DropoutMask};
+use primm_sim::eval::ego_motion::ego_motion_labels;
 use primm_sim::eval::plots::{
     ground_truth_points, majority_ground_truth, write_mode_probability_svg, write_trajectory_svg,
     TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint,
@@ -142,6 +143,7 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
                 }
             })?;
             evaluator.add_sequence(&records);
+            evaluator.add_ego_motion(&records, &ego_motion_labels(sequence, &records));
             if index == plot_sequence {
                 ground_truth = ground_truth_points(&records);
                 panels.push(TrajectoryPanel {
