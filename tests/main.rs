@@ -39,3 +39,4 @@ mod service_replay;
 mod track_loops;
 mod tracker;
 mod tracker_allocation;
+mod world_frame;

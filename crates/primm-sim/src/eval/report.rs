@@ -18,6 +18,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use primm_core::measurement::ObjectClass;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
 
@@ -55,6 +56,9 @@ pub struct MethodResult {
     pub missed_detection: BTreeMap<u32, IdentityCounts>,
     /// Posterior mode probabilities of all updates.
     pub modes: ModeProbabilityAccumulator,
+    /// Prior RMSE per object class.
+    #[serde(default)]
+    pub class_rmse: BTreeMap<ObjectClass, RmseAccumulator>,
     /// Prior RMSE per ego motion (sequences with ego poses only).
     #[serde(default)]
     pub ego_rmse: BTreeMap<EgoMotion, RmseAccumulator>,
@@ -77,6 +81,7 @@ impl MethodResult {
             crossing: IdentityCounts::default(),
             missed_detection: BTreeMap::new(),
             modes: ModeProbabilityAccumulator::new(),
+            class_rmse: BTreeMap::new(),
             ego_rmse: BTreeMap::new(),
             ego_identity: BTreeMap::new(),
         }
@@ -103,6 +108,9 @@ impl MethodResult {
             self.missed_detection.entry(*percent).or_default().merge(counts);
         }
         self.modes.merge(&other.modes);
+        for (class, acc) in &other.class_rmse {
+            self.class_rmse.entry(*class).or_default().merge(acc);
+        }
         for (motion, acc) in &other.ego_rmse {
             self.ego_rmse.entry(*motion).or_default().merge(acc);
         }
@@ -158,6 +166,7 @@ impl MethodEvaluator {
         let result = &mut self.result;
         for (record, label) in records.iter().zip(&labels) {
             result.rmse.push_record(record);
+            result.class_rmse.entry(record.class).or_default().push_record(record);
             result.modes.push_record(record);
             if let Some(label) = label {
                 let category = label.category();
@@ -296,6 +305,38 @@ impl EvaluationReport {
             .collect::<Vec<_>>();
         let mut text = render_table("Table II. One-step prior prediction RMSE", &header, &rows);
         self.append_notes(&mut text, "* lowest value in its column");
+        text
+    }
+
+    /// Table II by object class: RMSE_xy per class (rows) and method (columns), for the classes
+    /// with rows.
+    pub fn table_class_rmse(&self) -> String {
+        let mut header = vec!["Class (prior samples)".to_string()];
+        header.extend(Method::ALL.iter().map(|m| m.label().to_string()));
+        let classes: Vec<ObjectClass> = ObjectClass::ALL
+            .into_iter()
+            .filter(|class| {
+                Method::ALL.iter().any(|m| self.result(*m).is_some_and(|r| r.class_rmse.contains_key(class)))
+            })
+            .collect();
+        let rows = classes
+            .iter()
+            .map(|class| {
+                let values: Vec<Option<f64>> = Method::ALL
+                    .iter()
+                    .map(|m| {
+                        self.result(*m).and_then(|r| r.class_rmse.get(class)).and_then(|acc| acc.rmse_xy())
+                    })
+                    .collect();
+                let count = self.common_count(|r| r.class_rmse.get(class).map_or(0, |acc| acc.count()));
+                let mut line = vec![format!("{} ({count})", class.name())];
+                line.extend(mark_best(&values, Better::Lower, 3).iter().map(Cell::to_string));
+                line
+            })
+            .collect::<Vec<_>>();
+        let mut text =
+            render_table("Table II by class. One-step prior prediction RMSE_xy [m]", &header, &rows);
+        self.append_notes(&mut text, "* lowest value in its row");
         text
     }
 
@@ -463,6 +504,7 @@ impl EvaluationReport {
     pub fn to_text(&self) -> String {
         [
             self.table_prior_rmse(),
+            self.table_class_rmse(),
             self.table_scenario_rmse(),
             self.table_overall_mot(),
             self.table_scenario_mot(),
@@ -541,6 +583,12 @@ impl EvaluationReport {
         }
         for (percent, counts) in &result.missed_detection {
             scenarios.insert(format!("miss_{percent}"), identity_json(counts));
+        }
+        for (class, acc) in &result.class_rmse {
+            scenarios.insert(
+                format!("class_{}", class.name()),
+                json!({ "rmse_xy": acc.rmse_xy(), "rmse_samples": acc.count() }),
+            );
         }
         for (motion, counts) in &result.ego_identity {
             let key = match motion {

@@ -655,7 +655,7 @@ impl ScenarioConfig {
     pub fn turning() -> Self {
         let mut config = Self::default();
         config.splits.seed_base = 0x5455_524e_494e;
-        config.road.block_length_m = 70.0;
+        config.road.block_length_m = 90.0;
         config.ego.desired_speed_mps = [6.0, 10.0];
         config.ego.start_distance_to_junction_m = [15.0, 40.0];
         config.ego.turn_left_probability = Some(0.45);
