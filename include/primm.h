@@ -136,6 +136,17 @@ typedef struct PrimmStepSummary {
   size_t tracks_initiated;
   // Tracks deleted in this step.
   size_t tracks_deleted;
+  // Association clusters of this step handed to the optimal assignment solver (a cluster of
+  // one track and one measurement is paired directly and not counted).
+  size_t solved_clusters;
+  // Tracks of the smallest cluster solved in this step (0 if none was).
+  size_t smallest_solved_cluster_tracks;
+  // Measurements of the smallest cluster solved in this step (0 if none was).
+  size_t smallest_solved_cluster_measurements;
+  // Tracks of the largest cluster solved in this step (0 if none was).
+  size_t largest_solved_cluster_tracks;
+  // Measurements of the largest cluster solved in this step (0 if none was).
+  size_t largest_solved_cluster_measurements;
 } PrimmStepSummary;
 
 // The ego vehicle's pose in the world (odometry) frame at a frame's time: the reference point

@@ -1,8 +1,13 @@
 //! The per-track loops of `primm_core::track_loops` (compiled for baseline x86-64 and for AVX2 +
-//! FMA, chosen at run time) compute exactly what the plain IMM calls compute, bit for bit, on
-//! tracks taken from a running tracker. On a CPU with AVX2 the dispatched loops run their AVX2
-//! version while the reference loops below are compiled for the baseline, so the comparison
-//! covers both.
+//! FMA, chosen at run time) compute exactly what the baseline build of the same loops and the
+//! plain IMM calls compute, bit for bit, on tracks taken from a running tracker.
+//!
+//! The test names the two versions it compared and refuses to compare a version with itself:
+//! on a CPU with AVX, AVX2 and FMA the dispatch must have picked the wide version, and the
+//! baseline reference must not have been compiled with AVX2 (as `-C target-cpu=native` would).
+//! On a CPU without them only the baseline can run: there is no second version to compare, the
+//! test checks that the dispatch picked the baseline, says so and stops. That is not a gap in
+//! what ships: on such a CPU the program runs the baseline too, which is the reference here.
 
 use crate::common;
 
@@ -15,7 +20,7 @@ use primm_core::measurement::{Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::motion::ModeModels;
 use primm_core::track::Track;
-use primm_core::track_loops::{self, ClassModels};
+use primm_core::track_loops::{self, ClassModels, LoopVersion};
 use primm_core::tracker::Tracker;
 
 /// The tracks of a tracker running `method` on 24 lanes after `frames` frames.
@@ -39,8 +44,36 @@ fn bits<T: std::fmt::Debug>(value: &T) -> String {
     format!("{value:?}")
 }
 
+/// Whether this CPU can run the wide version (AVX, AVX2 and FMA).
+fn cpu_runs_the_wide_loops() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        is_x86_feature_detected!("avx") && is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 #[test]
-fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
+fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit() {
+    let selected = track_loops::selected_version();
+    assert!(
+        !track_loops::baseline_built_with_avx2(),
+        "primm-core's baseline was compiled with AVX2: the comparison would compare a build with itself"
+    );
+    if !cpu_runs_the_wide_loops() {
+        assert_eq!(selected, LoopVersion::Baseline, "the dispatch picked a version this CPU cannot run");
+        println!(
+            "track loops: this CPU lacks AVX/AVX2/FMA, only the baseline runs; no second version to compare"
+        );
+        return;
+    }
+    assert_eq!(selected, LoopVersion::Wide, "the CPU has AVX2 but the dispatch picked {selected:?}");
+    println!(
+        "track loops: compared the dispatched {selected:?} (AVX+AVX2+FMA) version with the Baseline build"
+    );
     for method in [Method::Imm, Method::PrImm] {
         let (config, tracks) = running_tracks(method, 40);
         assert!(tracks.len() >= 20, "{method}: only {} tracks", tracks.len());
@@ -55,6 +88,9 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
             imm.predict_physics_into(&models[track.class.index()], &track.estimate, dt_s, prior);
         }
         assert_eq!(bits(&dispatched), bits(&plain), "{method}: predict_physics");
+        let mut baseline = vec![ImmPrior::default(); tracks.len()];
+        track_loops::baseline::predict_physics(&imm, &models, &tracks, dt_s, &mut baseline);
+        assert_eq!(bits(&dispatched), bits(&baseline), "{method}: predict_physics, wide vs baseline");
 
         // Every third track without a learned displacement.
         let displacements: Vec<Option<DVec2>> = (0..tracks.len())
@@ -65,6 +101,8 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
             imm.complete_prior_in_place(&models[track.class.index()], prior, dt_s, *displacement);
         }
         assert_eq!(bits(&dispatched), bits(&plain), "{method}: complete_priors");
+        track_loops::baseline::complete_priors(&imm, &models, &tracks, dt_s, &displacements, &mut baseline);
+        assert_eq!(bits(&dispatched), bits(&baseline), "{method}: complete_priors, wide vs baseline");
 
         // Every fourth track without a measurement; the others measured 0.3 m off their prior.
         let measurements: Vec<Option<Measurement>> = plain
@@ -92,6 +130,22 @@ fn dispatched_loops_equal_the_plain_imm_calls_bit_for_bit() {
         }
         let estimates = |tracks: &[Track]| bits(&tracks.iter().map(|t| t.estimate).collect::<Vec<_>>());
         assert_eq!(estimates(&dispatched_tracks), estimates(&plain_tracks), "{method}: update");
+        let mut baseline_tracks = tracks.clone();
+        let mut baseline_outcomes = vec![Err(UpdateError); tracks.len()];
+        track_loops::baseline::update(
+            &imm,
+            &models,
+            &mut baseline_tracks,
+            &baseline,
+            &measurements,
+            &mut baseline_outcomes,
+        );
+        assert_eq!(baseline_outcomes, outcomes, "{method}: update outcomes, wide vs baseline");
+        assert_eq!(
+            estimates(&dispatched_tracks),
+            estimates(&baseline_tracks),
+            "{method}: update, wide vs baseline"
+        );
         assert_ne!(estimates(&dispatched_tracks), estimates(&tracks), "{method}: the update changed nothing");
     }
 }

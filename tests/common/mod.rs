@@ -149,6 +149,35 @@ pub fn lanes(count: usize) -> Vec<SceneObject> {
         .collect()
 }
 
+/// `clusters` groups of `per_cluster` cars, 30 m apart, in which every car crosses the others:
+/// car `i` of a group starts on a circle of radius 2 m at angle `2πi/n` and drives along a
+/// chord to the angle `0.8π` further on, which it reaches after `crossing_s` seconds. Every car
+/// of a group stays within 4 m of every other, well inside the car gate, so that each group
+/// is one association cluster of `per_cluster` tracks and measurements. Played for
+/// `crossing_s` and then started again, the cars jump back by at most 4 m: the groups stay
+/// clusters for as long as the scene runs.
+pub fn crossing_clusters(clusters: usize, per_cluster: usize, crossing_s: f64) -> Vec<SceneObject> {
+    const RADIUS_M: f64 = 2.0;
+    let mut objects = Vec::new();
+    for cluster in 0..clusters {
+        let centre = [40.0, -120.0 + 30.0 * cluster as f64];
+        for i in 0..per_cluster {
+            let from = std::f64::consts::TAU * i as f64 / per_cluster as f64;
+            let to = from + 0.8 * std::f64::consts::PI;
+            let start = [centre[0] + RADIUS_M * from.cos(), centre[1] + RADIUS_M * from.sin()];
+            let end = [centre[0] + RADIUS_M * to.cos(), centre[1] + RADIUS_M * to.sin()];
+            objects.push(SceneObject {
+                id: objects.len() as u64 + 1,
+                class: ObjectClass::Car,
+                start,
+                velocity: [(end[0] - start[0]) / crossing_s, (end[1] - start[1]) / crossing_s],
+                visible: (0.0, f64::INFINITY),
+            });
+        }
+    }
+    objects
+}
+
 /// A predictor that knows the lane scene: it finds the object nearest to the request's anchor
 /// and returns its exact displacement over the step. Allocates nothing.
 pub struct LaneOracle {

@@ -8,6 +8,10 @@
 //! add into a fused multiply-add on its own, so the extra instructions change how values move
 //! between registers, not what is computed. Other architectures get the baseline loop, and so
 //! does a build without the `std` feature (run-time detection needs the standard library).
+//!
+//! [`selected_version`] says which version the dispatch picks on this CPU, and [`baseline`]
+//! holds the same loops compiled for the baseline only, never dispatched, so that a test can
+//! compare the two versions and know that it compared two different builds.
 
 use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
@@ -31,6 +35,17 @@ pub fn predict_physics(
     dt_s: f64,
     priors: &mut [ImmPrior],
 ) {
+    predict_physics_loop(imm, models, tracks, dt_s, priors);
+}
+
+#[inline(always)]
+fn predict_physics_loop(
+    imm: &Imm,
+    models: &ClassModels,
+    tracks: &[Track],
+    dt_s: f64,
+    priors: &mut [ImmPrior],
+) {
     for (track, prior) in tracks.iter().zip(priors.iter_mut()) {
         imm.predict_physics_into(&models[track.class.index()], &track.estimate, dt_s, prior);
     }
@@ -39,6 +54,18 @@ pub fn predict_physics(
 /// The PR prior from each track's learned displacement and the fused prior of every track.
 #[cfg_attr(feature = "std", multiversion(targets("x86_64+avx+avx2+fma")))]
 pub fn complete_priors(
+    imm: &Imm,
+    models: &ClassModels,
+    tracks: &[Track],
+    dt_s: f64,
+    displacements_m: &[Option<DVec2>],
+    priors: &mut [ImmPrior],
+) {
+    complete_priors_loop(imm, models, tracks, dt_s, displacements_m, priors);
+}
+
+#[inline(always)]
+fn complete_priors_loop(
     imm: &Imm,
     models: &ClassModels,
     tracks: &[Track],
@@ -63,6 +90,18 @@ pub fn update(
     measurements: &[Option<Measurement>],
     outcomes: &mut [Result<(), UpdateError>],
 ) {
+    update_loop(imm, models, tracks, priors, measurements, outcomes);
+}
+
+#[inline(always)]
+fn update_loop(
+    imm: &Imm,
+    models: &ClassModels,
+    tracks: &mut [Track],
+    priors: &[ImmPrior],
+    measurements: &[Option<Measurement>],
+    outcomes: &mut [Result<(), UpdateError>],
+) {
     for (((track, prior), measurement), outcome) in
         tracks.iter_mut().zip(priors).zip(measurements).zip(outcomes.iter_mut())
     {
@@ -72,5 +111,81 @@ pub fn update(
             }
             None => Ok(()),
         };
+    }
+}
+
+/// A compiled version of the per-track loops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoopVersion {
+    /// Baseline x86-64 (or the only version, on other architectures and without `std`).
+    Baseline,
+    /// x86-64 with AVX, AVX2 and FMA.
+    Wide,
+}
+
+/// Whether the crate's baseline code was itself compiled with AVX2 (a build with
+/// `-C target-cpu=native` or `-C target-feature=+avx2`): then [`baseline`] is not the baseline
+/// and comparing it with the dispatched loops compares a build with itself.
+pub fn baseline_built_with_avx2() -> bool {
+    cfg!(target_feature = "avx2")
+}
+
+/// The version of the loops the run-time dispatch picks on this CPU. It is dispatched over the
+/// same targets as the loops, so it picks what they pick.
+#[cfg(feature = "std")]
+#[multiversion(targets("x86_64+avx+avx2+fma"))]
+pub fn selected_version() -> LoopVersion {
+    if multiversion::target::selected_target!().supports_feature_str("avx2") {
+        LoopVersion::Wide
+    } else {
+        LoopVersion::Baseline
+    }
+}
+
+/// The version of the loops in use: without `std` there is no run-time dispatch, only the
+/// baseline.
+#[cfg(not(feature = "std"))]
+pub fn selected_version() -> LoopVersion {
+    LoopVersion::Baseline
+}
+
+/// The loops compiled for the baseline only, never dispatched: the reference against which the
+/// wide version is compared.
+pub mod baseline {
+    use super::*;
+
+    /// [`predict_physics`](super::predict_physics), baseline build.
+    pub fn predict_physics(
+        imm: &Imm,
+        models: &ClassModels,
+        tracks: &[Track],
+        dt_s: f64,
+        priors: &mut [ImmPrior],
+    ) {
+        predict_physics_loop(imm, models, tracks, dt_s, priors);
+    }
+
+    /// [`complete_priors`](super::complete_priors), baseline build.
+    pub fn complete_priors(
+        imm: &Imm,
+        models: &ClassModels,
+        tracks: &[Track],
+        dt_s: f64,
+        displacements_m: &[Option<DVec2>],
+        priors: &mut [ImmPrior],
+    ) {
+        complete_priors_loop(imm, models, tracks, dt_s, displacements_m, priors);
+    }
+
+    /// [`update`](super::update), baseline build.
+    pub fn update(
+        imm: &Imm,
+        models: &ClassModels,
+        tracks: &mut [Track],
+        priors: &[ImmPrior],
+        measurements: &[Option<Measurement>],
+        outcomes: &mut [Result<(), UpdateError>],
+    ) {
+        update_loop(imm, models, tracks, priors, measurements, outcomes);
     }
 }

@@ -9,7 +9,7 @@
 //! repeatable.
 
 use crate::association::assignment::AssignmentError;
-use crate::association::associator::Associator;
+use crate::association::associator::{AssociationStats, Associator};
 use crate::config::{Config, ConfigError};
 use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
@@ -619,6 +619,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.step_pose = None;
         self.last_step = StepSummary::default();
         self.stats.resets += 1;
+    }
+
+    /// What the associator did in the last association: allowed pairs, clusters paired
+    /// directly, clusters handed to the optimal solver and the largest and smallest of those.
+    pub fn association_stats(&self) -> &AssociationStats {
+        self.associator.stats()
     }
 
     /// The counters.

@@ -118,7 +118,7 @@ impl PrimmTracker {
             })
             .map_err(Failure::Step)?;
         self.track_count = count;
-        Ok(PrimmStepSummary::new(&summary, &self.tracks[..count]))
+        Ok(PrimmStepSummary::new(&summary, self.tracker.association_stats(), &self.tracks[..count]))
     }
 }
 

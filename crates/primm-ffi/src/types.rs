@@ -4,6 +4,7 @@
 //! Rust enums, so that an out-of-range value from C is an error and never undefined behaviour.
 
 use core::ffi::c_char;
+use primm_core::association::associator::AssociationStats;
 use primm_core::limits::{MAX_MEASUREMENTS_PER_FRAME, MAX_TRACKS};
 use primm_core::measurement::{Measurement, ObjectClass, UnknownClass};
 use primm_core::mode::{Method, MODE_COUNT};
@@ -304,11 +305,23 @@ pub struct PrimmStepSummary {
     pub tracks_initiated: usize,
     /// Tracks deleted in this step.
     pub tracks_deleted: usize,
+    /// Association clusters of this step handed to the optimal assignment solver (a cluster of
+    /// one track and one measurement is paired directly and not counted).
+    pub solved_clusters: usize,
+    /// Tracks of the smallest cluster solved in this step (0 if none was).
+    pub smallest_solved_cluster_tracks: usize,
+    /// Measurements of the smallest cluster solved in this step (0 if none was).
+    pub smallest_solved_cluster_measurements: usize,
+    /// Tracks of the largest cluster solved in this step (0 if none was).
+    pub largest_solved_cluster_tracks: usize,
+    /// Measurements of the largest cluster solved in this step (0 if none was).
+    pub largest_solved_cluster_measurements: usize,
 }
 
 impl PrimmStepSummary {
-    /// The C form of the tracker's summary of a step whose tracks are `tracks`.
-    pub(crate) fn new(summary: &StepSummary, tracks: &[PrimmTrack]) -> Self {
+    /// The C form of the tracker's summary of a step whose association did `association` and
+    /// whose tracks are `tracks`.
+    pub(crate) fn new(summary: &StepSummary, association: &AssociationStats, tracks: &[PrimmTrack]) -> Self {
         PrimmStepSummary {
             track_count: tracks.len(),
             updated_track_count: tracks
@@ -319,6 +332,11 @@ impl PrimmStepSummary {
             measurements_rejected: summary.measurements_rejected,
             tracks_initiated: summary.initiated,
             tracks_deleted: summary.deleted,
+            solved_clusters: association.solved_clusters,
+            smallest_solved_cluster_tracks: association.smallest_solved_cluster.0,
+            smallest_solved_cluster_measurements: association.smallest_solved_cluster.1,
+            largest_solved_cluster_tracks: association.largest_cluster.0,
+            largest_solved_cluster_measurements: association.largest_cluster.1,
         }
     }
 }

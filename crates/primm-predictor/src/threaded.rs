@@ -39,6 +39,11 @@ pub const INFERENCE_THREAD_NAME: &str = "primm-pr-inference";
 /// Batch buffers shared by the two threads.
 const BUFFERS: usize = 2;
 
+/// How long [`ThreadedPredictor::warm_up`] waits on the empty return channel: long enough
+/// that the wait really blocks (it returns at once only if the thread was descheduled for
+/// longer than this between starting the wait and checking its deadline).
+const WAIT_PRIMING: Duration = Duration::from_millis(50);
+
 /// One batch in flight: requests in, displacements out.
 struct Batch {
     sequence: u64,
@@ -145,8 +150,21 @@ impl ThreadedPredictor {
         Ok(threaded)
     }
 
-    /// One empty round trip (not counted in the statistics), waiting as long as it takes.
+    /// One empty round trip (not counted in the statistics), waiting as long as it takes; then
+    /// one wait on the empty return channel.
+    ///
+    /// The first time a thread blocks on a channel, std allocates (the thread's wait context
+    /// and the channel's list of waiters). The round trip blocks only if the answer is not back
+    /// yet, which depends on scheduling, so a wait on the empty channel makes sure those
+    /// allocations happen here, on the thread that builds the predictor, instead of in the
+    /// first `collect` that has to wait.
     fn warm_up(&mut self) {
+        self.round_trip();
+        let _ = self.from_worker.recv_timeout(WAIT_PRIMING);
+    }
+
+    /// See [`warm_up`](Self::warm_up).
+    fn round_trip(&mut self) {
         let Some(mut batch) = self.free[0].take() else { return };
         batch.len = 0;
         batch.sequence = u64::MAX;

@@ -1,6 +1,8 @@
 //! The C header `include/primm_wire.h` and the Python module `python/primm_wire.py`
 //! describe exactly the bytes of the Rust wire types: same size, alignment and offset of every
-//! field. The Rust field lists are checked for completeness by exhaustive destructuring.
+//! field. The Rust field lists are checked for completeness by exhaustive destructuring, and
+//! every field is checked to start exactly where the one before it ends, so that no type has
+//! padding the compiler inserted (every gap is a named `_pad` field instead).
 
 use primm_wire::{
     LatencyReport, MeasurementFrame, StageLatency, TrackFrame, WireMeasurement, WireTrack, WIRE_VERSION,
@@ -15,7 +17,13 @@ struct TypeLayout {
     c_name: &'static str,
     size: usize,
     align: usize,
-    fields: Vec<(&'static str, usize)>,
+    /// Name, offset and size of every field, in declaration order (which `repr(C)` keeps).
+    fields: Vec<(&'static str, usize, usize)>,
+}
+
+/// The size of the field that `project` reads, from its type alone.
+fn field_size<T, F>(_project: fn(&T) -> &F) -> usize {
+    size_of::<F>()
 }
 
 macro_rules! layout {
@@ -30,7 +38,11 @@ macro_rules! layout {
             c_name: $c_name,
             size: size_of::<$ty>(),
             align: align_of::<$ty>(),
-            fields: vec![$((stringify!($field), offset_of!($ty, $field))),*],
+            fields: vec![$((
+                stringify!($field),
+                offset_of!($ty, $field),
+                field_size(|value: &$ty| &value.$field),
+            )),*],
         }
     }};
 }
@@ -150,7 +162,7 @@ fn rust_lines() -> BTreeSet<String> {
     lines.insert(format!("version {WIRE_VERSION}"));
     for layout in rust_layouts() {
         lines.insert(format!("{} size {} align {}", layout.name, layout.size, layout.align));
-        for (field, offset) in &layout.fields {
+        for (field, offset, _) in &layout.fields {
             lines.insert(format!("{}.{} {}", layout.name, field, offset));
         }
     }
@@ -161,19 +173,76 @@ fn lines_of(output: &[u8]) -> BTreeSet<String> {
     String::from_utf8_lossy(output).lines().map(str::to_owned).collect()
 }
 
+/// Every gap in `layout`: bytes between the end of a field and the start of the next, or
+/// between the last field and the end of the type.
+fn gaps(layout: &TypeLayout) -> Vec<String> {
+    let mut gaps = Vec::new();
+    let mut end = 0;
+    let mut previous = "the start";
+    for &(field, offset, size) in &layout.fields {
+        if offset != end {
+            gaps.push(format!(
+                "{}: {} bytes between {previous} and {field}",
+                layout.name,
+                offset as isize - end as isize
+            ));
+        }
+        end = offset + size;
+        previous = field;
+    }
+    if end != layout.size {
+        gaps.push(format!("{}: {} bytes after {previous}", layout.name, layout.size as isize - end as isize));
+    }
+    gaps
+}
+
 #[test]
 fn the_rust_types_have_no_implicit_padding() {
-    for layout in rust_layouts() {
-        let mut offsets: Vec<usize> = layout.fields.iter().map(|(_, offset)| *offset).collect();
-        offsets.push(layout.size);
-        assert!(offsets.windows(2).all(|w| w[0] < w[1]), "{}: fields out of order", layout.name);
+    // The payloads and every type nested in them (`WireMeasurement` in `MeasurementFrame`,
+    // `WireTrack` in `TrackFrame`, `StageLatency` in `LatencyReport`); the other fields are
+    // integers, floats and arrays of them, and an array has no padding between its elements
+    // (an element's size is a multiple of its alignment).
+    let layouts = rust_layouts();
+    assert_eq!(layouts.len(), 6);
+    for layout in &layouts {
+        assert_eq!(gaps(layout), Vec::<String>::new());
         assert_eq!(layout.size % 8, 0, "{}", layout.name);
+        println!("{}: {} fields, {} bytes, no gaps", layout.name, layout.fields.len(), layout.size);
     }
     assert_eq!(size_of::<WireMeasurement>(), 64);
     assert_eq!(size_of::<MeasurementFrame>(), 16_448);
     assert_eq!(size_of::<WireTrack>(), 184);
     assert_eq!(size_of::<TrackFrame>(), 94_272);
     assert_eq!(size_of::<LatencyReport>(), 1032);
+}
+
+#[test]
+fn the_padding_check_finds_gaps_between_fields_and_at_the_end() {
+    #[allow(dead_code)]
+    #[repr(C)]
+    struct GapInside {
+        flag: u8,
+        value: u32,
+    }
+    #[allow(dead_code)]
+    #[repr(C)]
+    struct GapAtTheEnd {
+        value: u64,
+        flag: u8,
+    }
+    #[allow(dead_code)]
+    #[repr(C)]
+    struct Padded {
+        flag: u8,
+        _pad0: [u8; 3],
+        value: u32,
+    }
+    let inside = layout!(GapInside, "gap_inside", [flag, value]);
+    assert_eq!(gaps(&inside), vec!["GapInside: 3 bytes between flag and value".to_owned()]);
+    let at_the_end = layout!(GapAtTheEnd, "gap_at_the_end", [value, flag]);
+    assert_eq!(gaps(&at_the_end), vec!["GapAtTheEnd: 7 bytes after flag".to_owned()]);
+    let padded = layout!(Padded, "padded", [flag, _pad0, value]);
+    assert_eq!(gaps(&padded), Vec::<String>::new());
 }
 
 #[test]
@@ -190,7 +259,7 @@ fn the_c_header_matches_the_rust_layout() {
             layout.name,
             c = layout.c_name
         );
-        for (field, _) in &layout.fields {
+        for (field, _, _) in &layout.fields {
             source += &format!(
                 "    printf(\"{}.{} %zu\\n\", offsetof({}, {}));\n",
                 layout.name, field, layout.c_name, field

@@ -58,6 +58,8 @@ pub struct AssociationStats {
     pub solved_clusters: usize,
     /// Rows × columns of the largest cluster handed to the solver.
     pub largest_cluster: (usize, usize),
+    /// Rows × columns of the smallest cluster handed to the solver; `(0, 0)` when none was.
+    pub smallest_solved_cluster: (usize, usize),
 }
 
 /// Reusable association workspace.
@@ -275,6 +277,10 @@ impl Associator {
             let largest = &mut self.stats.largest_cluster;
             if height * width > largest.0 * largest.1 {
                 *largest = (height, width);
+            }
+            let smallest = &mut self.stats.smallest_solved_cluster;
+            if self.stats.solved_clusters == 1 || height * width < smallest.0 * smallest.1 {
+                *smallest = (height, width);
             }
             for (local_row, &r) in cluster_rows.iter().enumerate() {
                 if let Some(local) = self.row_to_column[local_row] {
