@@ -20,6 +20,7 @@
 pub mod replay;
 
 use crate::replay::{Pacing, ReplayError, ReplayOptions, Replayer};
+use primm_core::readable_number::readable;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::{read_dataset_dir, read_sequence_file, CsvError, Sequence};
@@ -66,6 +67,11 @@ pub struct Args {
     /// Wait this long for a tracker to serve before sending (0: send at once).
     #[arg(long, default_value_t = 30.0, value_name = "S")]
     pub wait_for_tracker_s: f64,
+    /// Stay connected this long after the last frame (or until SIGINT/SIGTERM), s. iceoryx2
+    /// discards the frames of a publisher that disconnects before a subscriber took them, so a
+    /// tracker that is behind loses the replay's last frames unless the publisher lingers.
+    #[arg(long, default_value_t = 0.0, value_name = "S")]
+    pub linger_s: f64,
     /// Prefix of the service names (`PREFIX/primm/...`).
     #[arg(long, env = SERVICE_PREFIX_ENV, default_value = "")]
     pub service_prefix: String,
@@ -90,7 +96,10 @@ pub enum PublishError {
     #[error(transparent)]
     Connect(#[from] ConnectError),
     /// No tracker served within the wait.
-    #[error("no tracker is serving '{service}' after {waited_s} s (start `primm serve` first)")]
+    #[error(
+        "no tracker is serving '{service}' after {} s (start `primm serve` first)",
+        readable(.waited_s)
+    )]
     NoTracker {
         /// The track service waited for.
         service: String,
@@ -161,10 +170,18 @@ pub fn run(args: Args) -> Result<(), PublishError> {
     }
     tracing::info!(
         frames_sent = summary.frames_sent,
+        frames_dropped = summary.frames_dropped,
+        frames_without_receiver = summary.frames_without_receiver,
         measurements_sent = summary.measurements_sent,
         passes = summary.passes,
         interrupted = summary.interrupted,
         "replay finished"
     );
+    if args.linger_s > 0.0 && !summary.interrupted {
+        let until = std::time::Instant::now() + Duration::from_secs_f64(args.linger_s);
+        while std::time::Instant::now() < until && !shutdown.is_requested() {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
     Ok(())
 }

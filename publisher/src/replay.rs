@@ -8,8 +8,10 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::{LoanError, ReceiveError, SendError};
+use primm_core::readable_number::readable;
 use primm_service::catalog::{self, ConnectError, Ipc, ServiceNames, Stream};
 use primm_service::clock::monotonic_ns;
+use primm_service::log_limit::LogLimiter;
 use primm_service::shutdown::ShutdownFlag;
 use primm_sim::io::{RecordedFrame, Sequence};
 use primm_wire::{
@@ -59,10 +61,19 @@ impl Default for ReplayOptions {
 }
 
 /// What a replay sent.
+///
+/// Every frame the replay came to is either sent or dropped: `frames_sent + frames_dropped`
+/// frames were attempted. A dropped frame consumes no sequence number, so the tracker's count of
+/// lost frames (sequence gaps) covers only frames lost after they were sent.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct ReplaySummary {
     /// Frames sent.
     pub frames_sent: u64,
+    /// Frames dropped because no shared-memory sample could be loaned for them, or the loaned
+    /// sample could not be sent (counted and logged; the replay goes on instead of waiting).
+    pub frames_dropped: u64,
+    /// Frames sent while no subscriber was connected (no tracker received them).
+    pub frames_without_receiver: u64,
     /// Measurements sent.
     pub measurements_sent: u64,
     /// Passes through the sequences started.
@@ -105,8 +116,17 @@ pub enum ReplayError {
         timeout: Duration,
     },
     /// The pacing speed is not a positive number.
-    #[error("replay speed must be a positive number, got {0}")]
+    #[error("replay speed must be a positive number, got {}", readable(.0))]
     InvalidSpeed(f64),
+}
+
+/// A frame [`Replayer::send`] sent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SentFrame {
+    /// Its sequence number.
+    pub sequence: u64,
+    /// Subscribers it was delivered to (0: no tracker was connected).
+    pub receivers: usize,
 }
 
 /// Sends recorded frames to `primm/measurements`.
@@ -118,6 +138,7 @@ pub struct Replayer {
     answers: Option<(Subscriber<Ipc, TrackFrame, ()>, Listener<Ipc>)>,
     next_sequence: u64,
     answered_up_to: Option<u64>,
+    drop_log: LogLimiter,
     _measurements: Stream<MeasurementFrame>,
     _node: Node<Ipc>,
 }
@@ -137,6 +158,7 @@ impl Replayer {
             answers,
             next_sequence: 0,
             answered_up_to: None,
+            drop_log: LogLimiter::default(),
             _measurements: measurements,
             _node: node,
         })
@@ -162,13 +184,15 @@ impl Replayer {
         self.next_sequence
     }
 
-    /// Sends one frame with the given `FRAME_FLAG_*` bits; returns its sequence number.
+    /// Sends one frame with the given `FRAME_FLAG_*` bits; returns its sequence number and how
+    /// many subscribers received it. Never waits: with safe overflow a full subscriber buffer
+    /// drops its oldest frame instead.
     pub fn send(
         &mut self,
         sequence_name: &str,
         frame: &RecordedFrame,
         flags: u32,
-    ) -> Result<u64, ReplayError> {
+    ) -> Result<SentFrame, ReplayError> {
         if frame.measurements.len() > MEASUREMENT_CAPACITY {
             return Err(ReplayError::TooManyMeasurements {
                 sequence: sequence_name.to_owned(),
@@ -200,11 +224,11 @@ impl Replayer {
         // other slots hold bytes left in the shared-memory chunk, and every field of
         // `WireMeasurement` is a plain integer or float, valid for any bit pattern.
         let sample = unsafe { loan.assume_init() };
-        sample.send().map_err(ReplayError::Send)?;
+        let receivers = sample.send().map_err(ReplayError::Send)?;
         // A missing listener is not an error: the tracker may poll.
         let _ = self.notifier.notify();
         self.next_sequence += 1;
-        Ok(sequence)
+        Ok(SentFrame { sequence, receivers })
     }
 
     /// Reads the tracker's answers that arrived so far.
@@ -316,9 +340,26 @@ impl Replayer {
                     if last_of_replay || last_of_limit {
                         flags |= FRAME_FLAG_STREAM_END;
                     }
-                    self.send(&sequence.name, frame, flags)?;
-                    summary.frames_sent += 1;
-                    summary.measurements_sent += frame.measurements.len() as u64;
+                    match self.send(&sequence.name, frame, flags) {
+                        Ok(sent) => {
+                            summary.frames_sent += 1;
+                            summary.measurements_sent += frame.measurements.len() as u64;
+                            if sent.receivers == 0 {
+                                summary.frames_without_receiver += 1;
+                            }
+                        }
+                        Err(error @ (ReplayError::Loan(_) | ReplayError::Send(_))) => {
+                            summary.frames_dropped += 1;
+                            if self.drop_log.occur() {
+                                tracing::warn!(
+                                    %error,
+                                    occurrences = self.drop_log.occurrences(),
+                                    "measurement frame dropped"
+                                );
+                            }
+                        }
+                        Err(error) => return Err(error),
+                    }
                     if last_of_limit {
                         return Ok(summary);
                     }

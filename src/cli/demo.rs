@@ -31,6 +31,10 @@ pub struct Args {
     /// `models/pr.onnx` on the tracker's inference thread).
     #[arg(long, default_value = "imm")]
     pub method: Method,
+    /// PR model (ONNX) for the methods pr and pr-imm, passed to `primm serve --model`; default:
+    /// the model built into primm.
+    #[arg(long, value_name = "FILE")]
+    pub model: Option<PathBuf>,
     /// Let the tracker and subscriber spin instead of sleeping.
     #[arg(long)]
     pub busy_poll: bool,
@@ -50,6 +54,14 @@ pub enum DemoError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// The state of a started process could not be queried.
+    #[error("cannot watch {what}: {source}")]
+    Watch {
+        /// Which process.
+        what: &'static str,
+        /// The OS error.
+        source: std::io::Error,
+    },
     /// The demo could not watch the services.
     #[error(transparent)]
     Connect(#[from] ConnectError),
@@ -63,59 +75,80 @@ pub enum DemoError {
         /// The wait.
         seconds: u64,
     },
-    /// A process failed.
-    #[error("{what} failed ({status}){output}")]
-    Failed {
+    /// A process exited with a failure, or (the tracker) before it was asked to stop.
+    #[error("{what} exited ({status}){log}")]
+    Exited {
         /// Which process.
         what: &'static str,
         /// Its exit status.
         status: ExitStatus,
-        /// What it printed, if captured.
-        output: String,
+        /// What it wrote to stderr and stdout, indented, if anything.
+        log: String,
     },
     /// The subscriber never saw the end of the replay.
     #[error("the subscriber did not receive the answer to the last frame")]
     Incomplete,
 }
 
-/// A child process killed when dropped, unless it was waited for.
+/// How long a child asked to stop (SIGINT) may take before it is killed.
+const STOP_GRACE: Duration = Duration::from_secs(5);
+
+/// A child process, its stderr in a file. Dropping it stops it (SIGINT, then SIGKILL after
+/// [`STOP_GRACE`]) unless it has exited; with the demo killed outright, the kernel sends it
+/// SIGTERM (Linux), so that it still shuts down cleanly.
 struct Managed {
     what: &'static str,
     child: Child,
+    stderr_path: PathBuf,
 }
 
 impl Managed {
-    fn spawn(what: &'static str, command: &mut Command) -> Result<Self, DemoError> {
+    /// Starts `command` with its stderr written to `stderr_path`.
+    fn spawn(what: &'static str, command: &mut Command, stderr_path: PathBuf) -> Result<Self, DemoError> {
+        let stderr =
+            std::fs::File::create(&stderr_path).map_err(|source| DemoError::Spawn { what, source })?;
+        command.stderr(stderr);
+        stop_with_parent(command);
         let child = command.spawn().map_err(|source| DemoError::Spawn { what, source })?;
-        Ok(Self { what, child })
+        Ok(Self { what, child, stderr_path })
     }
 
-    fn is_running(&mut self) -> bool {
-        matches!(self.child.try_wait(), Ok(None))
+    /// Its exit status, if it has exited.
+    fn exited(&mut self) -> Result<Option<ExitStatus>, DemoError> {
+        self.child.try_wait().map_err(|source| DemoError::Watch { what: self.what, source })
     }
 
-    /// Waits for exit; captured stdout is returned.
-    fn wait(mut self, timeout: Duration) -> Result<(ExitStatus, String), DemoError> {
+    /// What it wrote to stdout (if captured; read once it has exited) and stderr.
+    fn output(&mut self) -> (String, String) {
+        let mut stdout = String::new();
+        if let Some(mut pipe) = self.child.stdout.take() {
+            use std::io::Read;
+            let _ = pipe.read_to_string(&mut stdout);
+        }
+        let stderr = std::fs::read_to_string(&self.stderr_path).unwrap_or_default();
+        (stdout, stderr)
+    }
+
+    /// The error for an exit with `status`, with everything the process printed.
+    fn exited_error(&mut self, status: ExitStatus) -> DemoError {
+        let (stdout, stderr) = self.output();
+        let printed: Vec<&str> =
+            stderr.lines().chain(stdout.lines()).filter(|line| !line.trim().is_empty()).collect();
+        let log = if printed.is_empty() { String::new() } else { format!(":\n  {}", printed.join("\n  ")) };
+        DemoError::Exited { what: self.what, status, log }
+    }
+
+    /// Waits up to `timeout` for exit.
+    fn wait(&mut self, timeout: Duration) -> Result<Option<ExitStatus>, DemoError> {
         let deadline = Instant::now() + timeout;
         loop {
-            if let Some(status) =
-                self.child.try_wait().map_err(|source| DemoError::Spawn { what: self.what, source })?
-            {
-                let mut output = String::new();
-                if let Some(mut stdout) = self.child.stdout.take() {
-                    use std::io::Read;
-                    let _ = stdout.read_to_string(&mut output);
-                }
-                return Ok((status, output));
+            if let Some(status) = self.exited()? {
+                return Ok(Some(status));
             }
             if Instant::now() >= deadline {
-                return Err(DemoError::Timeout {
-                    what: self.what,
-                    event: "finish",
-                    seconds: timeout.as_secs(),
-                });
+                return Ok(None);
             }
-            std::thread::sleep(Duration::from_millis(20));
+            std::thread::sleep(POLL_INTERVAL);
         }
     }
 
@@ -130,11 +163,39 @@ impl Managed {
 impl Drop for Managed {
     fn drop(&mut self) {
         if matches!(self.child.try_wait(), Ok(None)) {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
+            self.interrupt();
+            if !matches!(self.wait(STOP_GRACE), Ok(Some(_))) {
+                let _ = self.child.kill();
+                let _ = self.child.wait();
+            }
         }
+        let _ = std::fs::remove_file(&self.stderr_path);
     }
 }
+
+/// Asks the kernel to send `command`'s process SIGTERM when the demo dies (Linux), so that a
+/// demo killed with SIGKILL leaves no orphans; they stop as on Ctrl-C and clean up.
+fn stop_with_parent(command: &mut Command) {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::process::CommandExt;
+        // SAFETY: the closure runs in the child between fork and exec and calls only prctl,
+        // which is async-signal-safe.
+        unsafe {
+            command.pre_exec(|| {
+                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM) == -1 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = command;
+}
+
+/// How often the demo looks at its children.
+const POLL_INTERVAL: Duration = Duration::from_millis(20);
 
 /// A command running `binary` next to `exe` if it exists, else `exe subcommand`.
 fn companion(exe: &Path, binary: &str, subcommand: &str) -> Command {
@@ -153,25 +214,36 @@ pub fn run(args: Args) -> Result<(), DemoError> {
     let exe = std::env::current_exe().map_err(DemoError::Executable)?;
     let prefix = format!("primm-demo-{}", std::process::id());
     let names = ServiceNames::new(&prefix);
-    let summary_path: PathBuf = std::env::temp_dir().join(format!("{prefix}-summary.json"));
+    let files = std::env::temp_dir();
+    let summary_path: PathBuf = files.join(format!("{prefix}-summary.json"));
 
     println!(
         "primm demo: {:.0} s scenario (seed {}) replayed at {}x; tracker method {}; services under '{prefix}/'",
         args.duration_s, args.seed, args.speed, args.method
     );
-    let mut tracker = spawn_tracker(&exe, &prefix, &args)?;
-    let mut subscriber = spawn_subscriber(&exe, &prefix, &summary_path, &args)?;
+    let mut tracker = spawn_tracker(&exe, &prefix, &args, files.join(format!("{prefix}-tracker.log")))?;
+    let mut subscriber = spawn_subscriber(
+        &exe,
+        &prefix,
+        &summary_path,
+        &args,
+        files.join(format!("{prefix}-subscriber.log")),
+    )?;
     // Start the publisher once the tracker serves and the subscriber listens, so that no frame
     // and no answer is missed.
     wait_until_connected(&names, &mut tracker, &mut subscriber)?;
-    let publisher = spawn_publisher(&exe, &prefix, &args)?;
+    let publisher = spawn_publisher(&exe, &prefix, &args, files.join(format!("{prefix}-publisher.log")))?;
     let replay_s = args.duration_s / args.speed.max(1e-3);
-    let (subscriber_output, tracker_output) = wait_for_the_end(publisher, subscriber, tracker, replay_s)?;
-
-    println!("\n== subscriber (primm-subscriber) ==\n{subscriber_output}");
-    println!("== tracker (primm serve) ==\n{tracker_output}");
+    let outputs = wait_for_the_end(publisher, subscriber, tracker, replay_s);
     let complete = stream_end_seen(&summary_path);
     let _ = std::fs::remove_file(&summary_path);
+    let outputs = outputs?;
+
+    println!("\n== subscriber (primm-subscriber) ==\n{}", outputs.subscriber);
+    println!("== tracker (primm serve) ==\n{}", outputs.tracker);
+    if !outputs.logs.is_empty() {
+        println!("== logs ==\n{}", outputs.logs);
+    }
     if !complete {
         return Err(DemoError::Incomplete);
     }
@@ -185,16 +257,19 @@ fn quiet_logs(command: &mut Command) {
 }
 
 /// Starts `primm serve` under `prefix`, its output captured.
-fn spawn_tracker(exe: &Path, prefix: &str, args: &Args) -> Result<Managed, DemoError> {
+fn spawn_tracker(exe: &Path, prefix: &str, args: &Args, stderr_path: PathBuf) -> Result<Managed, DemoError> {
     let mut command = Command::new(exe);
     command
         .args(["serve", "--service-prefix", prefix, "--method", args.method.id(), "--latency-every", "50"])
         .stdout(Stdio::piped());
+    if let Some(model) = &args.model {
+        command.arg("--model").arg(model);
+    }
     if args.busy_poll {
         command.arg("--busy-poll");
     }
     quiet_logs(&mut command);
-    Managed::spawn("the tracker (primm serve)", &mut command)
+    Managed::spawn("the tracker (primm serve)", &mut command, stderr_path)
 }
 
 /// Starts the subscriber under `prefix` until the end of the replay, its output captured and
@@ -204,6 +279,7 @@ fn spawn_subscriber(
     prefix: &str,
     summary_path: &Path,
     args: &Args,
+    stderr_path: PathBuf,
 ) -> Result<Managed, DemoError> {
     let mut command = companion(exe, "primm-subscriber", "subscribe");
     command
@@ -214,11 +290,16 @@ fn spawn_subscriber(
         command.arg("--busy-poll");
     }
     quiet_logs(&mut command);
-    Managed::spawn("the subscriber", &mut command)
+    Managed::spawn("the subscriber", &mut command, stderr_path)
 }
 
 /// Starts the publisher replaying the built-in scenario under `prefix`.
-fn spawn_publisher(exe: &Path, prefix: &str, args: &Args) -> Result<Managed, DemoError> {
+fn spawn_publisher(
+    exe: &Path,
+    prefix: &str,
+    args: &Args,
+    stderr_path: PathBuf,
+) -> Result<Managed, DemoError> {
     let mut command = companion(exe, "primm-publisher", "publish");
     command.args([
         "--service-prefix",
@@ -231,12 +312,16 @@ fn spawn_publisher(exe: &Path, prefix: &str, args: &Args) -> Result<Managed, Dem
         "--speed",
         &args.speed.to_string(),
     ]);
+    command.stdout(Stdio::null());
     quiet_logs(&mut command);
-    Managed::spawn("the publisher", &mut command)
+    Managed::spawn("the publisher", &mut command, stderr_path)
 }
 
-/// Waits up to 30 s until the tracker publishes and the subscriber subscribes to the tracks of
-/// `names`.
+/// How long the tracker and the subscriber may take to come up.
+const READY_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// Waits up to [`READY_TIMEOUT`] until the tracker publishes and the subscriber subscribes to
+/// the tracks of `names`; fails at once, with its status and output, if either exits meanwhile.
 fn wait_until_connected(
     names: &ServiceNames,
     tracker: &mut Managed,
@@ -244,48 +329,89 @@ fn wait_until_connected(
 ) -> Result<(), DemoError> {
     let node = catalog::create_node("primm-demo")?;
     let tracks = catalog::tracks(&node, names)?;
-    let ready_deadline = Instant::now() + Duration::from_secs(30);
+    let ready_deadline = Instant::now() + READY_TIMEOUT;
     while tracks.publisher_count() == 0 || tracks.subscriber_count() == 0 {
-        if !tracker.is_running() || !subscriber.is_running() || Instant::now() >= ready_deadline {
-            let what = if !tracker.is_running() { tracker.what } else { subscriber.what };
-            return Err(DemoError::Timeout { what, event: "come up", seconds: 30 });
+        for child in [&mut *tracker, &mut *subscriber] {
+            if let Some(status) = child.exited()? {
+                return Err(child.exited_error(status));
+            }
         }
-        std::thread::sleep(Duration::from_millis(20));
+        if Instant::now() >= ready_deadline {
+            let what = if tracks.publisher_count() == 0 { tracker.what } else { subscriber.what };
+            return Err(DemoError::Timeout { what, event: "come up", seconds: READY_TIMEOUT.as_secs() });
+        }
+        std::thread::sleep(POLL_INTERVAL);
     }
     Ok(())
 }
 
-/// Waits for the publisher to finish its replay (`replay_s` plus a minute), the subscriber to see
-/// its end, and the tracker to stop when interrupted. Returns the subscriber's and the tracker's
-/// output.
+/// What the children printed in a successful demo.
+struct Outputs {
+    /// The subscriber's summary.
+    subscriber: String,
+    /// The tracker's counters and latency table.
+    tracker: String,
+    /// Their logs (stderr), labelled, if any.
+    logs: String,
+}
+
+/// Watches the three children until the publisher has finished its replay and the subscriber
+/// has seen its end (at most `replay_s` plus a minute), then stops the tracker. Fails at once
+/// when a child fails, or when the tracker exits before it is asked to.
 fn wait_for_the_end(
-    publisher: Managed,
-    subscriber: Managed,
-    tracker: Managed,
+    mut publisher: Managed,
+    mut subscriber: Managed,
+    mut tracker: Managed,
     replay_s: f64,
-) -> Result<(String, String), DemoError> {
-    let (status, _) = publisher.wait(Duration::from_secs_f64(replay_s + 60.0))?;
-    if !status.success() {
-        return Err(DemoError::Failed { what: "the publisher", status, output: String::new() });
-    }
-    let (status, subscriber_output) = subscriber.wait(Duration::from_secs(60))?;
-    if !status.success() {
-        return Err(DemoError::Failed {
-            what: "the subscriber",
-            status,
-            output: format!(":\n{subscriber_output}"),
-        });
+) -> Result<Outputs, DemoError> {
+    let limit = Duration::from_secs_f64(replay_s + 60.0);
+    let deadline = Instant::now() + limit;
+    let (mut publisher_done, mut subscriber_done) = (false, false);
+    while !(publisher_done && subscriber_done) {
+        if let Some(status) = tracker.exited()? {
+            return Err(tracker.exited_error(status));
+        }
+        for (child, done) in [(&mut publisher, &mut publisher_done), (&mut subscriber, &mut subscriber_done)]
+        {
+            if *done {
+                continue;
+            }
+            if let Some(status) = child.exited()? {
+                if !status.success() {
+                    return Err(child.exited_error(status));
+                }
+                *done = true;
+            }
+        }
+        if Instant::now() >= deadline {
+            let what = if publisher_done { subscriber.what } else { publisher.what };
+            return Err(DemoError::Timeout { what, event: "finish", seconds: limit.as_secs() });
+        }
+        std::thread::sleep(POLL_INTERVAL);
     }
     tracker.interrupt();
-    let (status, tracker_output) = tracker.wait(Duration::from_secs(10))?;
-    if !status.success() {
-        return Err(DemoError::Failed {
-            what: "the tracker",
-            status,
-            output: format!(":\n{tracker_output}"),
-        });
+    match tracker.wait(STOP_GRACE)? {
+        Some(status) if status.success() => {}
+        Some(status) => return Err(tracker.exited_error(status)),
+        None => {
+            return Err(DemoError::Timeout {
+                what: tracker.what,
+                event: "stop",
+                seconds: STOP_GRACE.as_secs(),
+            })
+        }
     }
-    Ok((subscriber_output, tracker_output))
+    let (subscriber_output, subscriber_log) = subscriber.output();
+    let (tracker_output, tracker_log) = tracker.output();
+    let (_, publisher_log) = publisher.output();
+    let logs =
+        [(tracker.what, tracker_log), (publisher.what, publisher_log), (subscriber.what, subscriber_log)]
+            .iter()
+            .filter(|(_, log)| !log.trim().is_empty())
+            .map(|(what, log)| format!("{what}:\n{}", log.trim_end()))
+            .collect::<Vec<_>>()
+            .join("\n");
+    Ok(Outputs { subscriber: subscriber_output, tracker: tracker_output, logs })
 }
 
 /// Whether the subscriber's JSON summary at `path` says it saw the end of the stream.

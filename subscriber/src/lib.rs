@@ -442,6 +442,7 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
     let names = ServiceNames::new(&args.service_prefix);
     let node = catalog::create_node("primm-subscriber")?;
     let ports = Ports::open(&node, &names, !args.no_truth)?;
+    tracing::info!(service = %names.tracks(), "subscribed");
     let mut viewer = Viewer::new(args, ports.truth.is_some(), open_csv(args)?);
     let waitset = WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)

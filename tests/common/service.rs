@@ -203,3 +203,143 @@ pub fn spawn_serve(prefix: &str, extra: &[&str]) -> ChildGuard {
         .expect("primm serve starts");
     ChildGuard(child)
 }
+
+/// A private iceoryx2 domain for the processes of one test (`PRIMM_ICEORYX2_DOMAIN`): every file
+/// iceoryx2 creates for them, in `/dev/shm` and under its directory in `/tmp`, starts with its
+/// name, so a test can count exactly its own resources while other tests run. Dropping it
+/// removes whatever the domain still holds (declare it before the test's `ChildGuard`s so that
+/// the processes are gone first).
+pub struct Iceoryx2Domain {
+    name: String,
+}
+
+/// Where iceoryx2 keeps the shared-memory segments and its own files.
+const ICEORYX2_LOCATIONS: [&str; 2] = ["/dev/shm", "/tmp/iceoryx2"];
+
+impl Iceoryx2Domain {
+    pub fn new(test: &str) -> Self {
+        let stamp = monotonic_ns() % 1_000_000_000_000;
+        Self { name: format!("primm_{test}_{}_{stamp}_", std::process::id()) }
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Every file of the domain, except its node counter (`…_node.<version>.global_mgmt`), which
+    /// iceoryx2 creates once per domain and never removes.
+    pub fn resources(&self) -> Vec<std::path::PathBuf> {
+        self.all_files()
+            .into_iter()
+            .filter(|path| !path.to_string_lossy().ends_with(".global_mgmt"))
+            .collect()
+    }
+
+    /// The domain's node counter files (at most one per iceoryx2 version).
+    pub fn node_counters(&self) -> usize {
+        self.all_files().len() - self.resources().len()
+    }
+
+    fn all_files(&self) -> Vec<std::path::PathBuf> {
+        let mut found = Vec::new();
+        let mut pending: Vec<std::path::PathBuf> = ICEORYX2_LOCATIONS.iter().map(Into::into).collect();
+        while let Some(directory) = pending.pop() {
+            let Ok(entries) = std::fs::read_dir(&directory) else { continue };
+            for entry in entries.flatten() {
+                let path = entry.path();
+                if entry.file_type().is_ok_and(|kind| kind.is_dir()) {
+                    pending.push(path);
+                } else if entry.file_name().to_string_lossy().starts_with(&self.name) {
+                    found.push(path);
+                }
+            }
+        }
+        found.sort();
+        found
+    }
+
+    /// Processes running in this domain (by their environment), other than this one.
+    pub fn processes(&self) -> usize {
+        let marker = format!("PRIMM_ICEORYX2_DOMAIN={}", self.name);
+        let Ok(entries) = std::fs::read_dir("/proc") else { return 0 };
+        entries
+            .flatten()
+            .filter(|entry| entry.file_name().to_string_lossy().chars().all(|c| c.is_ascii_digit()))
+            .filter_map(|entry| std::fs::read(entry.path().join("environ")).ok())
+            .filter(|environment| {
+                environment.split(|&byte| byte == 0).any(|variable| variable == marker.as_bytes())
+            })
+            .count()
+    }
+
+    /// A `primm` command in this domain, its logs at `log_level`.
+    pub fn primm(&self, log_level: &str) -> Command {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_primm"));
+        command.env("PRIMM_ICEORYX2_DOMAIN", &self.name).env("RUST_LOG", log_level);
+        command
+    }
+}
+
+impl Drop for Iceoryx2Domain {
+    fn drop(&mut self) {
+        for path in self.all_files() {
+            let _ = std::fs::remove_file(&path);
+            // Node directories are named by the node's id and hold only its tag files.
+            if let Some(parent) = path.parent() {
+                if parent.parent().is_some_and(|p| p.ends_with("nodes")) {
+                    let _ = std::fs::remove_dir(parent);
+                }
+            }
+        }
+    }
+}
+
+/// Waits until `condition` holds, polling; panics with `what` after `timeout` (a guard against a
+/// hang, not a timing assertion).
+pub fn wait_until(what: &str, timeout: Duration, mut condition: impl FnMut() -> bool) {
+    let deadline = Instant::now() + timeout;
+    while !condition() {
+        assert!(Instant::now() < deadline, "{what} (waited {timeout:?})");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// The lines a child writes to a pipe (stdout or stderr), collected by a thread so that the
+/// child never blocks on a full pipe.
+pub struct LineCollector {
+    lines: std::sync::Arc<std::sync::Mutex<Vec<String>>>,
+}
+
+impl LineCollector {
+    pub fn new(pipe: impl std::io::Read + Send + 'static) -> Self {
+        use std::io::BufRead;
+        let lines = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        let sink = lines.clone();
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(pipe).lines() {
+                let Ok(line) = line else { break };
+                sink.lock().unwrap().push(line);
+            }
+        });
+        Self { lines }
+    }
+
+    /// Everything collected so far.
+    pub fn text(&self) -> String {
+        self.lines.lock().unwrap().join("\n")
+    }
+
+    /// Waits until a line contains `needle` (panics after `timeout`, a guard against a hang).
+    pub fn wait_for(&self, needle: &str, timeout: Duration) {
+        wait_until(&format!("no line contains '{needle}' in:\n{}", self.text()), timeout, || {
+            self.lines.lock().unwrap().iter().any(|line| line.contains(needle))
+        });
+    }
+}
+
+/// `command` started with its stderr collected.
+pub fn spawn_collecting_stderr(command: &mut Command) -> (ChildGuard, LineCollector) {
+    let mut child = command.stderr(Stdio::piped()).spawn().expect("the process starts");
+    let stderr = LineCollector::new(child.stderr.take().unwrap());
+    (ChildGuard(child), stderr)
+}

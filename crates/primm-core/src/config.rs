@@ -7,6 +7,7 @@
 
 use crate::measurement::ObjectClass;
 use crate::mode::{ModeSet, MODE_COUNT};
+use crate::readable_number::readable;
 pub use crate::tracking_frame::{FrameConfig, TrackingFrame};
 use alloc::format;
 use alloc::string::String;
@@ -323,7 +324,7 @@ fn positive(key: &str, value: f64) -> Result<(), ConfigError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(invalid(key, format!("must be a finite number > 0, got {value}")))
+        Err(invalid(key, format!("must be a finite number > 0, got {}", readable(value))))
     }
 }
 
@@ -379,7 +380,7 @@ fn validate_imm(imm: &ImmConfig) -> Result<(), ConfigError> {
         if !(0.0..=1.0).contains(&p) {
             return Err(invalid(
                 format!("imm.initial_mode_probabilities[{i}]"),
-                format!("must be a probability in [0, 1], got {p}"),
+                format!("must be a probability in [0, 1], got {}", readable(p)),
             ));
         }
     }
@@ -391,7 +392,7 @@ fn validate_imm(imm: &ImmConfig) -> Result<(), ConfigError> {
     if !(floor >= 0.0 && floor < 1.0 / imm.modes.len() as f64) {
         return Err(invalid(
             "imm.mode_probability_floor",
-            format!("must be in [0, 1/number of active modes), got {floor}"),
+            format!("must be in [0, 1/number of active modes), got {}", readable(floor)),
         ));
     }
     Ok(())
@@ -405,13 +406,16 @@ fn validate_transition(imm: &ImmConfig) -> Result<(), ConfigError> {
             if !(0.0..=1.0).contains(&p) {
                 return Err(invalid(
                     format!("imm.transition[{i}][{j}]"),
-                    format!("must be a probability in [0, 1], got {p}"),
+                    format!("must be a probability in [0, 1], got {}", readable(p)),
                 ));
             }
         }
         let sum: f64 = row.iter().sum();
         if (sum - 1.0).abs() > 1e-9 {
-            return Err(invalid(format!("imm.transition[{i}]"), format!("row must sum to 1, sums to {sum}")));
+            return Err(invalid(
+                format!("imm.transition[{i}]"),
+                format!("row must sum to 1, sums to {}", readable(sum)),
+            ));
         }
     }
     for mode in imm.modes.iter() {

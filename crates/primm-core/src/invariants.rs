@@ -15,6 +15,7 @@ use crate::imm::ImmState;
 use crate::limits::MAX_TRACKS;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
 use crate::predictor::DisplacementPredictor;
+use crate::readable_number::readable;
 use crate::track::Track;
 use crate::tracker::Tracker;
 use nalgebra::SMatrix;
@@ -102,10 +103,10 @@ impl core::fmt::Display for InvariantViolation {
                 write!(f, "track {track_id}: the {} covariance is not positive definite", mode.id())
             }
             InvariantViolation::InvalidProbability { track_id, mode, probability } => {
-                write!(f, "track {track_id}: the {} probability is {probability}", mode.id())
+                write!(f, "track {track_id}: the {} probability is {}", mode.id(), readable(probability))
             }
             InvariantViolation::ProbabilitiesDoNotSumToOne { track_id, sum } => {
-                write!(f, "track {track_id}: the mode probabilities sum to {sum}")
+                write!(f, "track {track_id}: the mode probabilities sum to {}", readable(sum))
             }
         }
     }

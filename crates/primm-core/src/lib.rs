@@ -63,6 +63,7 @@ pub mod mode;
 pub mod motion;
 pub mod pose;
 pub mod predictor;
+pub mod readable_number;
 pub mod stage_timing;
 pub mod track;
 pub mod track_loops;

@@ -7,6 +7,7 @@
 
 use crate::config::TrackerConfig;
 use crate::measurement::{FrameView, Measurement, MAX_MEASUREMENTS_PER_FRAME};
+use crate::readable_number::readable;
 
 /// Largest accepted magnitude of a position, radial velocity or RCS value. Anything beyond is
 /// not a radar measurement and would overflow squared distances.
@@ -16,13 +17,17 @@ pub const MAX_ABSOLUTE_VALUE: f64 = 1.0e6;
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum FrameError {
     /// The timestamp is NaN or infinite.
-    #[error("frame timestamp {timestamp_s} is not finite")]
+    #[error("frame timestamp {} is not finite", readable(.timestamp_s))]
     NonFiniteTimestamp {
         /// The timestamp, s.
         timestamp_s: f64,
     },
     /// The timestamp is not later than the previous accepted frame's.
-    #[error("frame timestamp {timestamp_s} s does not advance past the previous frame at {previous_s} s")]
+    #[error(
+        "frame timestamp {} s does not advance past the previous frame at {} s",
+        readable(.timestamp_s),
+        readable(.previous_s)
+    )]
     TimestampNotIncreasing {
         /// The timestamp, s.
         timestamp_s: f64,
@@ -32,7 +37,7 @@ pub enum FrameError {
     /// The time since the previous accepted frame exceeds `tracker.max_frame_interval_s`.
     /// Tracks cannot be bridged over such a gap; the caller may [`reset`](crate::tracker::Tracker::reset)
     /// the tracker and resubmit the frame.
-    #[error("frame interval {interval_s} s exceeds the maximum of {max_s} s")]
+    #[error("frame interval {} s exceeds the maximum of {} s", readable(.interval_s), readable(.max_s))]
     IntervalTooLong {
         /// The interval, s.
         interval_s: f64,
@@ -43,7 +48,12 @@ pub enum FrameError {
     /// when tracking in the world frame).
     ///
     /// [`MAX_EGO_POSITION_M`]: crate::pose::MAX_EGO_POSITION_M
-    #[error("frame ego pose (x {x_m} m, y {y_m} m, yaw {yaw_rad} rad) is not finite or too far out")]
+    #[error(
+        "frame ego pose (x {} m, y {} m, yaw {} rad) is not finite or too far out",
+        readable(.x_m),
+        readable(.y_m),
+        readable(.yaw_rad)
+    )]
     InvalidEgoPose {
         /// x of the pose, m.
         x_m: f64,

@@ -81,6 +81,14 @@ pub enum ConnectError {
         /// iceoryx2's reason.
         reason: iceoryx2::service::service_name::ServiceNameError,
     },
+    /// The iceoryx2 domain in [`ICEORYX2_DOMAIN_ENV`] is not a valid file-name prefix.
+    #[error("invalid iceoryx2 domain '{domain}' in {ICEORYX2_DOMAIN_ENV}: {reason:?}")]
+    InvalidDomain {
+        /// The domain as given.
+        domain: String,
+        /// Why iceoryx2 refuses it as a file name.
+        reason: SemanticStringError,
+    },
     /// The iceoryx2 node could not be created.
     #[error("cannot create the iceoryx2 node: {0}")]
     Node(NodeCreationFailure),
@@ -182,19 +190,68 @@ impl ServiceNames {
     }
 }
 
+/// Environment variable naming the iceoryx2 domain primm's programs use: the prefix of every
+/// file iceoryx2 creates in `/dev/shm` and in its directory under `/tmp` (default `iox2_`, the
+/// domain every iceoryx2 program shares). Programs in different domains never see each other,
+/// so a private domain isolates a setup completely (the integration tests use one each).
+pub const ICEORYX2_DOMAIN_ENV: &str = "PRIMM_ICEORYX2_DOMAIN";
+
+/// The iceoryx2 configuration of primm's nodes: iceoryx2's global configuration, in the domain
+/// [`ICEORYX2_DOMAIN_ENV`] names (if set), with the removal of dead nodes left to
+/// [`create_node`] so that it can count them.
+pub fn iceoryx2_config() -> Result<Config, ConnectError> {
+    let mut config = Config::global_config().clone();
+    if let Ok(domain) = std::env::var(ICEORYX2_DOMAIN_ENV) {
+        config.global.prefix = FileName::new(domain.as_bytes())
+            .map_err(|reason| ConnectError::InvalidDomain { domain: domain.clone(), reason })?;
+    }
+    config.global.node.cleanup_dead_nodes_on_creation = false;
+    Ok(config)
+}
+
 /// Creates a node named `name` that leaves SIGINT/SIGTERM to the program (see
-/// [`crate::shutdown`]). Creating a node also removes the resources of nodes that died
-/// without cleaning up (e.g. after `kill -9`), so a restarted program starts clean.
+/// [`crate::shutdown`]), in the domain of [`iceoryx2_config`].
+///
+/// It then removes, through iceoryx2's own bookkeeping (`Node::try_cleanup_dead_nodes`), the
+/// resources of every node of the domain whose process died without cleaning up (e.g. after
+/// `kill -9`): their shared-memory segments, their ports in the services they used, and services
+/// only they still held. How many were removed is logged (and how many could not be, e.g. while
+/// another process is removing them), so a restarted program starts clean and says so.
+///
+/// Dropping the node (after every port and service handle made from it) removes all of its own
+/// resources; a program that returns from `main` normally leaves nothing of its own in
+/// `/dev/shm`. One file stays by design: the domain's node counter
+/// (`<domain><hash>_node.<version>.global_mgmt`, 16 bytes), which iceoryx2 creates once per domain
+/// and version without an owner, shares with every process of the domain and never removes.
 pub fn create_node(name: &str) -> Result<Node<Ipc>, ConnectError> {
     // iceoryx2 logs to the console on its own; keep it to errors unless IOX2_LOG_LEVEL says
     // otherwise (primm's own logs go through `tracing`).
     static QUIET_ICEORYX2: std::sync::Once = std::sync::Once::new();
     QUIET_ICEORYX2.call_once(|| set_log_level_from_env_or(LogLevel::Error));
-    let mut builder = NodeBuilder::new().signal_handling_mode(SignalHandlingMode::Disabled);
+    let config = iceoryx2_config()?;
+    let mut builder = NodeBuilder::new().config(&config).signal_handling_mode(SignalHandlingMode::Disabled);
     if let Ok(node_name) = NodeName::new(name) {
         builder = builder.name(&node_name);
     }
-    builder.create::<Ipc>().map_err(ConnectError::Node)
+    let node = builder.create::<Ipc>().map_err(ConnectError::Node)?;
+    let cleanup = node.try_cleanup_dead_nodes();
+    if cleanup.cleanups > 0 {
+        tracing::info!(
+            removed = cleanup.cleanups,
+            domain = %config.global.prefix,
+            "removed the resources of {} dead iceoryx2 node(s)",
+            cleanup.cleanups
+        );
+    }
+    if cleanup.failed_cleanups > 0 {
+        tracing::warn!(
+            failed = cleanup.failed_cleanups,
+            domain = %config.global.prefix,
+            "could not remove the resources of {} dead iceoryx2 node(s)",
+            cleanup.failed_cleanups
+        );
+    }
+    Ok(node)
 }
 
 /// One opened stream: the pub/sub service and its event service.

@@ -89,7 +89,8 @@ pub struct ServiceCounters {
     pub frames_tracked: u64,
     /// Frames rejected (answered with a rejection status).
     pub frames_rejected: u64,
-    /// Input sequence numbers skipped (frames lost before the tracker saw them).
+    /// Input sequence numbers skipped: frames a publisher sent that this tracker never took
+    /// (dropped from its full input buffer, or sent before it subscribed).
     pub frames_lost: u64,
     /// Resets because a frame started a new stream.
     pub resets_stream_start: u64,
@@ -193,11 +194,14 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         })
     }
 
-    /// Runs until `shutdown` is raised, then publishes a last latency report.
+    /// Runs until `shutdown` is raised, then tracks the frames already in the input buffer (at
+    /// most its 64, so that every frame delivered is either tracked or counted as lost) and
+    /// publishes a last latency report.
     pub fn run(&mut self, shutdown: &ShutdownFlag) -> Result<(), TrackingLoopError> {
         while !shutdown.is_requested() {
             self.poll(self.options.poll_timeout)?;
         }
+        self.drain()?;
         self.publish_latency_report();
         Ok(())
     }
@@ -377,39 +381,46 @@ impl<P: DisplacementPredictor> TrackingService<P> {
 
     /// Resets the tracker when a new stream or publisher starts; counts sequence gaps. Returns
     /// the track-frame flags this implies.
+    ///
+    /// A publisher numbers its frames from 0 without a break, across the streams it sends, and
+    /// a frame it could not send takes no number; so every number missing before the frame in
+    /// hand (since the previous frame of the same publisher, or since 0 for its first frame
+    /// here) is a frame sent but never taken by this tracker: dropped from the full input
+    /// buffer, or sent before this tracker subscribed.
     fn follow_stream(&mut self, origin: UniquePublisherId, frame: &MeasurementFrame) -> u8 {
         let mut flags = 0;
-        let new_publisher = self.stream.origin.is_some_and(|previous| previous != origin);
+        let first_from_publisher = self.stream.origin != Some(origin);
+        let new_publisher = self.stream.origin.is_some() && first_from_publisher;
         let stream_start = frame.flags & FRAME_FLAG_STREAM_START != 0;
-        if stream_start || new_publisher {
-            if self.stream.tracker_dirty {
-                self.tracker.reset();
-                self.stream.tracker_dirty = false;
-                flags |= TRACK_FLAG_TRACKER_RESET;
-                if new_publisher {
-                    self.counters.resets_new_publisher += 1;
-                    tracing::info!(sequence = frame.sequence, "frames from a new publisher: tracker reset");
-                } else {
-                    self.counters.resets_stream_start += 1;
-                    tracing::info!(sequence = frame.sequence, "new stream: tracker reset");
-                }
+        if (stream_start || new_publisher) && self.stream.tracker_dirty {
+            self.tracker.reset();
+            self.stream.tracker_dirty = false;
+            flags |= TRACK_FLAG_TRACKER_RESET;
+            if new_publisher {
+                self.counters.resets_new_publisher += 1;
+                tracing::info!(sequence = frame.sequence, "frames from a new publisher: tracker reset");
+            } else {
+                self.counters.resets_stream_start += 1;
+                tracing::info!(sequence = frame.sequence, "new stream: tracker reset");
             }
+        }
+        if first_from_publisher {
             self.stream.last_sequence = None;
         }
         self.stream.origin = Some(origin);
-        if let Some(last) = self.stream.last_sequence {
-            if frame.sequence > last.saturating_add(1) {
-                let lost = frame.sequence - last - 1;
-                self.counters.frames_lost += lost;
-                flags |= TRACK_FLAG_SEQUENCE_GAP;
-                if self.logs.lost.occur() {
-                    tracing::warn!(
-                        lost,
-                        after = last,
-                        occurrences = self.logs.lost.occurrences(),
-                        "measurement frames lost"
-                    );
-                }
+        let expected = self.stream.last_sequence.map_or(0, |last| last.saturating_add(1));
+        if frame.sequence > expected {
+            let lost = frame.sequence - expected;
+            self.counters.frames_lost += lost;
+            flags |= TRACK_FLAG_SEQUENCE_GAP;
+            if self.logs.lost.occur() {
+                tracing::warn!(
+                    lost,
+                    expected,
+                    received = frame.sequence,
+                    occurrences = self.logs.lost.occurrences(),
+                    "measurement frames lost"
+                );
             }
         }
         self.stream.last_sequence = Some(frame.sequence);

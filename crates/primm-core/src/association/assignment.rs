@@ -78,6 +78,7 @@
 //! copy add `O(rows·cols)`. Every buffer is sized once by [`AssignmentSolver::with_capacity`] and
 //! reused, so [`AssignmentSolver::solve`] performs no heap allocation at all.
 
+use crate::readable_number::readable;
 use alloc::vec;
 use alloc::vec::Vec;
 use thiserror::Error;
@@ -151,7 +152,11 @@ pub enum AssignmentError {
         col: usize,
     },
     /// The allowed costs span a range so wide that solving could overflow `f64`.
-    #[error("allowed costs range from {lowest} to {highest}, too wide to solve without overflow")]
+    #[error(
+        "allowed costs range from {} to {}, too wide to solve without overflow",
+        readable(.lowest),
+        readable(.highest)
+    )]
     CostRangeTooLarge {
         /// Smallest allowed cost.
         lowest: f64,

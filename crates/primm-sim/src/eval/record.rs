@@ -4,6 +4,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use primm_core::measurement::ObjectClass;
+use primm_core::readable_number::readable;
 
 pub use primm_core::mode::Method;
 
@@ -61,7 +62,7 @@ impl AssociationRecord {
 #[derive(Debug, thiserror::Error)]
 pub enum EvalError {
     /// A drop fraction outside `[0, 1]` (or not finite).
-    #[error("drop fraction {0} is not within [0, 1]")]
+    #[error("drop fraction {} is not within [0, 1]", readable(.0))]
     InvalidDropFraction(f64),
     /// Scenario or interaction rules that cannot be applied.
     #[error("invalid rule parameters: {0}")]

@@ -39,6 +39,7 @@ use glam::DVec2;
 
 use super::recording::{EgoPose, RecordedFrame, RecordedMeasurement, Sequence};
 use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use primm_core::readable_number::readable;
 
 /// Columns every file must have.
 pub const REQUIRED_COLUMNS: [&str; 10] =
@@ -86,7 +87,11 @@ pub enum CsvErrorKind {
         found: u64,
     },
     /// Rows of one frame carry different timestamps.
-    #[error("timestamp {found} differs from {expected}, the timestamp of the first row of frame {frame}")]
+    #[error(
+        "timestamp {} differs from {}, the timestamp of the first row of frame {frame}",
+        readable(.found),
+        readable(.expected)
+    )]
     TimeMismatch {
         /// The frame.
         frame: u64,
@@ -97,7 +102,9 @@ pub enum CsvErrorKind {
     },
     /// A frame starts earlier than the previous frame.
     #[error(
-        "timestamp {found} of frame {frame} is earlier than {previous}, the timestamp of the previous frame"
+        "timestamp {} of frame {frame} is earlier than {}, the timestamp of the previous frame",
+        readable(.found),
+        readable(.previous)
     )]
     TimeDecreasing {
         /// The frame.
@@ -141,7 +148,7 @@ pub enum CsvErrorKind {
         found: u64,
     },
     /// Writer: a value to be written is NaN or infinite.
-    #[error("non-finite value {0}")]
+    #[error("non-finite value {}", readable(.0))]
     NonFinite(f64),
 }
 

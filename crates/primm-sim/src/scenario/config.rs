@@ -5,6 +5,7 @@
 //! missing fields taken from the default, and [`ScenarioConfig::validate`] checks the physical
 //! and logical consistency of a configuration before it is used.
 
+use primm_core::readable_number::readable;
 use serde::{Deserialize, Serialize};
 
 /// A closed interval `[min, max]` from which a value is drawn uniformly.
@@ -786,7 +787,7 @@ impl ScenarioConfig {
         if r.block_length_m < needed {
             return Err(ConfigError::new(
                 "road.block_length_m",
-                format!("must be at least {needed:.1} m for these lanes and turn radii"),
+                format!("must be at least {:.1} m for these lanes and turn radii", readable(needed)),
             ));
         }
         Ok(())
@@ -974,7 +975,7 @@ impl ScenarioConfig {
                 "radar.scan_jitter_s",
                 format!(
                     "plus radar.phase_jitter_s must stay below half the slot between sensors ({:.4} s) so that scans stay interleaved",
-                    slot / 2.0
+                    readable(slot / 2.0)
                 ),
             ));
         }
@@ -1054,7 +1055,7 @@ fn positive(field: &str, value: f64) -> Result<(), ConfigError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(ConfigError::new(field, format!("must be a positive number (got {value})")))
+        Err(ConfigError::new(field, format!("must be a positive number (got {})", readable(value))))
     }
 }
 
@@ -1062,7 +1063,7 @@ fn non_negative(field: &str, value: f64) -> Result<(), ConfigError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(ConfigError::new(field, format!("must be a non-negative number (got {value})")))
+        Err(ConfigError::new(field, format!("must be a non-negative number (got {})", readable(value))))
     }
 }
 
@@ -1070,7 +1071,7 @@ fn probability(field: &str, value: f64) -> Result<(), ConfigError> {
     if (0.0..=1.0).contains(&value) {
         Ok(())
     } else {
-        Err(ConfigError::new(field, format!("must be a probability in [0, 1] (got {value})")))
+        Err(ConfigError::new(field, format!("must be a probability in [0, 1] (got {})", readable(value))))
     }
 }
 
@@ -1079,11 +1080,18 @@ fn interval(field: &str, value: Interval, strictly_positive: bool) -> Result<(),
     if !(lo.is_finite() && hi.is_finite()) || lo > hi {
         return Err(ConfigError::new(
             field,
-            format!("must be an interval [min, max] with min <= max (got [{lo}, {hi}])"),
+            format!(
+                "must be an interval [min, max] with min <= max (got [{}, {}])",
+                readable(lo),
+                readable(hi)
+            ),
         ));
     }
     if strictly_positive && lo <= 0.0 {
-        return Err(ConfigError::new(field, format!("must be positive (got [{lo}, {hi}])")));
+        return Err(ConfigError::new(
+            field,
+            format!("must be positive (got [{}, {}])", readable(lo), readable(hi)),
+        ));
     }
     Ok(())
 }

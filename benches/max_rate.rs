@@ -1,0 +1,149 @@
+//! Highest sustained frame rate: the fastest publish rate at which a `primm serve` process
+//! loses no frame, at a given number of objects per frame.
+//!
+//! A trial sends frames at a fixed wall-clock rate for a fixed time (the scene of
+//! `benches/service_latency.rs`: objects on lanes, 0.2 m noise, 50 ms sensor time between
+//! frames, repeating every 500 frames as a new stream), reading the answers as they come. The
+//! tracker's input buffer holds 64 frames, so a rate above what it sustains overflows it within
+//! the trial and the tracker counts the lost frames (sequence gaps); the trial's verdict is that
+//! count, read from `primm serve`'s summary at shutdown. The rate doubles from `--start-hz`
+//! until a trial loses frames, then bisection narrows the boundary `--steps` times. The latency
+//! of the answered frames (publisher send → answer received) is reported per trial.
+//!
+//! Prints one line per trial and a summary table; writes nothing and asserts nothing.
+//!
+//! `cargo bench --bench max_rate [-- --objects 64] [--methods imm,pr-imm] [--seconds 20] [--start-hz 50] [--steps 4]`
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::service::{spawn_serve, unique_prefix, TestClient};
+use hdrhistogram::Histogram;
+use primm_service::clock::monotonic_ns;
+use primm_service::ServiceNames;
+use std::time::{Duration, Instant};
+
+/// What one trial saw.
+struct Trial {
+    rate_hz: f64,
+    sent: u64,
+    lost: u64,
+    answered: u64,
+    latency_ns: Histogram<u64>,
+    tracker_summary: String,
+}
+
+/// The value before `what` in the tracker's `frames: ...` summary line.
+fn summary_count(summary: &str, what: &str) -> Option<u64> {
+    let line = summary.lines().find(|line| line.starts_with("frames: "))?;
+    let field = line.split([',', ';', ':']).find(|field| field.trim().ends_with(what))?;
+    field.trim().split(' ').next()?.parse().ok()
+}
+
+fn trial(method: &str, objects: usize, rate_hz: f64, seconds: f64) -> Trial {
+    let prefix = unique_prefix(&format!("max-rate-{method}"));
+    let client = TestClient::new(&ServiceNames::new(&prefix));
+    let serve = spawn_serve(&prefix, &["--method", method, "--latency-every", "100"]);
+    client.wait_for_tracker(Duration::from_secs(60));
+    let scene = common::scene_frames(&common::lanes(objects), 500, 0.05, 0.2, 11);
+    let mut latency_ns = Histogram::<u64>::new_with_bounds(1, 60_000_000_000, 3).unwrap();
+    let mut answered = 0;
+    let mut read_answers = |latency_ns: &mut Histogram<u64>| {
+        while let Some(sample) = client.answers.receive().unwrap() {
+            latency_ns.saturating_record(monotonic_ns().saturating_sub(sample.input_publish_time_ns).max(1));
+            answered += 1;
+        }
+    };
+    let frames = (rate_hz * seconds).ceil() as u64;
+    let interval = Duration::from_secs_f64(1.0 / rate_hz);
+    let start = Instant::now();
+    let mut frame = scene[0].clone();
+    for k in 0..frames {
+        let due = start + interval.mul_f64(k as f64);
+        loop {
+            read_answers(&mut latency_ns);
+            let now = Instant::now();
+            if now >= due {
+                break;
+            }
+            std::thread::sleep((due - now).min(Duration::from_micros(500)));
+        }
+        let source = &scene[(k as usize) % scene.len()];
+        frame.timestamp_s = k as f64 * 0.05;
+        frame.measurements.clone_from(&source.measurements);
+        let flags = if (k as usize) % scene.len() == 0 { primm_wire::FRAME_FLAG_STREAM_START } else { 0 };
+        client.send(&frame, k, flags);
+    }
+    let drain_until = Instant::now() + Duration::from_secs(2);
+    while Instant::now() < drain_until {
+        read_answers(&mut latency_ns);
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    serve.signal(libc::SIGINT);
+    let (_, tracker_summary) = serve.wait(Duration::from_secs(30));
+    let lost = summary_count(&tracker_summary, "lost").unwrap_or(u64::MAX);
+    Trial { rate_hz, sent: frames, lost, answered, latency_ns, tracker_summary }
+}
+
+fn argument(name: &str) -> Option<String> {
+    let args: Vec<String> = std::env::args().collect();
+    args.iter().position(|a| a == name).and_then(|i| args.get(i + 1).cloned())
+}
+
+fn report(method: &str, trial: &Trial) {
+    let ms = |q: f64| trial.latency_ns.value_at_quantile(q) as f64 / 1.0e6;
+    println!(
+        "{method} {:.0} Hz: {} sent, {} lost, {} answers read; send -> answer p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms",
+        trial.rate_hz,
+        trial.sent,
+        trial.lost,
+        trial.answered,
+        ms(0.5),
+        ms(0.99),
+        trial.latency_ns.max() as f64 / 1.0e6
+    );
+    if let Some(line) = trial.tracker_summary.lines().find(|line| line.starts_with("learned predictor")) {
+        println!("    {line}");
+    }
+}
+
+fn main() {
+    let objects: usize = argument("--objects").and_then(|v| v.parse().ok()).unwrap_or(64);
+    let seconds: f64 = argument("--seconds").and_then(|v| v.parse().ok()).unwrap_or(20.0);
+    let start_hz: f64 = argument("--start-hz").and_then(|v| v.parse().ok()).unwrap_or(50.0);
+    let steps: usize = argument("--steps").and_then(|v| v.parse().ok()).unwrap_or(4);
+    let methods = argument("--methods").unwrap_or_else(|| "imm,pr-imm".into());
+    let mut results = Vec::new();
+    for method in methods.split(',') {
+        let (mut good, mut bad): (Option<f64>, Option<f64>) = (None, None);
+        let mut rate = start_hz;
+        while bad.is_none() && rate <= 100_000.0 {
+            let outcome = trial(method, objects, rate, seconds);
+            report(method, &outcome);
+            if outcome.lost == 0 {
+                good = Some(rate);
+                rate *= 2.0;
+            } else {
+                bad = Some(rate);
+            }
+        }
+        for _ in 0..steps {
+            let (Some(low), Some(high)) = (good, bad) else { break };
+            let rate = (low + high) / 2.0;
+            let outcome = trial(method, objects, rate, seconds);
+            report(method, &outcome);
+            if outcome.lost == 0 {
+                good = Some(rate);
+            } else {
+                bad = Some(rate);
+            }
+        }
+        results.push((method.to_owned(), good, bad));
+    }
+    println!("\n| method | objects | trial s | highest rate without loss, Hz | lowest rate with loss, Hz |");
+    println!("|---|---|---|---|---|");
+    let show = |rate: Option<f64>| rate.map_or("-".to_owned(), |r| format!("{r:.0}"));
+    for (method, good, bad) in results {
+        println!("| {method} | {objects} | {seconds} | {} | {} |", show(good), show(bad));
+    }
+}
