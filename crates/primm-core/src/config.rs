@@ -245,17 +245,17 @@ impl Default for Config {
             },
             classes: ClassTable {
                 car: ClassConfig {
-                    gate_m: 6.0,
+                    gate_m: 8.4,
                     measurement_noise_covariance_m2: diagonal(0.36, 0.36),
                     radial_velocity_std_mps: 0.5,
-                    initial_tangential_speed_std_mps: 8.0,
-                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 4.0 },
+                    initial_tangential_speed_std_mps: 2.0,
+                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
                     constant_acceleration: ConstantAccelerationConfig {
-                        jerk_psd_m2_per_s5: 20.0,
+                        jerk_psd_m2_per_s5: 5.0,
                         initial_acceleration_std_mps2: 2.0,
                     },
                     coordinated_turn: CoordinatedTurnConfig {
-                        acceleration_psd_m2_per_s3: 2.0,
+                        acceleration_psd_m2_per_s3: 0.5,
                         turn_rate_psd_rad2_per_s3: 0.3,
                         initial_turn_rate_std_radps: 0.3,
                     },
@@ -265,18 +265,18 @@ impl Default for Config {
                     },
                 },
                 pedestrian: ClassConfig {
-                    gate_m: 3.0,
+                    gate_m: 4.2,
                     measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     radial_velocity_std_mps: 0.3,
-                    initial_tangential_speed_std_mps: 1.5,
-                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
+                    initial_tangential_speed_std_mps: 0.525,
+                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
                     constant_acceleration: ConstantAccelerationConfig {
-                        jerk_psd_m2_per_s5: 5.0,
+                        jerk_psd_m2_per_s5: 1.75,
                         initial_acceleration_std_mps2: 1.0,
                     },
                     coordinated_turn: CoordinatedTurnConfig {
-                        acceleration_psd_m2_per_s3: 0.5,
-                        turn_rate_psd_rad2_per_s3: 1.0,
+                        acceleration_psd_m2_per_s3: 0.25,
+                        turn_rate_psd_rad2_per_s3: 0.25,
                         initial_turn_rate_std_radps: 0.5,
                     },
                     learned: LearnedConfig {
