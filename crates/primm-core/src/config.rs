@@ -260,7 +260,7 @@ impl Default for Config {
                         initial_turn_rate_std_radps: 0.3,
                     },
                     learned: LearnedConfig {
-                        process_noise_covariance_m2: diagonal(0.01, 0.017),
+                        process_noise_covariance_m2: diagonal(0.011, 0.011),
                         measurement_noise_covariance_m2: diagonal(0.36, 0.36),
                     },
                 },
@@ -280,7 +280,7 @@ impl Default for Config {
                         initial_turn_rate_std_radps: 0.5,
                     },
                     learned: LearnedConfig {
-                        process_noise_covariance_m2: diagonal(0.008, 0.0025),
+                        process_noise_covariance_m2: diagonal(0.0006, 0.0006),
                         measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     },
                 },
