@@ -149,6 +149,17 @@ typedef struct PrimmStepSummary {
   size_t largest_solved_cluster_measurements;
 } PrimmStepSummary;
 
+// The ego vehicle's pose in the world (odometry) frame at a frame's time: the reference point
+// (centre of the rear axle) and the heading of the vehicle's x axis.
+typedef struct PrimmEgoPose {
+  // World x of the reference point, m.
+  double x_m;
+  // World y of the reference point, m.
+  double y_m;
+  // Heading, rad, counter-clockwise from the world x axis.
+  double yaw_rad;
+} PrimmEgoPose;
+
 // A track status code, one of the `PRIMM_TRACK_STATUS_*` constants.
 typedef uint8_t PrimmTrackStatus;
 
@@ -194,6 +205,19 @@ typedef struct PrimmTrack {
   PrimmTrackStatus status;
   // Whether the track has a prior (false for a track started in this step).
   bool has_prior_position;
+  // Whether the step tracked in the world frame (it had an ego pose): then the position,
+  // covariance, prior and velocity above are in the vehicle frame of this step (the velocity
+  // over ground in the vehicle's axes) and the `world_*` fields hold the world-frame
+  // estimate; otherwise those are NaN.
+  bool has_world_estimate;
+  // Fused position in the world frame, x, m.
+  double world_x_m;
+  // Fused position in the world frame, y, m.
+  double world_y_m;
+  // Fused velocity over ground in the world frame, x, m/s.
+  double world_velocity_x_mps;
+  // Fused velocity over ground in the world frame, y, m/s.
+  double world_velocity_y_mps;
 } PrimmTrack;
 
 // The tracker's counters since it was built (`TrackerStats` of primm-core).
@@ -208,6 +232,17 @@ typedef struct PrimmStats {
   uint64_t frames_rejected_interval_too_long;
   // Frames rejected because they carried too many measurements.
   uint64_t frames_rejected_too_many_measurements;
+  // Frames rejected because their ego pose was not finite or absurdly far out.
+  uint64_t frames_rejected_invalid_ego_pose;
+  // Frames tracked in the world frame.
+  uint64_t frames_in_world_frame;
+  // Frames tracked in the vehicle frame although the configuration asks for the world frame
+  // (they carried no ego pose).
+  uint64_t frames_without_ego_pose;
+  // Times the live tracks were moved between the world and the vehicle frame.
+  uint64_t tracking_frame_changes;
+  // Tracks started in the world frame by a measurement of a sensor without configured mount.
+  uint64_t initiations_from_unknown_sensor;
   // Measurements tracked (accepted by validation).
   uint64_t measurements_accepted;
   // Measurements rejected for an unknown class code.
@@ -337,9 +372,25 @@ struct PrimmTrackerOptions primm_tracker_options_default(void);
 enum PrimmStatus primm_tracker_create(const struct PrimmTrackerOptions *options,
                                       struct PrimmTracker **out_tracker);
 
+// Tracks one frame without an ego pose (in the vehicle frame): `primm_tracker_step_with_pose`
+// with a NULL pose.
+//
+// # Safety
+// As `primm_tracker_step_with_pose`.
+enum PrimmStatus primm_tracker_step(struct PrimmTracker *tracker,
+                                    double timestamp_s,
+                                    const struct PrimmMeasurement *measurements,
+                                    size_t count,
+                                    struct PrimmStepSummary *out_summary);
+
 // Tracks one frame: `count` measurements at `measurements` (NULL allowed when `count` is 0),
-// taken at `timestamp_s` (seconds, strictly increasing from frame to frame). The measurements
-// are read in place during the call. Writes what the step did to `*out_summary` unless it is
+// taken at `timestamp_s` (seconds, strictly increasing from frame to frame), with the ego
+// vehicle's pose `*ego_pose` at that time, or NULL when unknown. With a pose (and the
+// configuration's `frame.tracking_frame` "world", the default) the tracker keeps its tracks in
+// the world frame and reports them in the vehicle frame of this step with their world estimate
+// beside (`PrimmTrack::has_world_estimate`); a pose that is not finite or absurdly far out
+// rejects the frame (`PRIMM_STATUS_INVALID_FRAME`). The measurements are read in place during
+// the call. Writes what the step did to `*out_summary` unless it is
 // NULL (zeroed on failure).
 //
 // Allocates nothing, unless the PR model runs inside the step (`inference_thread` false),
@@ -352,13 +403,15 @@ enum PrimmStatus primm_tracker_create(const struct PrimmTrackerOptions *options,
 // tracked.
 //
 // # Safety
-// `tracker` is NULL or a live handle used by no other thread; `measurements` is NULL or points
-// to `count` readable, aligned `PrimmMeasurement`s; `out_summary` is NULL or writable.
-enum PrimmStatus primm_tracker_step(struct PrimmTracker *tracker,
-                                    double timestamp_s,
-                                    const struct PrimmMeasurement *measurements,
-                                    size_t count,
-                                    struct PrimmStepSummary *out_summary);
+// `tracker` is NULL or a live handle used by no other thread; `ego_pose` is NULL or points to a
+// readable `PrimmEgoPose`; `measurements` is NULL or points to `count` readable, aligned
+// `PrimmMeasurement`s; `out_summary` is NULL or writable.
+enum PrimmStatus primm_tracker_step_with_pose(struct PrimmTracker *tracker,
+                                              double timestamp_s,
+                                              const struct PrimmEgoPose *ego_pose,
+                                              const struct PrimmMeasurement *measurements,
+                                              size_t count,
+                                              struct PrimmStepSummary *out_summary);
 
 // Copies the tracks of the last successful step (every live track, in table order) to `out`,
 // which holds `capacity` entries, and writes their number to `*out_count`.

@@ -46,3 +46,4 @@ mod shm_hygiene;
 mod track_loops;
 mod tracker;
 mod tracker_allocation;
+mod world_frame;

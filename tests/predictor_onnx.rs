@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
-use primm_predictor::onnx::{ModelError, OnnxPredictor, PrModel};
+use primm_predictor::onnx::{ModelError, MotionFrame, OnnxPredictor, PrModel};
 use std::path::{Path, PathBuf};
 
 fn repo_path(relative: &str) -> PathBuf {
@@ -144,12 +144,50 @@ fn history(points: &[(f64, f64, f64)]) -> Vec<HistoryEntry> {
         .collect()
 }
 
+/// The model's displacement for one request, with the request rotated into the frame of its
+/// latest motion and the output rotated back, as `OnnxPredictor` does.
 fn run_one(model: &mut PrModel, request: &PredictionRequest) -> DVec2 {
+    let frame = MotionFrame::of(request);
+    let mut features = request.features;
+    for row in &mut features[..request.len] {
+        let position = frame.to_model(DVec2::new(f64::from(row[0]), f64::from(row[1])));
+        row[0] = position.x as f32;
+        row[1] = position.y as f32;
+    }
     let mut valid = [0.0f32; MAX_HISTORY];
     valid[..request.len].fill(1.0);
     let mut out = [0.0f32; 2];
-    model.run(request.features.as_flattened(), &valid, &mut out).unwrap();
-    DVec2::new(f64::from(out[0]), f64::from(out[1]))
+    model.run(features.as_flattened(), &valid, &mut out).unwrap();
+    frame.from_model(DVec2::new(f64::from(out[0]), f64::from(out[1])))
+}
+
+#[test]
+fn a_rotated_history_gets_the_rotated_displacement() {
+    let mut predictor = OnnxPredictor::load(repo_path("models/pr.onnx")).unwrap();
+    let points = [(0.00, 20.0, 3.0), (0.03, 19.7, 3.2), (0.06, 19.4, 3.5), (0.09, 19.1, 3.9)];
+    let predict = |predictor: &mut OnnxPredictor, angle: f64| {
+        let rotation = DVec2::from_angle(angle);
+        let rotated: Vec<(f64, f64, f64)> = points
+            .iter()
+            .map(|&(t, x, y)| {
+                let p = rotation.rotate(DVec2::new(x, y));
+                (t, p.x, p.y)
+            })
+            .collect();
+        let mut out = [None];
+        predictor.predict(&[PredictionRequest::from_history(&history(&rotated), 0.105)], &mut out);
+        out[0].unwrap()
+    };
+    let base = predict(&mut predictor, 0.0);
+    assert!(base.length() > 1e-3, "the model predicts motion: {base}");
+    for angle in [0.4, 1.9, -2.6, std::f64::consts::PI] {
+        let expected = DVec2::from_angle(angle).rotate(base);
+        let got = predict(&mut predictor, angle);
+        assert!((got - expected).length() < 1e-4, "at {angle} rad: {got} vs {expected}");
+    }
+    // Without a direction of motion (one measurement) the input goes in unrotated.
+    let single = PredictionRequest::from_history(&history(&points[..1]), 0.03);
+    assert_eq!(MotionFrame::of(&single), MotionFrame::IDENTITY);
 }
 
 #[test]

@@ -573,3 +573,27 @@ fn split_summary_counts_match_the_sequences() {
     assert!(table.contains("Validation"));
     assert!(table.lines().next().unwrap().contains("Pedestrian object frames"));
 }
+
+#[test]
+fn the_turning_preset_turns_the_ego_often_and_up_to_half_a_radian_per_second() {
+    use primm_sim::eval::ego_motion::{ego_yaw_rates, TURNING_YAW_RATE_RADPS};
+    assert_eq!(Preset::from_name("turning"), Some(Preset::Turning));
+    Preset::Turning.config().validate().expect("turning preset is valid");
+    // Share of frames with |yaw rate| above the turning threshold, and the largest |yaw rate|.
+    let turning = |preset: Preset| {
+        let generator = short_generator(preset, 7.0);
+        let (mut turning, mut frames, mut largest) = (0usize, 0usize, 0.0f64);
+        for index in 0..4 {
+            let rates = ego_yaw_rates(&generator.generate(Split::Validation, index).sequence);
+            frames += rates.len();
+            turning += rates.values().filter(|rate| rate.abs() > TURNING_YAW_RATE_RADPS).count();
+            largest = rates.values().fold(largest, |m, rate| m.max(rate.abs()));
+        }
+        (turning as f64 / frames as f64, largest)
+    };
+    let (default_share, _) = turning(Preset::Default);
+    let (turning_share, largest) = turning(Preset::Turning);
+    assert!(turning_share > 2.0 * default_share, "turning share {turning_share} vs default {default_share}");
+    assert!(turning_share > 0.15, "turning share {turning_share}");
+    assert!((0.3..1.0).contains(&largest), "largest ego yaw rate {largest} rad/s");
+}

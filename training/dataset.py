@@ -7,9 +7,16 @@ anchor ``j`` with at least one later measurement, the history is ``m_{max(0, j-4
 track that coasts that long) and the prediction time ``tau`` is the time of one of the next
 ``max_horizon`` measurements ``m_{j+h}`` no more than ``max_horizon_s`` after ``m_j``.
 
+Positions are taken in the world frame: each row's vehicle-frame position (and true position) is
+mapped with that row's ego pose (``ego_x, ego_y, ego_yaw``), as primm's tracker does when frames
+carry a pose (``frame="vehicle"`` keeps the vehicle frame; rows without a pose stay as they are).
+
 Each window is laid out exactly like ``PredictionRequest`` (``eq:pr_input``): rows ``0..len``
 hold ``[x_l - x_j, y_l - y_j, v_r_l, RCS_l, t_l - tau]``, rows ``len..`` are zero (right
-padding), and ``valid`` marks the rows ``0..len``.
+padding), and ``valid`` marks the rows ``0..len``. Windows are kept in the world frame; before a
+window goes into the model, :func:`motion_frames` and :func:`to_model_frame` rotate it into the
+frame of its latest motion (primm-predictor's ``MotionFrame``), and displacements are rotated the
+same way.
 
 Two displacement labels are kept per window:
 
@@ -30,6 +37,9 @@ import numpy as np
 
 MAX_HISTORY = 5
 FEATURES = 5
+# Shortest distance between a window's last two measurements that gives it a direction of motion,
+# m (primm-predictor's MIN_HEADING_DISTANCE_M).
+MIN_HEADING_DISTANCE_M = 0.01
 CLASSES = {"car": 0, "pedestrian": 1, "two_wheeler": 2}
 
 
@@ -57,10 +67,21 @@ class Windows:
         return Windows(**{name: getattr(self, name)[mask] for name in self.__dataclass_fields__})
 
 
-def read_objects(path: str) -> list[np.ndarray]:
+def to_world(row: dict, x: float, y: float) -> tuple[float, float]:
+    """A vehicle-frame point of ``row`` in the world frame of the row's ego pose (unchanged without
+    a pose)."""
+    if row.get("ego_x", "") in ("", None):
+        return x, y
+    yaw = float(row["ego_yaw"])
+    c, s = np.cos(yaw), np.sin(yaw)
+    return float(row["ego_x"]) + c * x - s * y, float(row["ego_y"]) + s * x + c * y
+
+
+def read_objects(path: str, frame: str = "world") -> list[np.ndarray]:
     """Per ground-truth object, its measurements in time order as rows
-    ``[t, x, y, vr, rcs, true_x, true_y, class, frame]``. Rows without a ground-truth id or a true
-    position are skipped."""
+    ``[t, x, y, vr, rcs, true_x, true_y, class, frame]``, positions in the world frame (or the
+    vehicle frame with ``frame="vehicle"``). Rows without a ground-truth id or a true position
+    are skipped."""
     objects: dict[int, list[list[float]]] = {}
     with open(path, newline="") as handle:
         rows = csv.DictReader(line for line in handle if not line.startswith("#"))
@@ -68,15 +89,20 @@ def read_objects(path: str) -> list[np.ndarray]:
             gt = row.get("gt_id", "")
             if gt in ("", "-1") or row.get("x", "") == "" or row.get("true_x", "") == "":
                 continue
+            x, y = float(row["x"]), float(row["y"])
+            true_x, true_y = float(row["true_x"]), float(row["true_y"])
+            if frame == "world":
+                x, y = to_world(row, x, y)
+                true_x, true_y = to_world(row, true_x, true_y)
             objects.setdefault(int(gt), []).append(
                 [
                     float(row["t"]),
-                    float(row["x"]),
-                    float(row["y"]),
+                    x,
+                    y,
                     float(row["vr"]),
                     float(row["rcs"]),
-                    float(row["true_x"]),
-                    float(row["true_y"]),
+                    true_x,
+                    true_y,
                     float(CLASSES[row["class"]]),
                     float(row["frame"]),
                 ]
@@ -135,15 +161,15 @@ def object_windows(m: np.ndarray, max_horizon: int, max_horizon_s: float, max_ga
 
 
 def load_split(
-    directory: str, max_horizon: int, max_horizon_s: float, max_gap_s: float = 1.0
+    directory: str, max_horizon: int, max_horizon_s: float, max_gap_s: float = 1.0, frame: str = "world"
 ) -> tuple[Windows, list[str]]:
-    """Windows of every ``*.csv`` file in ``directory`` (sorted by name)."""
+    """Windows of every ``*.csv`` file in ``directory`` (sorted by name), positions in ``frame``."""
     files = sorted(glob.glob(os.path.join(directory, "*.csv")))
     if not files:
         raise FileNotFoundError(f"no measurement CSV files in {directory}")
     parts: dict[str, list] = {k: [] for k in Windows.__dataclass_fields__}
     for index, path in enumerate(files):
-        for m in read_objects(path):
+        for m in read_objects(path, frame):
             windows = object_windows(m, max_horizon, max_horizon_s, max_gap_s)
             for key, values in windows.items():
                 parts[key].extend(values)
@@ -189,3 +215,48 @@ def truncate(features: np.ndarray, valid: np.ndarray, length: np.ndarray, new_le
     out_f[keep] = gathered[keep]
     out_v[keep] = 1.0
     return out_f, out_v
+
+
+def motion_frames(features: np.ndarray, length: np.ndarray, rng: np.random.Generator | None = None):
+    """``(cos, sin)`` of each window's latest motion, from its second-latest to its latest row
+    (positions are relative to the latest row, so the motion is minus the second-latest row's
+    position). Windows without one (one row, or the last two rows closer than
+    ``MIN_HEADING_DISTANCE_M``) get the identity, or a random direction when ``rng`` is given
+    (training: the model then sees such windows in every orientation)."""
+    n = len(length)
+    previous = features[np.arange(n), np.maximum(length - 2, 0), :2].astype(np.float64)
+    motion = -previous
+    norm = np.hypot(motion[:, 0], motion[:, 1])
+    has = (length >= 2) & (norm >= MIN_HEADING_DISTANCE_M)
+    safe = np.where(has, norm, 1.0)
+    cos = np.where(has, motion[:, 0] / safe, 1.0)
+    sin = np.where(has, motion[:, 1] / safe, 0.0)
+    if rng is not None:
+        angle = rng.uniform(-np.pi, np.pi, n)
+        cos = np.where(has, cos, np.cos(angle))
+        sin = np.where(has, sin, np.sin(angle))
+    return cos, sin
+
+
+def to_model_frame(features: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> np.ndarray:
+    """The windows with their positions rotated by ``(x, y) -> (c x + s y, -s x + c y)`` (padding
+    rows stay zero)."""
+    out = features.copy()
+    x = features[:, :, 0].astype(np.float64)
+    y = features[:, :, 1].astype(np.float64)
+    c, s = cos[:, None], sin[:, None]
+    out[:, :, 0] = (c * x + s * y).astype(np.float32)
+    out[:, :, 1] = (-s * x + c * y).astype(np.float32)
+    return out
+
+
+def vectors_to_model_frame(vectors: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> np.ndarray:
+    """``[N, 2]`` displacements rotated like :func:`to_model_frame`."""
+    x, y = vectors[:, 0].astype(np.float64), vectors[:, 1].astype(np.float64)
+    return np.stack([cos * x + sin * y, -sin * x + cos * y], axis=1).astype(np.float32)
+
+
+def vectors_from_model_frame(vectors: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> np.ndarray:
+    """``[N, 2]`` displacements rotated back from the model's frame."""
+    x, y = vectors[:, 0].astype(np.float64), vectors[:, 1].astype(np.float64)
+    return np.stack([cos * x - sin * y, sin * x + cos * y], axis=1).astype(np.float32)

@@ -34,7 +34,17 @@ import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from dataset import CLASSES, MAX_HISTORY, Windows, load_split, truncate  # noqa: E402
+from dataset import (  # noqa: E402
+    CLASSES,
+    MAX_HISTORY,
+    Windows,
+    load_split,
+    motion_frames,
+    to_model_frame,
+    truncate,
+    vectors_from_model_frame,
+    vectors_to_model_frame,
+)
 from model import ExportGraph, PRModel, score_bound  # noqa: E402
 import onnx_graph  # noqa: E402
 
@@ -96,6 +106,12 @@ def parse_args(argv=None):
         help="attention-score bound (from the weights) above which training is penalised, keeping the "
         "exported softmax free of a row maximum (see model.ExportGraph)",
     )
+    parser.add_argument(
+        "--frame",
+        choices=["world", "vehicle"],
+        default="world",
+        help="frame the windows' positions are taken in (world: with each row's ego pose)",
+    )
     parser.add_argument("--threads", type=int, default=1, help="PyTorch threads (1 is fastest on a busy 2-core machine)")
     return parser.parse_args(argv)
 
@@ -118,15 +134,24 @@ def labels(windows: Windows, target: str) -> np.ndarray:
     return windows.true_displacement if target == "true" else windows.measured_displacement
 
 
-def normalisation(train: Windows, target: str):
+def normalisation(train: Windows, target: str, rng: np.random.Generator):
     """Mean and standard deviation of each feature over the valid rows, and the per-axis RMS of
-    the displacement label."""
-    rows = train.features[train.valid > 0]
+    the displacement label, both in the model's input frame."""
+    cos, sin = motion_frames(train.features, train.length, rng)
+    rows = to_model_frame(train.features, cos, sin)[train.valid > 0]
     mean = rows.mean(axis=0).astype(np.float64)
     std = rows.std(axis=0).astype(np.float64)
     std = np.where(std > 1e-6, std, 1.0)
-    scale = np.sqrt((labels(train, target).astype(np.float64) ** 2).mean(axis=0))
+    target = vectors_to_model_frame(labels(train, target), cos, sin)
+    scale = np.sqrt((target.astype(np.float64) ** 2).mean(axis=0))
     return mean, std, scale
+
+
+def predict_windows(model: PRModel, features: np.ndarray, valid: np.ndarray, length: np.ndarray) -> np.ndarray:
+    """The model's displacements for windows given in the data's frame: each rotated into the
+    frame of its latest motion, predicted, and rotated back (what primm-predictor does)."""
+    cos, sin = motion_frames(features, length)
+    return vectors_from_model_frame(predict(model, to_model_frame(features, cos, sin), valid), cos, sin)
 
 
 def predict(model: PRModel, features: np.ndarray, valid: np.ndarray, batch: int = 4096) -> np.ndarray:
@@ -182,7 +207,7 @@ def baselines(windows: Windows) -> dict[str, np.ndarray]:
 
 def evaluate(model: PRModel, windows: Windows) -> dict:
     """Validation metrics of the model and of the baselines, against the true displacement."""
-    prediction = predict(model, windows.features, windows.valid)
+    prediction = predict_windows(model, windows.features, windows.valid, windows.length)
     truth = windows.true_displacement.astype(np.float64)
     result = {"model": {}, "baselines": {}}
     one_step = windows.horizon == 1
@@ -210,7 +235,7 @@ def evaluate(model: PRModel, windows: Windows) -> dict:
         mask = one_step & (windows.length >= length)
         new_length = np.full(mask.sum(), length)
         f, v = truncate(windows.features[mask], windows.valid[mask], windows.length[mask], new_length)
-        by_length[str(length)] = rmse(predict(model, f, v) - truth[mask])
+        by_length[str(length)] = rmse(predict_windows(model, f, v, new_length) - truth[mask])
     result["model"]["one_step_by_history_length"] = by_length
     # Residual covariance of the one-step displacement, m^2, and what it suggests for Q_PR. The
     # tracker adds Q_PR once per frame (radar scan), and an object is measured only every few
@@ -238,17 +263,17 @@ def train(args) -> None:
     torch.set_num_threads(args.threads)
     print(f"loading windows from {args.data} ...", flush=True)
     train_windows, train_files = load_split(
-        os.path.join(args.data, "train"), args.max_horizon, args.max_horizon_s, args.max_gap_s
+        os.path.join(args.data, "train"), args.max_horizon, args.max_horizon_s, args.max_gap_s, args.frame
     )
     val_windows, val_files = load_split(
-        os.path.join(args.data, "validation"), args.max_horizon, args.max_horizon_s, args.max_gap_s
+        os.path.join(args.data, "validation"), args.max_horizon, args.max_horizon_s, args.max_gap_s, args.frame
     )
     print(
         f"{len(train_windows)} training windows from {len(train_files)} sequences, "
         f"{len(val_windows)} validation windows from {len(val_files)} sequences ({time.time() - started:.1f} s)",
         flush=True,
     )
-    mean, std, scale = normalisation(train_windows, args.target)
+    mean, std, scale = normalisation(train_windows, args.target, np.random.default_rng(args.seed + 2))
     model = PRModel(args.d_model, args.heads, args.layers, args.d_ff, mean, std, scale)
     print(f"model: {model.parameter_count()} parameters", flush=True)
     optimiser = torch.optim.AdamW(model.parameters(), lr=args.learning_rate, weight_decay=args.weight_decay)
@@ -264,9 +289,10 @@ def train(args) -> None:
 
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimiser, learning_rate_factor)
     target_scale = torch.from_numpy(scale.astype(np.float32))
-    val_features = torch.from_numpy(val_windows.features)
+    val_cos, val_sin = motion_frames(val_windows.features, val_windows.length)
+    val_features = torch.from_numpy(to_model_frame(val_windows.features, val_cos, val_sin))
     val_valid = torch.from_numpy(val_windows.valid)
-    val_target = torch.from_numpy(labels(val_windows, args.target))
+    val_target = torch.from_numpy(vectors_to_model_frame(labels(val_windows, args.target), val_cos, val_sin))
     train_weight = torch.from_numpy(loss_weight(train_windows.dt_s, args.full_weight_horizon_s))
     val_weight = torch.from_numpy(loss_weight(val_windows.dt_s, args.full_weight_horizon_s))
     rng = np.random.default_rng(args.seed)
@@ -279,8 +305,10 @@ def train(args) -> None:
         new_length = train_windows.length.copy()
         new_length[cut] = rng.integers(1, train_windows.length[cut] + 1)
         features, valid = truncate(train_windows.features, train_windows.valid, train_windows.length, new_length)
-        features, valid = torch.from_numpy(features), torch.from_numpy(valid)
-        target = torch.from_numpy(labels(train_windows, args.target))
+        # Into the frame of each window's latest motion (random for windows without one).
+        cos, sin = motion_frames(features, new_length, rng)
+        features, valid = torch.from_numpy(to_model_frame(features, cos, sin)), torch.from_numpy(valid)
+        target = torch.from_numpy(vectors_to_model_frame(labels(train_windows, args.target), cos, sin))
         order = torch.from_numpy(rng.permutation(len(train_windows))[: args.samples_per_epoch])
         model.train()
         total, count = 0.0, 0
@@ -368,9 +396,12 @@ def write_parity(model: PRModel, windows: Windows, path: str, seed: int) -> dict
     index = rng.choice(len(windows), PARITY_SAMPLES, replace=False)
     lengths = np.minimum(windows.length[index], 1 + np.arange(PARITY_SAMPLES) % MAX_HISTORY)
     features, valid = truncate(windows.features[index], windows.valid[index], windows.length[index], lengths)
+    cos, sin = motion_frames(features, lengths)
+    features = to_model_frame(features, cos, sin)
     output = predict(model, features, valid)
     parity = {
-        "description": "PR model inputs (eq:pr_input rows, right padded) and the PyTorch outputs, metres",
+        "description": "PR model inputs (eq:pr_input rows, right padded, in the frame of the latest motion) "
+        "and the PyTorch outputs, metres",
         "features": [[[float(v) for v in row] for row in sample] for sample in features],
         "valid": [[float(v) for v in sample] for sample in valid],
         "length": [int(v) for v in lengths],
@@ -430,6 +461,17 @@ def write_metadata(args, model, mean, std, scale, train_windows, train_files, va
                 "dtype": "float32",
                 "layout": "eq:pr_input rows oldest first; rows 0..len valid, rows len..5 zero (right padding)",
                 "features": FEATURE_NAMES,
+                "input_frame": (
+                    "positions relative to the latest measurement, rotated so that the latest motion (second-latest "
+                    "to latest measurement) points along +x; histories of one measurement or whose last two are "
+                    "closer than 0.01 m unrotated (primm-predictor MotionFrame); the output displacement is in the "
+                    "same frame and is rotated back by the caller"
+                ),
+                "training_positions": (
+                    "world frame (each measurement mapped with its frame's ego pose)"
+                    if args.frame == "world"
+                    else "vehicle frame"
+                ),
             },
             {"name": "valid", "shape": [BATCH_AXIS, MAX_HISTORY], "dtype": "float32",
              "layout": "1.0 for rows 0..len, 0.0 for padded rows"},

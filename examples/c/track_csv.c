@@ -10,12 +10,15 @@
  * -Wl,-z,noexecstack to the link line to keep the stack non-executable and the warning away.)
  *
  * Input: the measurement CSV format of docs/scenario.md. Columns are found by their header
- * names (frame, t, gt_id, class, x, y, vr, rcs required; sensor_id optional; others ignored),
+ * names (frame, t, gt_id, class, x, y, vr, rcs required; sensor_id and the ego pose ego_x,
+ * ego_y, ego_yaw optional; others ignored),
  * fields are trimmed, lines starting with '#' are comments, and a row with an empty class is
  * the one row of a frame without measurements. Rows of one frame are consecutive.
  *
  * Output: header frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct and
- * one row per track updated by a measurement in that frame. Numbers are written with
+ * one row per track updated by a measurement in that frame; a file with an ego pose adds the
+ * world-frame columns world_x,world_y,world_vx,world_vy (the tracker then tracks in the world
+ * frame, see primm_tracker_step_with_pose). Numbers are written with
  * primm_format_f64, the shortest form that reads back exactly (as primm writes them).
  */
 #define _POSIX_C_SOURCE 200809L
@@ -30,10 +33,24 @@
 
 #define MAX_FIELDS 64
 
-enum column { COL_FRAME, COL_T, COL_GT_ID, COL_CLASS, COL_X, COL_Y, COL_VR, COL_RCS, COL_SENSOR_ID, COL_COUNT };
+enum column {
+    COL_FRAME,
+    COL_T,
+    COL_GT_ID,
+    COL_CLASS,
+    COL_X,
+    COL_Y,
+    COL_VR,
+    COL_RCS,
+    COL_SENSOR_ID,
+    COL_EGO_X,
+    COL_EGO_Y,
+    COL_EGO_YAW,
+    COL_COUNT
+};
 
-static const char *const COLUMN_NAMES[COL_COUNT] = {"frame", "t", "gt_id", "class", "x", "y",
-                                                    "vr", "rcs", "sensor_id"};
+static const char *const COLUMN_NAMES[COL_COUNT] = {"frame", "t",   "gt_id",     "class", "x",     "y",
+                                                    "vr",    "rcs", "sensor_id", "ego_x", "ego_y", "ego_yaw"};
 
 /* Required columns: all but sensor_id. */
 #define REQUIRED_COLUMNS COL_SENSOR_ID
@@ -185,10 +202,23 @@ static void check(PrimmStatus status, const char *what) {
     }
 }
 
-/* Tracks one frame and writes the rows of the tracks a measurement updated. */
+/* The ego pose of the current row, if its ego columns are filled. */
+static int read_pose(const struct input *in, PrimmEgoPose *pose) {
+    if (in->columns[COL_EGO_X] < 0 || *field(in, COL_EGO_X) == '\0') {
+        return 0;
+    }
+    pose->x_m = parse_double(in, COL_EGO_X);
+    pose->y_m = parse_double(in, COL_EGO_Y);
+    pose->yaw_rad = parse_double(in, COL_EGO_YAW);
+    return 1;
+}
+
+/* Tracks one frame (with its ego pose, or NULL) and writes the rows of the tracks a measurement
+ * updated; with `world_columns`, each row ends with the world-frame estimate (empty without). */
 static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double timestamp_s,
-                        const PrimmMeasurement *measurements, size_t count, PrimmTrack *tracks) {
-    PrimmStatus status = primm_tracker_step(tracker, timestamp_s, measurements, count, NULL);
+                        const PrimmEgoPose *pose, const PrimmMeasurement *measurements, size_t count,
+                        PrimmTrack *tracks, int world_columns) {
+    PrimmStatus status = primm_tracker_step_with_pose(tracker, timestamp_s, pose, measurements, count, NULL);
     if (status != PRIMM_STATUS_OK) {
         char message[1024];
         primm_tracker_last_error(tracker, message, sizeof message);
@@ -220,6 +250,16 @@ static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double
         for (size_t mode = 0; mode < PRIMM_MODE_COUNT; mode++) {
             fputc(',', out);
             print_double(out, track->mode_probabilities[mode]);
+        }
+        if (world_columns && track->has_world_estimate) {
+            const double world[4] = {track->world_x_m, track->world_y_m, track->world_velocity_x_mps,
+                                     track->world_velocity_y_mps};
+            for (size_t i = 0; i < 4; i++) {
+                fputc(',', out);
+                print_double(out, world[i]);
+            }
+        } else if (world_columns) {
+            fputs(",,,,", out);
         }
         fputc('\n', out);
     }
@@ -261,7 +301,12 @@ int main(int argc, char **argv) {
         fprintf(stderr, "track_csv: cannot create %s: %s\n", argv[2], strerror(errno));
         return EXIT_FAILURE;
     }
-    fputs("frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct\n", out);
+    int world_columns = in.columns[COL_EGO_X] >= 0 && in.columns[COL_EGO_Y] >= 0 && in.columns[COL_EGO_YAW] >= 0;
+    if (!world_columns) {
+        in.columns[COL_EGO_X] = -1; /* an incomplete pose group is ignored */
+    }
+    fputs("frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct", out);
+    fputs(world_columns ? ",world_x,world_y,world_vx,world_vy\n" : "\n", out);
 
     static PrimmMeasurement measurements[PRIMM_MAX_MEASUREMENTS_PER_FRAME];
     static PrimmTrack tracks[PRIMM_MAX_TRACKS];
@@ -269,6 +314,8 @@ int main(int argc, char **argv) {
     int open = 0;
     uint64_t frame = 0;
     double timestamp_s = 0.0;
+    PrimmEgoPose pose;
+    int has_pose = 0;
     while (next_record(&in)) {
         uint64_t row_frame = parse_u64(&in, COL_FRAME);
         double row_t = parse_double(&in, COL_T);
@@ -277,12 +324,14 @@ int main(int argc, char **argv) {
                 if (row_frame < frame) {
                     fail("frame index `%s` decreases", in.path, in.line_number, field(&in, COL_FRAME));
                 }
-                track_frame(tracker, out, frame, timestamp_s, measurements, count, tracks);
+                track_frame(tracker, out, frame, timestamp_s, has_pose ? &pose : NULL, measurements, count, tracks,
+                            world_columns);
             }
             open = 1;
             frame = row_frame;
             timestamp_s = row_t;
             count = 0;
+            has_pose = read_pose(&in, &pose);
         } else if (row_t != timestamp_s) {
             fail("timestamp `%s` differs within a frame", in.path, in.line_number, field(&in, COL_T));
         }
@@ -310,7 +359,8 @@ int main(int argc, char **argv) {
         m->sensor_id = *sensor == '\0' ? PRIMM_NO_SENSOR_ID : (int32_t)parse_u64(&in, COL_SENSOR_ID);
     }
     if (open) {
-        track_frame(tracker, out, frame, timestamp_s, measurements, count, tracks);
+        track_frame(tracker, out, frame, timestamp_s, has_pose ? &pose : NULL, measurements, count, tracks,
+                    world_columns);
     }
 
     PrimmStats stats;

@@ -1,12 +1,13 @@
 //! `primm eval`: every method on every sequence of a data set, printed as the paper's tables.
 
 use clap::Args as ClapArgs;
-use primm_core::config::Config;
+use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::tracker::Tracker;
 use primm_predictor::predictor_for;
 use primm_sim::eval::dropout::{sequence_seed, DropoutMask};
+use primm_sim::eval::ego_motion::ego_motion_labels;
 use primm_sim::eval::plots::{
     ground_truth_points, majority_ground_truth, write_mode_probability_svg, write_trajectory_svg,
     TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint,
@@ -44,6 +45,10 @@ pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults otherwise.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
+    /// Overrides the configuration's `frame.tracking_frame`: `world` (tracks in the world
+    /// frame when frames carry an ego pose) or `vehicle` (always the vehicle frame).
+    #[arg(long, value_name = "FRAME", value_parser = super::parse_tracking_frame)]
+    pub tracking_frame: Option<TrackingFrame>,
     /// ONNX model of the learned predictor (default: the model built into primm,
     /// models/pr.onnx).
     #[arg(long, value_name = "FILE")]
@@ -91,10 +96,13 @@ pub enum EvaluateError {
 
 /// Runs `primm eval`.
 pub fn run(args: &Args) -> Result<(), EvaluateError> {
-    let base_config = match &args.config {
-        Some(path) => primm_config::from_file(path)?,
-        None => Config::default(),
-    };
+    let base_config = super::with_tracking_frame(
+        match &args.config {
+            Some(path) => primm_config::from_file(path)?,
+            None => Config::default(),
+        },
+        args.tracking_frame,
+    );
     let sequences = read_dataset_dir(&args.data)?;
     if sequences.is_empty() {
         return Err(EvaluateError::NoData { dir: args.data.clone() });
@@ -135,6 +143,7 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
                 }
             })?;
             evaluator.add_sequence(&records);
+            evaluator.add_ego_motion(&records, &ego_motion_labels(sequence, &records));
             if index == plot_sequence {
                 ground_truth = ground_truth_points(&records);
                 panels.push(TrajectoryPanel {

@@ -39,6 +39,8 @@ pub enum PresetChoice {
     Default,
     /// Faster objects, more erratic pedestrians, noisier sensors.
     Robustness,
+    /// An ego vehicle that turns at most junctions (yaw rates up to about 0.5 rad/s).
+    Turning,
 }
 
 impl From<PresetChoice> for Preset {
@@ -46,6 +48,7 @@ impl From<PresetChoice> for Preset {
         match choice {
             PresetChoice::Default => Preset::Default,
             PresetChoice::Robustness => Preset::Robustness,
+            PresetChoice::Turning => Preset::Turning,
         }
     }
 }

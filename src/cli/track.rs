@@ -1,7 +1,7 @@
 //! `primm track`: offline tracking of a measurement CSV file into a track CSV file.
 
 use clap::Args as ClapArgs;
-use primm_core::config::Config;
+use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_core::tracker::{StepError, Tracker};
 use primm_predictor::onnx::ModelError;
@@ -27,6 +27,10 @@ pub struct Args {
     /// Tracker configuration (TOML); the built-in defaults otherwise.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
+    /// Overrides the configuration's `frame.tracking_frame`: `world` (tracks in the world
+    /// frame when frames carry an ego pose) or `vehicle` (always the vehicle frame).
+    #[arg(long, value_name = "FRAME", value_parser = super::parse_tracking_frame)]
+    pub tracking_frame: Option<TrackingFrame>,
     /// ONNX model of the learned predictor (default: the model built into primm,
     /// models/pr.onnx).
     #[arg(long, value_name = "FILE")]
@@ -96,16 +100,20 @@ fn create(path: &Path) -> Result<std::fs::File, TrackError> {
 
 /// Runs `primm track`.
 pub fn run(args: &Args) -> Result<(), TrackError> {
-    let config = match &args.config {
-        Some(path) => primm_config::from_file(path)?,
-        None => Config::default(),
-    }
+    let config = super::with_tracking_frame(
+        match &args.config {
+            Some(path) => primm_config::from_file(path)?,
+            None => Config::default(),
+        },
+        args.tracking_frame,
+    )
     .with_modes(args.method.modes());
     let predictor = predictor_for(args.method, args.model.as_deref())?;
     let mut tracker = Tracker::with_predictor(config, predictor)?;
     let sequence = read_sequence_file(&args.input)?;
     let file = create(&args.output)?;
-    let mut writer = TrackCsvWriter::new(std::io::BufWriter::new(file))?;
+    let tracking_frame = tracker.config().frame.tracking_frame;
+    let mut writer = TrackCsvWriter::for_sequence(std::io::BufWriter::new(file), &sequence, tracking_frame)?;
     let mut associations = match &args.associations {
         Some(path) => {
             let file = create(path)?;

@@ -27,6 +27,7 @@ pub fn write_track_frame<W: Write>(csv: &mut TrackCsvWriter<W>, frame: &TrackFra
             prior_position_m: track.prior_m(),
             ground_truth_id: u64::try_from(track.gt_id).ok(),
             mode_probabilities: track.mode_probabilities,
+            world: track.world(),
         })?;
     }
     Ok(())

@@ -8,7 +8,7 @@
 //! [`Config::default`].
 //!
 //! ```
-//! let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 6.0", "gate_m = 4.5");
+//! let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 8.4", "gate_m = 4.5");
 //! let config = primm_config::from_toml_str(&text)?;
 //! assert_eq!(config.classes.car.gate_m, 4.5);
 //!
@@ -104,7 +104,7 @@ mod tests {
 
     #[test]
     fn an_unknown_key_is_a_parse_error_that_names_it() {
-        let text = DEFAULT_CONFIG_TOML.replace("gate_m = 6.0", "gate_m = 6.0\ngate_meters = 1.0");
+        let text = DEFAULT_CONFIG_TOML.replace("gate_m = 8.4", "gate_m = 8.4\ngate_meters = 1.0");
         let error = from_toml_str(&text).unwrap_err();
         assert!(matches!(error, ConfigError::Parse(_)), "{error:?}");
         assert!(error.to_string().contains("gate_meters"), "{error}");

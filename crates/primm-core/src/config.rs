@@ -8,6 +8,7 @@
 use crate::measurement::ObjectClass;
 use crate::mode::{ModeSet, MODE_COUNT};
 use crate::readable_number::readable;
+pub use crate::tracking_frame::{FrameConfig, TrackingFrame};
 use alloc::format;
 use alloc::string::String;
 use nalgebra::Matrix2;
@@ -31,6 +32,9 @@ pub struct Config {
     /// How the service runs the learned predictor (absent: the defaults).
     #[cfg_attr(feature = "serde", serde(default))]
     pub predictor: PredictorConfig,
+    /// The tracking frame and the sensors' mounting poses (absent: the defaults).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub frame: FrameConfig,
 }
 
 /// The learned predictor's runtime and the check of its answers.
@@ -250,42 +254,42 @@ impl Default for Config {
             },
             classes: ClassTable {
                 car: ClassConfig {
-                    gate_m: 6.0,
+                    gate_m: 8.4,
                     measurement_noise_covariance_m2: diagonal(0.36, 0.36),
                     radial_velocity_std_mps: 0.5,
-                    initial_tangential_speed_std_mps: 8.0,
-                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 4.0 },
+                    initial_tangential_speed_std_mps: 2.0,
+                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
                     constant_acceleration: ConstantAccelerationConfig {
-                        jerk_psd_m2_per_s5: 20.0,
+                        jerk_psd_m2_per_s5: 5.0,
                         initial_acceleration_std_mps2: 2.0,
                     },
                     coordinated_turn: CoordinatedTurnConfig {
-                        acceleration_psd_m2_per_s3: 2.0,
+                        acceleration_psd_m2_per_s3: 0.5,
                         turn_rate_psd_rad2_per_s3: 0.3,
                         initial_turn_rate_std_radps: 0.3,
                     },
                     learned: LearnedConfig {
-                        process_noise_covariance_m2: diagonal(0.01, 0.017),
+                        process_noise_covariance_m2: diagonal(0.011, 0.011),
                         measurement_noise_covariance_m2: diagonal(0.36, 0.36),
                     },
                 },
                 pedestrian: ClassConfig {
-                    gate_m: 3.0,
+                    gate_m: 4.2,
                     measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     radial_velocity_std_mps: 0.3,
-                    initial_tangential_speed_std_mps: 1.5,
-                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
+                    initial_tangential_speed_std_mps: 0.525,
+                    constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
                     constant_acceleration: ConstantAccelerationConfig {
-                        jerk_psd_m2_per_s5: 5.0,
+                        jerk_psd_m2_per_s5: 1.75,
                         initial_acceleration_std_mps2: 1.0,
                     },
                     coordinated_turn: CoordinatedTurnConfig {
-                        acceleration_psd_m2_per_s3: 0.5,
-                        turn_rate_psd_rad2_per_s3: 1.0,
+                        acceleration_psd_m2_per_s3: 0.25,
+                        turn_rate_psd_rad2_per_s3: 0.25,
                         initial_turn_rate_std_radps: 0.5,
                     },
                     learned: LearnedConfig {
-                        process_noise_covariance_m2: diagonal(0.008, 0.0025),
+                        process_noise_covariance_m2: diagonal(0.0006, 0.0006),
                         measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     },
                 },
@@ -311,6 +315,7 @@ impl Default for Config {
                 },
             },
             predictor: PredictorConfig::default(),
+            frame: FrameConfig::default(),
         }
     }
 }
@@ -364,6 +369,9 @@ impl Config {
         validate_imm(&self.imm)?;
         validate_association(&self.association)?;
         validate_tracker_and_predictor(&self.tracker, &self.predictor)?;
+        if let Some((key, reason)) = self.frame.problem() {
+            return Err(invalid(key, reason));
+        }
         for class in ObjectClass::ALL {
             validate_class(class, self.classes.get(class))?;
         }

@@ -12,6 +12,7 @@
 //!
 //! Nothing here allocates: all matrices are `nalgebra` static matrices.
 
+use crate::pose::RigidTransform;
 use glam::{DMat2, DVec2};
 use index::{OTHERS, X, Y};
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2};
@@ -76,6 +77,29 @@ impl<const N: usize> Gaussian<N> {
     /// The 2×2 position block `P_pp` of the covariance.
     pub fn position_covariance(&self) -> Matrix2<f64> {
         self.covariance.fixed_view::<2, 2>(X, X).into_owned()
+    }
+
+    /// This estimate in another frame: the position (elements [`X`], [`Y`]) mapped by
+    /// `transform`, every planar vector that starts at an index of `vectors` (a velocity at
+    /// 2, an acceleration at 4) rotated with it, other elements unchanged; the covariance
+    /// `J P Jᵀ` with `J` the block-diagonal Jacobian of that map.
+    pub fn transformed(&self, transform: &RigidTransform, vectors: &[usize]) -> Self {
+        let rotation = Matrix2::new(
+            transform.rotation.x_axis.x,
+            transform.rotation.y_axis.x,
+            transform.rotation.x_axis.y,
+            transform.rotation.y_axis.y,
+        );
+        let mut jacobian = SMatrix::<f64, N, N>::identity();
+        for &start in core::iter::once(&X).chain(vectors) {
+            jacobian.fixed_view_mut::<2, 2>(start, start).copy_from(&rotation);
+        }
+        let mut mean = jacobian * self.mean;
+        mean[X] += transform.translation_m.x;
+        mean[Y] += transform.translation_m.y;
+        let mut covariance = jacobian * self.covariance * jacobian.transpose();
+        symmetrize(&mut covariance);
+        Gaussian { mean, covariance }
     }
 }
 

@@ -30,6 +30,7 @@ use crate::motion::{
     ConstantAcceleration, ConstantVelocity, CoordinatedTurn, LearnedDisplacement, ModeModels, MotionModel,
     PredictContext,
 };
+use crate::pose::RigidTransform;
 use glam::{DMat2, DVec2};
 
 /// Mode probabilities in primm's mode order (PR, CV, CA, CT); inactive modes hold 0.
@@ -62,6 +63,19 @@ impl ImmState {
     /// The velocity estimate of one mode, m/s (PR: displacement over the last step).
     pub fn velocity(&self, mode: Mode) -> DVec2 {
         for_mode(mode, Velocity(self))
+    }
+
+    /// This state in another frame (see [`Gaussian::transformed`]): positions mapped,
+    /// velocities and accelerations rotated, turn rate and mode probabilities unchanged.
+    pub fn transformed(&self, transform: &RigidTransform) -> Self {
+        ImmState {
+            learned: self.learned.transformed(transform, &[]),
+            constant_velocity: self.constant_velocity.transformed(transform, &[cv::VX]),
+            constant_acceleration: self.constant_acceleration.transformed(transform, &[ca::VX, ca::AX]),
+            coordinated_turn: self.coordinated_turn.transformed(transform, &[ct::VX]),
+            probabilities: self.probabilities,
+            learned_velocity_mps: transform.apply_vector(self.learned_velocity_mps),
+        }
     }
 }
 
@@ -346,14 +360,27 @@ impl Imm {
         &self.transition
     }
 
-    /// A new track's state from its first measurement.
+    /// A new track's state from its first measurement, seen from the frame's origin.
     pub fn initiate(&self, models: &ModeModels, measurement: &Measurement) -> ImmState {
-        let constant_velocity = models.constant_velocity.initiate(measurement);
+        self.initiate_seen_from(models, measurement, DVec2::ZERO)
+    }
+
+    /// A new track's state from its first measurement, seen by a radar at `sensor_position_m`
+    /// (same frame as the measurement): the line of sight of the radial velocity starts there.
+    pub fn initiate_seen_from(
+        &self,
+        models: &ModeModels,
+        measurement: &Measurement,
+        sensor_position_m: DVec2,
+    ) -> ImmState {
+        let constant_velocity = models.constant_velocity.initiate_seen_from(measurement, sensor_position_m);
         ImmState {
-            learned: models.learned.initiate(measurement),
+            learned: models.learned.initiate_seen_from(measurement, sensor_position_m),
             constant_velocity,
-            constant_acceleration: models.constant_acceleration.initiate(measurement),
-            coordinated_turn: models.coordinated_turn.initiate(measurement),
+            constant_acceleration: models
+                .constant_acceleration
+                .initiate_seen_from(measurement, sensor_position_m),
+            coordinated_turn: models.coordinated_turn.initiate_seen_from(measurement, sensor_position_m),
             probabilities: self.initial_probabilities,
             learned_velocity_mps: DVec2::new(constant_velocity.mean[cv::VX], constant_velocity.mean[cv::VY]),
         }

@@ -19,3 +19,6 @@ pub const MAX_HISTORY: usize = 5;
 /// Largest number of gated track–measurement pairs the association considers in one class of
 /// one frame: every track with every measurement.
 pub const MAX_ASSOCIATION_PAIRS: usize = MAX_TRACKS * MAX_MEASUREMENTS_PER_FRAME;
+
+/// Largest number of radar sensors whose mounting poses a configuration can hold.
+pub const MAX_SENSORS: usize = 16;

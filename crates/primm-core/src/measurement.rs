@@ -6,6 +6,8 @@
 
 use arrayvec::ArrayVec;
 
+use crate::pose::EgoPose;
+
 pub use crate::limits::MAX_MEASUREMENTS_PER_FRAME;
 
 /// Object classes. The paper merges RadarScenes' *car* + *large vehicle* into [`ObjectClass::Car`]
@@ -106,6 +108,12 @@ pub trait FrameView {
     }
     /// Decodes measurement `index` (`index < len()`); an unknown class code is an error.
     fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass>;
+    /// The ego vehicle's pose in the world frame at the frame's time, if the frame carries one.
+    /// With a pose the tracker keeps its tracks in the world frame (see
+    /// [`TrackingFrame`](crate::config::TrackingFrame)).
+    fn ego_pose(&self) -> Option<EgoPose> {
+        None
+    }
 }
 
 /// A class code that names no [`ObjectClass`].
@@ -123,12 +131,14 @@ pub struct Frame {
     pub timestamp_s: f64,
     /// The frame's measurements.
     pub measurements: ArrayVec<Measurement, MAX_MEASUREMENTS_PER_FRAME>,
+    /// The ego vehicle's pose in the world frame, if known.
+    pub ego_pose: Option<EgoPose>,
 }
 
 impl Frame {
     /// An empty frame at `timestamp_s`.
     pub fn new(timestamp_s: f64) -> Self {
-        Self { timestamp_s, measurements: ArrayVec::new() }
+        Self { timestamp_s, measurements: ArrayVec::new(), ego_pose: None }
     }
 }
 
@@ -141,5 +151,8 @@ impl FrameView for Frame {
     }
     fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
         Ok(self.measurements[index])
+    }
+    fn ego_pose(&self) -> Option<EgoPose> {
+        self.ego_pose
     }
 }

@@ -3,6 +3,7 @@
 
 use crate::imm::{ImmState, ModeProbabilities};
 use crate::measurement::{Measurement, ObjectClass};
+use crate::pose::RigidTransform;
 use crate::predictor::{HistoryEntry, MAX_HISTORY};
 use glam::{DMat2, DVec2};
 use heapless::HistoryBuf;
@@ -66,6 +67,23 @@ impl Track {
         track
     }
 
+    /// Moves the track into another frame: its state (see [`ImmState::transformed`]) and the
+    /// positions of its measurement history.
+    pub fn transform(&mut self, transform: &RigidTransform) {
+        self.estimate = self.estimate.transformed(transform);
+        let mut entries = [HistoryEntry::default(); MAX_HISTORY];
+        let mut len = 0;
+        for entry in self.history.oldest_ordered() {
+            let position = transform.apply_point(DVec2::new(entry.x_m, entry.y_m));
+            entries[len] = HistoryEntry { x_m: position.x, y_m: position.y, ..*entry };
+            len += 1;
+        }
+        self.history.clear();
+        for entry in &entries[..len] {
+            self.history.write(*entry);
+        }
+    }
+
     /// Records an associated measurement.
     pub fn record_hit(&mut self, measurement: &Measurement, timestamp_s: f64, confirmation_hits: u32) {
         self.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
@@ -117,6 +135,13 @@ pub struct TrackOutput {
     /// Fused one-step prior used for association (`eq:prior_fusion`), m; `None` for a track
     /// started in this frame.
     pub prior_position_m: Option<DVec2>,
+    /// Fused position in the world frame, m, when the frame was tracked in the world frame
+    /// (then `position_m` and `prior_position_m` are in the vehicle frame of this frame, and
+    /// `velocity_mps` is the velocity over ground in the vehicle's axes).
+    pub world_position_m: Option<DVec2>,
+    /// Fused velocity over ground in the world frame, m/s, when the frame was tracked in the
+    /// world frame.
+    pub world_velocity_mps: Option<DVec2>,
     /// Posterior mode probabilities, order PR, CV, CA, CT (inactive modes 0).
     pub mode_probabilities: ModeProbabilities,
     /// Frames since the track started.

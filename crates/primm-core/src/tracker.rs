@@ -17,18 +17,21 @@ use crate::imm::{Imm, ImmPrior};
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::mode::{Mode, ModeSet};
 use crate::motion::ModeModels;
+use crate::pose::{EgoPose, RigidTransform};
 use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput, TrackStatus};
 use crate::track_loops;
 use crate::track_table::{TrackTable, MAX_TRACKS};
+use crate::tracking_frame::{InTrackingFrame, TrackingFrame};
 use crate::validation::{validate_frame, validate_measurement, FrameError, MeasurementRejection};
 use alloc::boxed::Box;
 use alloc::vec;
 use arrayvec::ArrayVec;
 use glam::DVec2;
 
-/// Why a step failed. The tracker's tracks are exactly as before the frame.
+/// Why a step failed. The tracker's tracks are exactly as before the frame (after an
+/// association failure, up to a change of their frame; see [`TrackingFrame`]).
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum StepError {
     /// The frame was rejected by validation.
@@ -54,6 +57,21 @@ pub struct TrackerStats {
     pub frames_rejected_interval_too_long: u64,
     /// Frames rejected because they carried too many measurements.
     pub frames_rejected_too_many_measurements: u64,
+    /// Frames rejected because their ego pose was not finite or absurdly far out (only when
+    /// tracking in the world frame; see [`EgoPose::is_valid`]).
+    pub frames_rejected_invalid_ego_pose: u64,
+    /// Frames tracked in the world frame (they carried an ego pose and the configuration asks
+    /// for [`TrackingFrame::World`]).
+    pub frames_in_world_frame: u64,
+    /// Frames tracked in the vehicle frame although the configuration asks for the world
+    /// frame, because they carried no ego pose.
+    pub frames_without_ego_pose: u64,
+    /// Times the live tracks were moved between the world and the vehicle frame, because a
+    /// stream started or stopped carrying ego poses.
+    pub tracking_frame_changes: u64,
+    /// Tracks started in the world frame by a measurement whose sensor has no configured
+    /// mount: their line of sight starts at the vehicle's reference point.
+    pub initiations_from_unknown_sensor: u64,
     /// Measurements tracked (accepted by validation).
     pub measurements_accepted: u64,
     /// Measurements rejected for an unknown class code.
@@ -122,6 +140,12 @@ pub struct StepSummary {
     pub live_tracks: usize,
     /// Confirmed tracks among the live ones.
     pub confirmed_tracks: usize,
+    /// The frame the step tracked in.
+    pub tracking_frame: TrackingFrame,
+    /// Whether the live tracks were moved into another frame at the start of the step.
+    pub tracking_frame_changed: bool,
+    /// Tracks started by a measurement whose sensor has no configured mount (world frame only).
+    pub initiations_from_unknown_sensor: usize,
 }
 
 impl TrackerStats {
@@ -139,6 +163,8 @@ impl TrackerStats {
         self.learned_predictions_rejected_non_finite += count(step.predictions_rejected_non_finite);
         self.learned_predictions_rejected_implausible += count(step.predictions_rejected_implausible);
         self.update_failures += count(step.update_failures);
+        self.initiations_from_unknown_sensor += count(step.initiations_from_unknown_sensor);
+        self.tracking_frame_changes += u64::from(step.tracking_frame_changed);
     }
 }
 
@@ -174,6 +200,12 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     stats: TrackerStats,
     /// What the latest step did.
     last_step: StepSummary,
+    /// The frame the live tracks are in.
+    tracks_frame: TrackingFrame,
+    /// The ego pose of the current step when it tracks in the world frame, else `None`.
+    step_pose: Option<EgoPose>,
+    /// The ego pose of the latest step tracked in the world frame.
+    last_pose: Option<EgoPose>,
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
     displacements: Box<[Option<DVec2>; MAX_TRACKS]>,
@@ -213,6 +245,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
             last_timestamp_s: None,
             stats: TrackerStats::default(),
             last_step: StepSummary::default(),
+            tracks_frame: TrackingFrame::Vehicle,
+            step_pose: None,
+            last_pose: None,
             requests: Box::new(ArrayVec::new()),
             displacements: Box::new([None; MAX_TRACKS]),
             priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
@@ -234,7 +269,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.advance(frame, &mut NoObserver)?;
         self.outputs.clear();
         let outputs = &mut self.outputs;
-        report(&self.table, &self.rows[..], &self.imm, |output| outputs.push(*output));
+        let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
+        report(&self.table, &self.rows[..], &self.imm, to_vehicle, |output| outputs.push(*output));
         Ok(&self.outputs)
     }
 
@@ -259,7 +295,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
         sink: impl FnMut(&TrackOutput),
     ) -> Result<StepSummary, StepError> {
         self.advance(frame, observer)?;
-        report(&self.table, &self.rows[..], &self.imm, sink);
+        let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
+        report(&self.table, &self.rows[..], &self.imm, to_vehicle, sink);
         observer.stage_finished(Stage::Report);
         Ok(self.last_step)
     }
@@ -289,6 +326,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let dt_s = self.validate(frame)?;
         observer.stage_finished(Stage::Validate);
         let t = frame.timestamp_s();
+        self.enter_tracking_frame(frame.ego_pose());
+        let frame = &InTrackingFrame {
+            frame,
+            vehicle_to_tracking: self.step_pose.map(|pose| pose.vehicle_to_world()),
+        };
         self.request_learned_predictions(t);
         self.predict_physics(dt_s);
         observer.stage_finished(Stage::Predict);
@@ -306,8 +348,50 @@ impl<P: DisplacementPredictor> Tracker<P> {
         Ok(())
     }
 
+    /// Decides the frame of this step from the frame's ego pose and the configuration, and
+    /// moves the live tracks into it if they are in the other one: into the world frame with
+    /// this frame's pose (the tracks' vehicle frame is taken as this frame's, which is off by
+    /// the ego motion since the last frame), back into the vehicle frame of the last pose.
+    fn enter_tracking_frame(&mut self, pose: Option<EgoPose>) {
+        let world = self.config.frame.tracking_frame == TrackingFrame::World;
+        self.step_pose = pose.filter(|_| world);
+        let step_frame = if self.step_pose.is_some() { TrackingFrame::World } else { TrackingFrame::Vehicle };
+        self.last_step.tracking_frame = step_frame;
+        if world && pose.is_none() {
+            self.stats.frames_without_ego_pose += 1;
+        }
+        if step_frame == TrackingFrame::World {
+            self.stats.frames_in_world_frame += 1;
+        }
+        if step_frame != self.tracks_frame && !self.table.is_empty() {
+            let transform = match (step_frame, self.step_pose, self.last_pose) {
+                (TrackingFrame::World, Some(pose), _) => Some(pose.vehicle_to_world()),
+                (TrackingFrame::Vehicle, _, Some(last)) => Some(last.world_to_vehicle()),
+                _ => None,
+            };
+            if let Some(transform) = transform {
+                self.table.tracks_mut().iter_mut().for_each(|track| track.transform(&transform));
+                self.last_step.tracking_frame_changed = true;
+            }
+        }
+        self.tracks_frame = step_frame;
+        if self.step_pose.is_some() {
+            self.last_pose = self.step_pose;
+        }
+    }
+
     /// Frame checks, then per-measurement checks; counts every rejection.
     fn validate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<f64, StepError> {
+        if self.config.frame.tracking_frame == TrackingFrame::World {
+            if let Some(pose) = frame.ego_pose().filter(|pose| !pose.is_valid()) {
+                self.stats.frames_rejected_invalid_ego_pose += 1;
+                return Err(StepError::InvalidFrame(FrameError::InvalidEgoPose {
+                    x_m: pose.x_m,
+                    y_m: pose.y_m,
+                    yaw_rad: pose.yaw_rad,
+                }));
+            }
+        }
         let dt_s =
             validate_frame(frame, self.last_timestamp_s, &self.config.tracker).inspect_err(|error| {
                 let counter = match error {
@@ -321,6 +405,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     FrameError::TooManyMeasurements { .. } => {
                         &mut self.stats.frames_rejected_too_many_measurements
                     }
+                    FrameError::InvalidEgoPose { .. } => &mut self.stats.frames_rejected_invalid_ego_pose,
                 };
                 *counter += 1;
             })?;
@@ -494,7 +579,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 continue;
             }
             let Ok(measurement) = frame.measurement(index) else { continue };
-            let estimate = self.imm.initiate(&self.models[measurement.class.index()], &measurement);
+            let sensor_position_m = self.sensor_position(&measurement);
+            let estimate = self.imm.initiate_seen_from(
+                &self.models[measurement.class.index()],
+                &measurement,
+                sensor_position_m,
+            );
             match self.table.insert(|id| Track::new(id, &measurement, t, estimate)) {
                 Ok(track) => {
                     self.last_step.initiated += 1;
@@ -537,12 +627,28 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.last_step.deleted = deleted;
     }
 
+    /// Where the radar that measured `measurement` is, in the tracking frame: the world
+    /// position of its mount in a world-frame step (the vehicle's reference point, counted, for
+    /// a sensor without a configured mount), the vehicle frame's origin otherwise.
+    fn sensor_position(&mut self, measurement: &Measurement) -> DVec2 {
+        let Some(pose) = self.step_pose else { return DVec2::ZERO };
+        match measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)) {
+            Some(mount) => pose.car_to_world(mount.position()),
+            None => {
+                self.last_step.initiations_from_unknown_sensor += 1;
+                pose.position()
+            }
+        }
+    }
+
     /// Removes every track and forgets the last timestamp, e.g. after a gap in the stream that
     /// [`FrameError::IntervalTooLong`] reported. Ids keep counting; statistics are kept;
     /// [`last_step`](Self::last_step) is cleared.
     pub fn reset(&mut self) {
         self.table.clear();
         self.last_timestamp_s = None;
+        self.last_pose = None;
+        self.step_pose = None;
         self.last_step = StepSummary::default();
         self.stats.resets += 1;
     }
@@ -585,18 +691,38 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 }
 
-/// The output record of every live track, handed to `sink`.
-fn report(table: &TrackTable, rows: &[RowRecord], imm: &Imm, mut sink: impl FnMut(&TrackOutput)) {
+/// The output record of every live track, handed to `sink`. Tracks in the world frame are
+/// reported in the vehicle frame of the current frame (`world_to_vehicle`) with their world
+/// position and velocity beside.
+fn report(
+    table: &TrackTable,
+    rows: &[RowRecord],
+    imm: &Imm,
+    world_to_vehicle: Option<RigidTransform>,
+    mut sink: impl FnMut(&TrackOutput),
+) {
     for (track, row) in table.tracks().iter().zip(rows.iter()) {
         let fused = imm.fuse_posterior(&track.estimate, row.available);
+        let velocity = imm.fuse_velocity(&track.estimate, row.available);
+        let (position_m, position_covariance_m2, velocity_mps, prior_position_m) = match world_to_vehicle {
+            Some(to_vehicle) => (
+                to_vehicle.apply_point(fused.mean),
+                to_vehicle.apply_covariance(fused.covariance),
+                to_vehicle.apply_vector(velocity),
+                row.prior_position_m.map(|prior| to_vehicle.apply_point(prior)),
+            ),
+            None => (fused.mean, fused.covariance, velocity, row.prior_position_m),
+        };
         sink(&TrackOutput {
             id: track.id,
             class: track.class,
             status: track.status,
-            position_m: fused.mean,
-            position_covariance_m2: fused.covariance,
-            velocity_mps: imm.fuse_velocity(&track.estimate, row.available),
-            prior_position_m: row.prior_position_m,
+            position_m,
+            position_covariance_m2,
+            velocity_mps,
+            prior_position_m,
+            world_position_m: world_to_vehicle.map(|_| fused.mean),
+            world_velocity_mps: world_to_vehicle.map(|_| velocity),
             mode_probabilities: track.estimate.probabilities,
             age_frames: track.age_frames,
             hits: track.hits,

@@ -44,6 +44,24 @@ pub enum FrameError {
         /// The configured maximum, s.
         max_s: f64,
     },
+    /// The frame's ego pose is not finite or lies beyond [`MAX_EGO_POSITION_M`] (checked only
+    /// when tracking in the world frame).
+    ///
+    /// [`MAX_EGO_POSITION_M`]: crate::pose::MAX_EGO_POSITION_M
+    #[error(
+        "frame ego pose (x {} m, y {} m, yaw {} rad) is not finite or too far out",
+        readable(.x_m),
+        readable(.y_m),
+        readable(.yaw_rad)
+    )]
+    InvalidEgoPose {
+        /// x of the pose, m.
+        x_m: f64,
+        /// y of the pose, m.
+        y_m: f64,
+        /// Yaw of the pose, rad.
+        yaw_rad: f64,
+    },
     /// The frame claims more measurements than a frame may carry.
     #[error("frame carries {count} measurements, more than the maximum of {MAX_MEASUREMENTS_PER_FRAME}")]
     TooManyMeasurements {

@@ -3,14 +3,15 @@
 use crate::status::{guard, guard_value, record_thread_error, ErrorText, Failure, PanicMessage, PrimmStatus};
 use crate::text::copy_to_c_buffer;
 use crate::types::{
-    method_from_code, PrimmMeasurement, PrimmStats, PrimmStepSummary, PrimmTrack, PrimmTrackerOptions,
-    PRIMM_MAX_TRACKS, PRIMM_METHOD_CONFIG,
+    method_from_code, PrimmEgoPose, PrimmMeasurement, PrimmStats, PrimmStepSummary, PrimmTrack,
+    PrimmTrackerOptions, PRIMM_MAX_TRACKS, PRIMM_METHOD_CONFIG,
 };
 use core::ffi::{c_char, CStr};
 use core::fmt;
 use primm_core::config::Config;
 use primm_core::measurement::{FrameView, Measurement, UnknownClass};
 use primm_core::mode::Mode;
+use primm_core::pose::EgoPose;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::{ModelSource, OnnxPredictor, PrModel};
@@ -127,6 +128,7 @@ struct CallerFrame {
     timestamp_s: f64,
     measurements: *const PrimmMeasurement,
     count: usize,
+    ego_pose: Option<EgoPose>,
 }
 
 impl FrameView for CallerFrame {
@@ -144,6 +146,10 @@ impl FrameView for CallerFrame {
         // `index < count`.
         let measurement = unsafe { self.measurements.add(index).read() };
         measurement.to_measurement()
+    }
+
+    fn ego_pose(&self) -> Option<EgoPose> {
+        self.ego_pose
     }
 }
 
@@ -239,9 +245,40 @@ pub unsafe extern "C" fn primm_tracker_create(
     })
 }
 
+/// Tracks one frame without an ego pose (in the vehicle frame): `primm_tracker_step_with_pose`
+/// with a NULL pose.
+///
+/// # Safety
+/// As `primm_tracker_step_with_pose`.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_step(
+    tracker: *mut PrimmTracker,
+    timestamp_s: f64,
+    measurements: *const PrimmMeasurement,
+    count: usize,
+    out_summary: *mut PrimmStepSummary,
+) -> PrimmStatus {
+    // SAFETY: forwarded caller contract; a NULL pose is allowed.
+    unsafe {
+        primm_tracker_step_with_pose(
+            tracker,
+            timestamp_s,
+            core::ptr::null(),
+            measurements,
+            count,
+            out_summary,
+        )
+    }
+}
+
 /// Tracks one frame: `count` measurements at `measurements` (NULL allowed when `count` is 0),
-/// taken at `timestamp_s` (seconds, strictly increasing from frame to frame). The measurements
-/// are read in place during the call. Writes what the step did to `*out_summary` unless it is
+/// taken at `timestamp_s` (seconds, strictly increasing from frame to frame), with the ego
+/// vehicle's pose `*ego_pose` at that time, or NULL when unknown. With a pose (and the
+/// configuration's `frame.tracking_frame` "world", the default) the tracker keeps its tracks in
+/// the world frame and reports them in the vehicle frame of this step with their world estimate
+/// beside (`PrimmTrack::has_world_estimate`); a pose that is not finite or absurdly far out
+/// rejects the frame (`PRIMM_STATUS_INVALID_FRAME`). The measurements are read in place during
+/// the call. Writes what the step did to `*out_summary` unless it is
 /// NULL (zeroed on failure).
 ///
 /// Allocates nothing, unless the PR model runs inside the step (`inference_thread` false),
@@ -254,12 +291,14 @@ pub unsafe extern "C" fn primm_tracker_create(
 /// tracked.
 ///
 /// # Safety
-/// `tracker` is NULL or a live handle used by no other thread; `measurements` is NULL or points
-/// to `count` readable, aligned `PrimmMeasurement`s; `out_summary` is NULL or writable.
+/// `tracker` is NULL or a live handle used by no other thread; `ego_pose` is NULL or points to a
+/// readable `PrimmEgoPose`; `measurements` is NULL or points to `count` readable, aligned
+/// `PrimmMeasurement`s; `out_summary` is NULL or writable.
 #[no_mangle]
-pub unsafe extern "C" fn primm_tracker_step(
+pub unsafe extern "C" fn primm_tracker_step_with_pose(
     tracker: *mut PrimmTracker,
     timestamp_s: f64,
+    ego_pose: *const PrimmEgoPose,
     measurements: *const PrimmMeasurement,
     count: usize,
     out_summary: *mut PrimmStepSummary,
@@ -272,7 +311,13 @@ pub unsafe extern "C" fn primm_tracker_step(
         if measurements.is_null() && count > 0 {
             return Err(Failure::NullArgument("measurements"));
         }
-        let summary = handle.step(&CallerFrame { timestamp_s, measurements, count })?;
+        // SAFETY: NULL or readable (caller contract).
+        let ego_pose = unsafe { ego_pose.as_ref() }.map(|pose| EgoPose {
+            x_m: pose.x_m,
+            y_m: pose.y_m,
+            yaw_rad: pose.yaw_rad,
+        });
+        let summary = handle.step(&CallerFrame { timestamp_s, measurements, count, ego_pose })?;
         if !out_summary.is_null() {
             // SAFETY: writable (caller contract).
             unsafe { out_summary.write(summary) };

@@ -197,6 +197,32 @@ pub struct PrimmTrack {
     pub status: PrimmTrackStatus,
     /// Whether the track has a prior (false for a track started in this step).
     pub has_prior_position: bool,
+    /// Whether the step tracked in the world frame (it had an ego pose): then the position,
+    /// covariance, prior and velocity above are in the vehicle frame of this step (the velocity
+    /// over ground in the vehicle's axes) and the `world_*` fields hold the world-frame
+    /// estimate; otherwise those are NaN.
+    pub has_world_estimate: bool,
+    /// Fused position in the world frame, x, m.
+    pub world_x_m: f64,
+    /// Fused position in the world frame, y, m.
+    pub world_y_m: f64,
+    /// Fused velocity over ground in the world frame, x, m/s.
+    pub world_velocity_x_mps: f64,
+    /// Fused velocity over ground in the world frame, y, m/s.
+    pub world_velocity_y_mps: f64,
+}
+
+/// The ego vehicle's pose in the world (odometry) frame at a frame's time: the reference point
+/// (centre of the rear axle) and the heading of the vehicle's x axis.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PrimmEgoPose {
+    /// World x of the reference point, m.
+    pub x_m: f64,
+    /// World y of the reference point, m.
+    pub y_m: f64,
+    /// Heading, rad, counter-clockwise from the world x axis.
+    pub yaw_rad: f64,
 }
 
 impl PrimmTrack {
@@ -221,6 +247,11 @@ impl PrimmTrack {
         class_code: PRIMM_OBJECT_CLASS_CAR,
         status: PRIMM_TRACK_STATUS_TENTATIVE,
         has_prior_position: false,
+        has_world_estimate: false,
+        world_x_m: f64::NAN,
+        world_y_m: f64::NAN,
+        world_velocity_x_mps: f64::NAN,
+        world_velocity_y_mps: f64::NAN,
     };
 }
 
@@ -228,6 +259,7 @@ impl From<&TrackOutput> for PrimmTrack {
     fn from(output: &TrackOutput) -> Self {
         let covariance = output.position_covariance_m2;
         let prior = output.prior_position_m;
+        let world = output.world_position_m.zip(output.world_velocity_mps);
         PrimmTrack {
             id: output.id,
             x_m: output.position_m.x,
@@ -248,6 +280,11 @@ impl From<&TrackOutput> for PrimmTrack {
             class_code: output.class.code(),
             status: output.status as u8,
             has_prior_position: prior.is_some(),
+            has_world_estimate: world.is_some(),
+            world_x_m: world.map_or(f64::NAN, |(p, _)| p.x),
+            world_y_m: world.map_or(f64::NAN, |(p, _)| p.y),
+            world_velocity_x_mps: world.map_or(f64::NAN, |(_, v)| v.x),
+            world_velocity_y_mps: world.map_or(f64::NAN, |(_, v)| v.y),
         }
     }
 }
@@ -318,6 +355,17 @@ pub struct PrimmStats {
     pub frames_rejected_interval_too_long: u64,
     /// Frames rejected because they carried too many measurements.
     pub frames_rejected_too_many_measurements: u64,
+    /// Frames rejected because their ego pose was not finite or absurdly far out.
+    pub frames_rejected_invalid_ego_pose: u64,
+    /// Frames tracked in the world frame.
+    pub frames_in_world_frame: u64,
+    /// Frames tracked in the vehicle frame although the configuration asks for the world frame
+    /// (they carried no ego pose).
+    pub frames_without_ego_pose: u64,
+    /// Times the live tracks were moved between the world and the vehicle frame.
+    pub tracking_frame_changes: u64,
+    /// Tracks started in the world frame by a measurement of a sensor without configured mount.
+    pub initiations_from_unknown_sensor: u64,
     /// Measurements tracked (accepted by validation).
     pub measurements_accepted: u64,
     /// Measurements rejected for an unknown class code.
@@ -360,6 +408,11 @@ impl From<&TrackerStats> for PrimmStats {
             frames_rejected_timestamp_not_increasing,
             frames_rejected_interval_too_long,
             frames_rejected_too_many_measurements,
+            frames_rejected_invalid_ego_pose,
+            frames_in_world_frame,
+            frames_without_ego_pose,
+            tracking_frame_changes,
+            initiations_from_unknown_sensor,
             measurements_accepted,
             measurements_rejected_unknown_class,
             measurements_rejected_non_finite,
@@ -381,6 +434,11 @@ impl From<&TrackerStats> for PrimmStats {
             frames_rejected_timestamp_not_increasing,
             frames_rejected_interval_too_long,
             frames_rejected_too_many_measurements,
+            frames_rejected_invalid_ego_pose,
+            frames_in_world_frame,
+            frames_without_ego_pose,
+            tracking_frame_changes,
+            initiations_from_unknown_sensor,
             measurements_accepted,
             measurements_rejected_unknown_class,
             measurements_rejected_non_finite,

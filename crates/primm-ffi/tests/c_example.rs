@@ -12,7 +12,7 @@ use primm_core::config::Config;
 use primm_core::mode::Method;
 use primm_core::tracker::Tracker;
 use primm_predictor::predictor_for;
-use primm_sim::io::track_csv::TrackCsvWriter;
+use primm_sim::io::track_csv::{TrackCsvWriter, WORLD_COLUMNS};
 use primm_sim::io::{read_sequence_file, write_sequence_file};
 use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
 use std::path::{Path, PathBuf};
@@ -58,7 +58,8 @@ fn primm_track_imm(input: &Path) -> String {
     let mut tracker = Tracker::with_predictor(config, predictor_for(method, None).unwrap()).unwrap();
     let sequence = read_sequence_file(input).unwrap();
     let frames = sequence.to_frames().unwrap();
-    let mut writer = TrackCsvWriter::new(Vec::new()).unwrap();
+    let mut writer =
+        TrackCsvWriter::for_sequence(Vec::new(), &sequence, tracker.config().frame.tracking_frame).unwrap();
     tracker.reset();
     for (recorded, frame) in sequence.frames.iter().zip(&frames) {
         let outputs = tracker.step(frame).unwrap();
@@ -95,6 +96,8 @@ fn the_c_example_writes_the_same_track_file_as_primm_track_with_imm() {
     let from_c = std::fs::read_to_string(&output).unwrap();
     let from_rust = primm_track_imm(&input);
 
+    // The generated scene carries ego poses: both track in the world frame.
+    assert!(from_rust.lines().next().unwrap().ends_with(WORLD_COLUMNS), "no world-frame columns");
     let rows = from_rust.lines().count() - 1;
     assert!(rows > 100, "a 3 s scenario gives more than 100 track rows, got {rows}");
     assert!(from_rust.lines().skip(1).any(|line| !line.split(',').nth(6).unwrap().is_empty()));

@@ -24,6 +24,16 @@
 //! Feature normalisation is part of the graph. The batch axis must be symbolic and is bound to a
 //! symbol named [`BATCH_SYMBOL`]; every other dimension must match exactly.
 //!
+//! # Input frame: aligned with the latest motion
+//!
+//! The model never sees absolute headings. Before a request goes in, its relative positions
+//! are rotated into the frame whose x axis points along the latest motion, from the
+//! second-latest to the latest measurement ([`MotionFrame`]); the displacement that comes out is
+//! rotated back. A history of one measurement, or whose last two measurements are closer than
+//! [`MIN_HEADING_DISTANCE_M`], has no such direction and goes in unrotated (the model is trained
+//! with such windows in random orientations). So tracks in the world frame, whose headings are
+//! arbitrary, and tracks in the vehicle frame are predicted alike.
+//!
 //! # From model output to the tracker's displacement
 //!
 //! The model answers `f(t)`: the displacement from a track's latest measurement to time `t`. The
@@ -40,6 +50,49 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tract_onnx::prelude::*;
 use tract_onnx::tract_hir::infer::GenericFactoid;
+
+/// Shortest distance between the last two measurements of a history that defines the direction
+/// of its latest motion, m.
+pub const MIN_HEADING_DISTANCE_M: f64 = 0.01;
+
+/// The rotation of a request into the model's input frame (see the module documentation):
+/// `(x, y) ↦ (c·x + s·y, −s·x + c·y)` with `(c, s)` the unit direction of the latest motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionFrame {
+    cos: f64,
+    sin: f64,
+}
+
+impl MotionFrame {
+    /// No rotation.
+    pub const IDENTITY: MotionFrame = MotionFrame { cos: 1.0, sin: 0.0 };
+
+    /// The frame of `request`'s latest motion; [`IDENTITY`](Self::IDENTITY) without one.
+    pub fn of(request: &PredictionRequest) -> Self {
+        if request.len < 2 || request.len > MAX_HISTORY {
+            return Self::IDENTITY;
+        }
+        // Positions are relative to the latest measurement, so the motion is minus the
+        // second-latest row's position.
+        let previous = request.features[request.len - 2];
+        let motion = DVec2::new(-f64::from(previous[0]), -f64::from(previous[1]));
+        let length = motion.length();
+        if !(length >= MIN_HEADING_DISTANCE_M && length.is_finite()) {
+            return Self::IDENTITY;
+        }
+        MotionFrame { cos: motion.x / length, sin: motion.y / length }
+    }
+
+    /// A position or displacement in the model's frame.
+    pub fn to_model(&self, vector: DVec2) -> DVec2 {
+        DVec2::new(self.cos * vector.x + self.sin * vector.y, -self.sin * vector.x + self.cos * vector.y)
+    }
+
+    /// A displacement from the model's frame back into the request's frame.
+    pub fn from_model(&self, vector: DVec2) -> DVec2 {
+        DVec2::new(self.cos * vector.x - self.sin * vector.y, self.sin * vector.x + self.cos * vector.y)
+    }
+}
 
 /// Name of the model's first input.
 pub const FEATURES_INPUT: &str = "features";
@@ -453,8 +506,9 @@ pub struct OnnxPredictor {
     features: Vec<f32>,
     valid: Vec<f32>,
     output: Vec<f32>,
-    /// Model row of each request (`None`: refused), and of its step-start row if it has one.
-    rows: Vec<(Option<usize>, Option<usize>)>,
+    /// Model row of each request (`None`: refused), of its step-start row if it has one, and
+    /// the request's input frame.
+    rows: Vec<(Option<usize>, Option<usize>, MotionFrame)>,
     results: Vec<Option<DVec2>>,
     stats: OnnxPredictorStats,
     last_error: Option<InferenceError>,
@@ -517,17 +571,18 @@ impl OnnxPredictor {
         self.rows.clear();
         let mut row_count = 0;
         for request in requests {
-            let row = push_row(request, &mut self.features, &mut self.valid).then(|| {
+            let frame = MotionFrame::of(request);
+            let row = push_row(request, &frame, &mut self.features, &mut self.valid).then(|| {
                 row_count += 1;
                 row_count - 1
             });
             self.stats.invalid_requests += u64::from(row.is_none());
-            self.rows.push((row, None));
+            self.rows.push((row, None, frame));
         }
         for (request, rows) in requests.iter().zip(self.rows.iter_mut()) {
             if rows.0.is_some() && request.step_starts_after_latest_measurement() {
                 let shifted = request.at_time(request.step_start_s);
-                if push_row(&shifted, &mut self.features, &mut self.valid) {
+                if push_row(&shifted, &rows.2, &mut self.features, &mut self.valid) {
                     rows.1 = Some(row_count);
                     row_count += 1;
                 } else {
@@ -550,12 +605,12 @@ impl OnnxPredictor {
         }
         let at =
             |row: usize| DVec2::new(f64::from(self.output[2 * row]), f64::from(self.output[2 * row + 1]));
-        for (out, &(row, start_row)) in displacements.iter_mut().zip(&self.rows) {
+        for (out, &(row, start_row, frame)) in displacements.iter_mut().zip(&self.rows) {
             let Some(row) = row else { continue };
-            let displacement = match start_row {
+            let displacement = frame.from_model(match start_row {
                 Some(start_row) => at(row) - at(start_row),
                 None => at(row),
-            };
+            });
             if displacement.is_finite() {
                 *out = Some(displacement);
                 self.stats.predictions += 1;
@@ -567,15 +622,22 @@ impl OnnxPredictor {
     }
 }
 
-/// Appends the model rows of one request; `false` (nothing appended) if the request is unusable.
-fn push_row(request: &PredictionRequest, features: &mut Vec<f32>, valid: &mut Vec<f32>) -> bool {
+/// Appends the model rows of one request, its positions rotated into `frame`; `false` (nothing
+/// appended) if the request is unusable.
+fn push_row(
+    request: &PredictionRequest,
+    frame: &MotionFrame,
+    features: &mut Vec<f32>,
+    valid: &mut Vec<f32>,
+) -> bool {
     let len = request.len;
     if !(1..=MAX_HISTORY).contains(&len) || !request.features[..len].iter().flatten().all(|v| v.is_finite()) {
         return false;
     }
     for (index, row) in request.features.iter().enumerate() {
         if index < len {
-            features.extend_from_slice(row);
+            let position = frame.to_model(DVec2::new(f64::from(row[0]), f64::from(row[1])));
+            features.extend_from_slice(&[position.x as f32, position.y as f32, row[2], row[3], row[4]]);
             valid.push(1.0);
         } else {
             features.extend_from_slice(&[0.0; FEATURES]);

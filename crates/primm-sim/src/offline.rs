@@ -43,6 +43,7 @@ pub fn track_sequence<P: DisplacementPredictor>(
     let mut frame = Frame::default();
     for recorded in &sequence.frames {
         frame.timestamp_s = recorded.timestamp_s;
+        frame.ego_pose = recorded.ego_pose;
         frame.measurements.clear();
         if recorded.measurements.len() > frame.measurements.capacity() {
             return Err(OfflineError::TooManyMeasurements {

@@ -15,6 +15,7 @@
 
 #include <stdint.h>
 
+#define PRIMM_WIRE_VERSION 2 /* layout version; primm_track_frame.wire_version carries the writer's */
 #define PRIMM_MEASUREMENT_CAPACITY 256
 #define PRIMM_TRACK_CAPACITY 512
 #define PRIMM_STAGE_CAPACITY 12
@@ -41,6 +42,7 @@
 #define PRIMM_STATUS_REJECTED_INTERVAL_TOO_LONG 3
 #define PRIMM_STATUS_REJECTED_TOO_MANY_MEASUREMENTS 4
 #define PRIMM_STATUS_ASSOCIATION_FAILED 5
+#define PRIMM_STATUS_REJECTED_INVALID_EGO_POSE 6
 
 /* Object class codes */
 #define PRIMM_CLASS_CAR 0
@@ -76,7 +78,9 @@ typedef struct primm_measurement_frame {
     primm_wire_measurement measurements[PRIMM_MEASUREMENT_CAPACITY];
 } primm_measurement_frame;
 
-/* One track: 152 bytes. */
+/* One track: 184 bytes. With world_valid == 1 the frame was tracked in the world frame: x, y,
+ * covariance, prior and velocity are in the vehicle frame of the input frame (velocity over
+ * ground in the vehicle's axes), world_* in the world frame. */
 typedef struct primm_wire_track {
     uint64_t id;
     double x_m;
@@ -87,6 +91,10 @@ typedef struct primm_wire_track {
     double prior_x_m;             /* valid when prior_valid == 1 */
     double prior_y_m;
     double mode_probabilities[4]; /* PR, CV, CA, CT */
+    double world_x_m;             /* valid when world_valid == 1 */
+    double world_y_m;
+    double world_vx_mps;
+    double world_vy_mps;
     int64_t gt_id;                /* -1: none */
     uint32_t age_frames;
     uint32_t hits;
@@ -95,10 +103,11 @@ typedef struct primm_wire_track {
     uint8_t class_code;
     uint8_t status;               /* 0 tentative, 1 confirmed */
     uint8_t prior_valid;
-    uint8_t _pad0[5];
+    uint8_t world_valid;
+    uint8_t _pad0[4];
 } primm_wire_track;
 
-/* "primm::TrackFrame": 77888 bytes. */
+/* "primm::TrackFrame": 94272 bytes. */
 typedef struct primm_track_frame {
     uint64_t input_sequence;
     uint64_t source_frame;
@@ -111,7 +120,8 @@ typedef struct primm_track_frame {
     uint8_t flags;
     uint16_t measurements_accepted;
     uint16_t measurements_rejected;
-    uint8_t _pad0[6];
+    uint16_t wire_version; /* PRIMM_WIRE_VERSION of the writer */
+    uint8_t _pad0[4];
     primm_wire_track tracks[PRIMM_TRACK_CAPACITY];
 } primm_track_frame;
 

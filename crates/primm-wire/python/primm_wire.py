@@ -9,6 +9,7 @@ nanoseconds (``time.monotonic_ns()``), ``_s`` times are sensor seconds.
 
 import ctypes
 
+WIRE_VERSION = 2  # layout version; TrackFrame.wire_version carries the writer's
 MEASUREMENT_CAPACITY = 256
 TRACK_CAPACITY = 512
 STAGE_CAPACITY = 12
@@ -105,6 +106,10 @@ class WireTrack(ctypes.Structure):
         ("prior_x_m", ctypes.c_double),
         ("prior_y_m", ctypes.c_double),
         ("mode_probabilities", ctypes.c_double * 4),
+        ("world_x_m", ctypes.c_double),
+        ("world_y_m", ctypes.c_double),
+        ("world_vx_mps", ctypes.c_double),
+        ("world_vy_mps", ctypes.c_double),
         ("gt_id", ctypes.c_int64),
         ("age_frames", ctypes.c_uint32),
         ("hits", ctypes.c_uint32),
@@ -113,7 +118,8 @@ class WireTrack(ctypes.Structure):
         ("class_code", ctypes.c_uint8),
         ("status", ctypes.c_uint8),
         ("prior_valid", ctypes.c_uint8),
-        ("_pad0", ctypes.c_uint8 * 5),
+        ("world_valid", ctypes.c_uint8),
+        ("_pad0", ctypes.c_uint8 * 4),
     ]
 
     @staticmethod
@@ -122,7 +128,7 @@ class WireTrack(ctypes.Structure):
 
 
 class TrackFrame(ctypes.Structure):
-    """The tracker's answer to one measurement frame (77888 bytes)."""
+    """The tracker's answer to one measurement frame (94272 bytes)."""
 
     _fields_ = [
         ("input_sequence", ctypes.c_uint64),
@@ -136,7 +142,8 @@ class TrackFrame(ctypes.Structure):
         ("flags", ctypes.c_uint8),
         ("measurements_accepted", ctypes.c_uint16),
         ("measurements_rejected", ctypes.c_uint16),
-        ("_pad0", ctypes.c_uint8 * 6),
+        ("wire_version", ctypes.c_uint16),
+        ("_pad0", ctypes.c_uint8 * 4),
         ("tracks", WireTrack * TRACK_CAPACITY),
     ]
 
@@ -203,6 +210,7 @@ def layout() -> dict:
 
 
 if __name__ == "__main__":
+    print(f"version {WIRE_VERSION}")
     for name, info in layout().items():
         print(f"{name} size {info['size']} align {info['align']}")
         for field, offset in info["fields"].items():

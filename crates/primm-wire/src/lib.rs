@@ -53,6 +53,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+/// Version of the payload layouts. It changes whenever a layout changes; the tracker writes it
+/// into every [`TrackFrame`] (`wire_version`), and the C header (`PRIMM_WIRE_VERSION`) and the
+/// Python module (`WIRE_VERSION`) declare it beside their layouts. Version 2 added the
+/// world-frame fields of [`WireTrack`] and [`FrameStatus::RejectedInvalidEgoPose`]. (iceoryx2
+/// also refuses to connect a publisher and a subscriber whose payload sizes differ.)
+pub const WIRE_VERSION: u16 = 2;
+
 mod latency_report;
 mod measurement_frame;
 mod track_frame;

@@ -7,6 +7,7 @@ use iceoryx2::prelude::ZeroCopySend;
 use primm_core::measurement::{
     FrameView, Measurement, ObjectClass, UnknownClass, MAX_MEASUREMENTS_PER_FRAME,
 };
+use primm_core::pose::EgoPose;
 
 /// Number of measurement slots in a [`MeasurementFrame`].
 pub const MEASUREMENT_CAPACITY: usize = MAX_MEASUREMENTS_PER_FRAME;
@@ -168,6 +169,15 @@ impl FrameView for MeasurementFrame {
     /// capacity if a caller ignores `len()`; the tracker validates `len()` first.
     fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
         self.measurements[index].decode()
+    }
+
+    /// The pose of the header when [`FRAME_FLAG_EGO_VALID`] is set (the tracker checks it).
+    fn ego_pose(&self) -> Option<EgoPose> {
+        (self.flags & FRAME_FLAG_EGO_VALID != 0).then_some(EgoPose {
+            x_m: self.ego_x_m,
+            y_m: self.ego_y_m,
+            yaw_rad: self.ego_yaw_rad,
+        })
     }
 }
 

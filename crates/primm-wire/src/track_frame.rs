@@ -42,6 +42,9 @@ pub enum FrameStatus {
     RejectedTooManyMeasurements = 4,
     /// The association solver failed (a defect); no track changed.
     AssociationFailed = 5,
+    /// Rejected: the frame's ego pose is not finite or absurdly far out (only when tracking in
+    /// the world frame). No track changed.
+    RejectedInvalidEgoPose = 6,
 }
 
 impl FrameStatus {
@@ -59,6 +62,7 @@ impl FrameStatus {
             Self::RejectedIntervalTooLong,
             Self::RejectedTooManyMeasurements,
             Self::AssociationFailed,
+            Self::RejectedInvalidEgoPose,
         ]
         .get(usize::from(code))
         .copied()
@@ -77,6 +81,7 @@ impl FrameStatus {
             StepError::InvalidFrame(FrameError::TooManyMeasurements { .. }) => {
                 Self::RejectedTooManyMeasurements
             }
+            StepError::InvalidFrame(FrameError::InvalidEgoPose { .. }) => Self::RejectedInvalidEgoPose,
             StepError::Association(_) => Self::AssociationFailed,
         }
     }
@@ -90,11 +95,17 @@ impl FrameStatus {
             Self::RejectedIntervalTooLong => "interval_too_long",
             Self::RejectedTooManyMeasurements => "too_many_measurements",
             Self::AssociationFailed => "association_failed",
+            Self::RejectedInvalidEgoPose => "invalid_ego_pose",
         }
     }
 }
 
-/// One track's fused state: 152 bytes, alignment 8.
+/// One track's fused state: 184 bytes, alignment 8.
+///
+/// When the frame was tracked in the world frame (`world_valid` 1), the position, covariance,
+/// prior and velocity are in the vehicle frame of the input frame (the velocity is the velocity
+/// over ground in the vehicle's axes) and the `world_*` fields hold the world-frame position
+/// and velocity; otherwise everything is in the vehicle frame and `world_*` are 0.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[type_name("primm::WireTrack")]
@@ -117,6 +128,14 @@ pub struct WireTrack {
     pub prior_y_m: f64,
     /// Posterior mode probabilities, order PR, CV, CA, CT (inactive modes 0).
     pub mode_probabilities: [f64; 4],
+    /// Fused position in the world frame, m (valid when `world_valid` is 1).
+    pub world_x_m: f64,
+    /// Fused position in the world frame, m (valid when `world_valid` is 1).
+    pub world_y_m: f64,
+    /// Fused velocity over ground in the world frame, m/s (valid when `world_valid` is 1).
+    pub world_vx_mps: f64,
+    /// Fused velocity over ground in the world frame, m/s (valid when `world_valid` is 1).
+    pub world_vy_mps: f64,
     /// Ground-truth id of the measurement that updated or started the track in this frame;
     /// -1 when none (coasting, or no ground truth).
     pub gt_id: i64,
@@ -135,8 +154,10 @@ pub struct WireTrack {
     pub status: u8,
     /// 1 when `prior_x_m`/`prior_y_m` are valid (0 for a track started in this frame).
     pub prior_valid: u8,
+    /// 1 when the `world_*` fields are valid (the frame was tracked in the world frame).
+    pub world_valid: u8,
     /// Explicit padding, written as zero.
-    pub _pad0: [u8; 5],
+    pub _pad0: [u8; 4],
 }
 
 impl WireTrack {
@@ -145,6 +166,10 @@ impl WireTrack {
     pub fn from_output(output: &TrackOutput) -> Self {
         let covariance = output.position_covariance_m2;
         let prior = output.prior_position_m;
+        let (world_position, world_velocity) = match (output.world_position_m, output.world_velocity_mps) {
+            (Some(position), Some(velocity)) => (Some(position), Some(velocity)),
+            _ => (None, None),
+        };
         Self {
             id: output.id,
             x_m: output.position_m.x,
@@ -160,6 +185,10 @@ impl WireTrack {
             prior_x_m: prior.map_or(0.0, |p| p.x),
             prior_y_m: prior.map_or(0.0, |p| p.y),
             mode_probabilities: output.mode_probabilities,
+            world_x_m: world_position.map_or(0.0, |p| p.x),
+            world_y_m: world_position.map_or(0.0, |p| p.y),
+            world_vx_mps: world_velocity.map_or(0.0, |v| v.x),
+            world_vy_mps: world_velocity.map_or(0.0, |v| v.y),
             gt_id: output.ground_truth_id.and_then(|id| i64::try_from(id).ok()).unwrap_or(-1),
             age_frames: output.age_frames,
             hits: output.hits,
@@ -171,7 +200,8 @@ impl WireTrack {
                 TrackStatus::Confirmed => 1,
             },
             prior_valid: u8::from(prior.is_some()),
-            _pad0: [0; 5],
+            world_valid: u8::from(world_position.is_some()),
+            _pad0: [0; 4],
         }
     }
 
@@ -180,13 +210,23 @@ impl WireTrack {
         (self.prior_valid != 0).then_some([self.prior_x_m, self.prior_y_m])
     }
 
+    /// The world-frame position and velocity `[x, y, vx, vy]`, when valid.
+    pub fn world(&self) -> Option<[f64; 4]> {
+        (self.world_valid != 0).then_some([
+            self.world_x_m,
+            self.world_y_m,
+            self.world_vx_mps,
+            self.world_vy_mps,
+        ])
+    }
+
     /// The measurement index, `None` when the track coasted.
     pub fn measurement_index(&self) -> Option<usize> {
         usize::try_from(self.measurement_index).ok()
     }
 }
 
-/// The tracker's output for one input frame: 77 888 bytes, alignment 8.
+/// The tracker's output for one input frame: 94 272 bytes, alignment 8.
 #[repr(C)]
 #[derive(Debug, ZeroCopySend)]
 #[type_name("primm::TrackFrame")]
@@ -213,8 +253,10 @@ pub struct TrackFrame {
     pub measurements_accepted: u16,
     /// Measurements of the input frame rejected by validation (unknown class, NaN, out of range).
     pub measurements_rejected: u16,
+    /// [`WIRE_VERSION`](crate::WIRE_VERSION) of the writer.
+    pub wire_version: u16,
     /// Explicit padding, written as zero.
-    pub _pad0: [u8; 6],
+    pub _pad0: [u8; 4],
     /// Every live track after the frame; entries at `count` and beyond are unused.
     pub tracks: [WireTrack; TRACK_CAPACITY],
 }
@@ -331,7 +373,8 @@ impl<'a> TrackFrameWriter<'a> {
             addr_of_mut!((*frame).flags).write(header.flags);
             addr_of_mut!((*frame).measurements_accepted).write(header.measurements_accepted);
             addr_of_mut!((*frame).measurements_rejected).write(header.measurements_rejected);
-            addr_of_mut!((*frame)._pad0).write([0; 6]);
+            addr_of_mut!((*frame).wire_version).write(crate::WIRE_VERSION);
+            addr_of_mut!((*frame)._pad0).write([0; 4]);
         }
         self.count
     }

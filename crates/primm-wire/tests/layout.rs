@@ -4,7 +4,9 @@
 //! every field is checked to start exactly where the one before it ends, so that no type has
 //! padding the compiler inserted (every gap is a named `_pad` field instead).
 
-use primm_wire::{LatencyReport, MeasurementFrame, StageLatency, TrackFrame, WireMeasurement, WireTrack};
+use primm_wire::{
+    LatencyReport, MeasurementFrame, StageLatency, TrackFrame, WireMeasurement, WireTrack, WIRE_VERSION,
+};
 use std::collections::BTreeSet;
 use std::mem::{align_of, offset_of, size_of};
 use std::path::Path;
@@ -93,6 +95,10 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 prior_x_m,
                 prior_y_m,
                 mode_probabilities,
+                world_x_m,
+                world_y_m,
+                world_vx_mps,
+                world_vy_mps,
                 gt_id,
                 age_frames,
                 hits,
@@ -101,6 +107,7 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 class_code,
                 status,
                 prior_valid,
+                world_valid,
                 _pad0
             ]
         ),
@@ -119,6 +126,7 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 flags,
                 measurements_accepted,
                 measurements_rejected,
+                wire_version,
                 _pad0,
                 tracks
             ]
@@ -151,6 +159,7 @@ fn rust_layouts() -> Vec<TypeLayout> {
 /// `Type size N align A` and `Type.field offset` lines, sorted.
 fn rust_lines() -> BTreeSet<String> {
     let mut lines = BTreeSet::new();
+    lines.insert(format!("version {WIRE_VERSION}"));
     for layout in rust_layouts() {
         lines.insert(format!("{} size {} align {}", layout.name, layout.size, layout.align));
         for (field, offset, _) in &layout.fields {
@@ -202,8 +211,8 @@ fn the_rust_types_have_no_implicit_padding() {
     }
     assert_eq!(size_of::<WireMeasurement>(), 64);
     assert_eq!(size_of::<MeasurementFrame>(), 16_448);
-    assert_eq!(size_of::<WireTrack>(), 152);
-    assert_eq!(size_of::<TrackFrame>(), 77_888);
+    assert_eq!(size_of::<WireTrack>(), 184);
+    assert_eq!(size_of::<TrackFrame>(), 94_272);
     assert_eq!(size_of::<LatencyReport>(), 1032);
 }
 
@@ -242,7 +251,7 @@ fn the_c_header_matches_the_rust_layout() {
     let dir = std::env::temp_dir().join(format!("primm-wire-layout-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut source = String::from(
-        "#include <stdio.h>\n#include <stddef.h>\n#include \"primm_wire.h\"\nint main(void) {\n",
+        "#include <stdio.h>\n#include <stddef.h>\n#include \"primm_wire.h\"\nint main(void) {\n    printf(\"version %d\\n\", PRIMM_WIRE_VERSION);\n",
     );
     for layout in rust_layouts() {
         source += &format!(

@@ -3,6 +3,7 @@
 use super::{initiate_position_velocity, InitialVelocity, MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
+use glam::DVec2;
 use nalgebra::{Matrix2, Matrix6};
 
 /// Named indices of the state `[x, y, vx, vy, ax, ay]`.
@@ -79,9 +80,13 @@ impl ConstantAcceleration {
 }
 
 impl MotionModel<6> for ConstantAcceleration {
-    fn initiate(&self, measurement: &Measurement) -> Gaussian<6> {
-        let mut gaussian =
-            initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
+    fn initiate_seen_from(&self, measurement: &Measurement, sensor_position_m: DVec2) -> Gaussian<6> {
+        let mut gaussian = initiate_position_velocity(
+            measurement,
+            sensor_position_m,
+            &self.measurement_noise_m2,
+            &self.initial_velocity,
+        );
         let acceleration_variance = crate::math::square(self.initial_acceleration_std_mps2);
         gaussian.covariance[(index::AX, index::AX)] = acceleration_variance;
         gaussian.covariance[(index::AY, index::AY)] = acceleration_variance;

@@ -3,6 +3,7 @@
 use super::{initiate_position_velocity, InitialVelocity, MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
+use glam::DVec2;
 use nalgebra::{Matrix2, Matrix4};
 
 /// Named indices of the state `[x, y, vx, vy]`.
@@ -54,8 +55,13 @@ impl ConstantVelocity {
 }
 
 impl MotionModel<4> for ConstantVelocity {
-    fn initiate(&self, measurement: &Measurement) -> Gaussian<4> {
-        initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity)
+    fn initiate_seen_from(&self, measurement: &Measurement, sensor_position_m: DVec2) -> Gaussian<4> {
+        initiate_position_velocity(
+            measurement,
+            sensor_position_m,
+            &self.measurement_noise_m2,
+            &self.initial_velocity,
+        )
     }
 
     fn predict(&self, posterior: &Gaussian<4>, context: &PredictContext) -> Gaussian<4> {

@@ -14,6 +14,7 @@ use super::{
 };
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
+use glam::DVec2;
 use nalgebra::{Matrix2, SMatrix, SVector};
 
 /// 5×5 matrix.
@@ -221,9 +222,13 @@ impl CoordinatedTurn {
 }
 
 impl MotionModel<5> for CoordinatedTurn {
-    fn initiate(&self, measurement: &Measurement) -> Gaussian<5> {
-        let mut gaussian =
-            initiate_position_velocity(measurement, &self.measurement_noise_m2, &self.initial_velocity);
+    fn initiate_seen_from(&self, measurement: &Measurement, sensor_position_m: DVec2) -> Gaussian<5> {
+        let mut gaussian = initiate_position_velocity(
+            measurement,
+            sensor_position_m,
+            &self.measurement_noise_m2,
+            &self.initial_velocity,
+        );
         gaussian.covariance[(index::OMEGA, index::OMEGA)] =
             crate::math::square(self.initial_turn_rate_std_radps);
         gaussian

@@ -9,6 +9,7 @@
 use super::{MotionModel, PredictContext};
 use crate::gaussian::Gaussian;
 use crate::measurement::Measurement;
+use glam::DVec2;
 use nalgebra::{Matrix2, Vector2};
 
 /// Named indices of the state `[x, y]`.
@@ -33,7 +34,7 @@ impl LearnedDisplacement {
 }
 
 impl MotionModel<2> for LearnedDisplacement {
-    fn initiate(&self, measurement: &Measurement) -> Gaussian<2> {
+    fn initiate_seen_from(&self, measurement: &Measurement, _sensor_position_m: DVec2) -> Gaussian<2> {
         Gaussian::new(Vector2::new(measurement.x_m, measurement.y_m), self.measurement_noise_m2)
     }
 

@@ -54,8 +54,14 @@ pub struct PredictContext {
 
 /// A stateless motion model of state size `N` (position first).
 pub trait MotionModel<const N: usize> {
-    /// The state of a new track from its first measurement.
-    fn initiate(&self, measurement: &Measurement) -> Gaussian<N>;
+    /// The state of a new track from its first measurement, seen by a radar at
+    /// `sensor_position_m` (in the frame of the measurement's position): the origin of the line
+    /// of sight along which the radial velocity was measured.
+    fn initiate_seen_from(&self, measurement: &Measurement, sensor_position_m: DVec2) -> Gaussian<N>;
+    /// [`initiate_seen_from`](Self::initiate_seen_from) a radar at the frame's origin.
+    fn initiate(&self, measurement: &Measurement) -> Gaussian<N> {
+        self.initiate_seen_from(measurement, DVec2::ZERO)
+    }
     /// The prior after `context.dt_s` (`eq:kf_state_pred`, `eq:kf_cov_pred`).
     fn predict(&self, posterior: &Gaussian<N>, context: &PredictContext) -> Gaussian<N>;
     /// [`predict`](Self::predict) in place: turns a posterior into the prior. Linear models
@@ -119,7 +125,7 @@ impl ModeModels {
 /// "initialised from the measured radial velocity").
 ///
 /// The radial velocity measures the velocity component along the line of sight, so the initial
-/// velocity is `v_r·û` with `û` the unit vector from the vehicle origin to the measurement; its
+/// velocity is `v_r·û` with `û` the unit vector from the sensor to the measurement; its
 /// covariance is `σ_r²ûûᵀ + σ_t²ŵŵᵀ` with `ŵ ⟂ û`: tight along the line of sight, wide across it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InitialVelocity {
@@ -130,9 +136,15 @@ pub struct InitialVelocity {
 }
 
 impl InitialVelocity {
-    /// Mean and covariance of the initial velocity for `measurement`.
-    pub fn estimate(&self, measurement: &Measurement) -> (Vector2<f64>, Matrix2<f64>) {
-        let position = Vector2::new(measurement.x_m, measurement.y_m);
+    /// Mean and covariance of the initial velocity for `measurement` seen by a radar at
+    /// `sensor_position_m` (same frame as the measurement).
+    pub fn estimate(
+        &self,
+        measurement: &Measurement,
+        sensor_position_m: DVec2,
+    ) -> (Vector2<f64>, Matrix2<f64>) {
+        let position =
+            Vector2::new(measurement.x_m - sensor_position_m.x, measurement.y_m - sensor_position_m.y);
         let range = position.norm();
         let along = if range > 1e-6 { position / range } else { Vector2::new(1.0, 0.0) };
         let across = Vector2::new(-along.y, along.x);
@@ -148,10 +160,11 @@ impl InitialVelocity {
 /// element zero.
 pub(crate) fn initiate_position_velocity<const N: usize>(
     measurement: &Measurement,
+    sensor_position_m: DVec2,
     measurement_noise_m2: &Matrix2<f64>,
     initial_velocity: &InitialVelocity,
 ) -> Gaussian<N> {
-    let (velocity, velocity_covariance) = initial_velocity.estimate(measurement);
+    let (velocity, velocity_covariance) = initial_velocity.estimate(measurement, sensor_position_m);
     let mut gaussian: Gaussian<N> = Gaussian::new(nalgebra::SVector::zeros(), nalgebra::SMatrix::zeros());
     gaussian.mean[X] = measurement.x_m;
     gaussian.mean[Y] = measurement.y_m;

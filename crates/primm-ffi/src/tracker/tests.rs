@@ -154,7 +154,7 @@ fn tracks_copied_out_are_the_core_trackers_outputs_field_for_field() {
 
 #[test]
 fn an_invalid_toml_value_gives_invalid_config_with_a_message_naming_the_key() {
-    let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 6.0", "gate_m = -1.0");
+    let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 8.4", "gate_m = -1.0");
     let text = CString::new(text).unwrap();
     let options = PrimmTrackerOptions { config_toml: text.as_ptr(), ..imm_options() };
     let (status, message) = create(&options).unwrap_err();

@@ -12,6 +12,8 @@
 //!   ([`interaction`]) and the seeded measurement removal for its missed-detection rows
 //!   ([`dropout`]),
 //! * mean IMM mode probabilities ([`modes`]),
+//! * the ego vehicle's motion (straight or turning) of each frame, for Tables II and IV split
+//!   by it ([`ego_motion`]),
 //!
 //! and assembles them into plain-text tables and JSON ([`report`]) and SVG figures ([`plots`]).
 //! The exact definitions, thresholds and units are documented in `docs/evaluation-metrics.md`.
@@ -19,6 +21,7 @@
 //! Nothing here is on the tracker's real-time path; clarity wins over speed.
 
 pub mod dropout;
+pub mod ego_motion;
 pub mod identity;
 pub mod interaction;
 pub mod modes;

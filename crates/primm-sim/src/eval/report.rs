@@ -18,9 +18,11 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use primm_core::measurement::ObjectClass;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
 
+use super::ego_motion::EgoMotion;
 use super::identity::{identity_counts, identity_counts_subset, IdentityCounts};
 use super::interaction::{interaction_flags, InteractionRules};
 use super::modes::{ModeProbabilityAccumulator, MODE_NAMES};
@@ -54,6 +56,15 @@ pub struct MethodResult {
     pub missed_detection: BTreeMap<u32, IdentityCounts>,
     /// Posterior mode probabilities of all updates.
     pub modes: ModeProbabilityAccumulator,
+    /// Prior RMSE per object class.
+    #[serde(default)]
+    pub class_rmse: BTreeMap<ObjectClass, RmseAccumulator>,
+    /// Prior RMSE per ego motion (sequences with ego poses only).
+    #[serde(default)]
+    pub ego_rmse: BTreeMap<EgoMotion, RmseAccumulator>,
+    /// Identity counts per ego motion (sequences with ego poses only).
+    #[serde(default)]
+    pub ego_identity: BTreeMap<EgoMotion, IdentityCounts>,
 }
 
 impl MethodResult {
@@ -70,6 +81,9 @@ impl MethodResult {
             crossing: IdentityCounts::default(),
             missed_detection: BTreeMap::new(),
             modes: ModeProbabilityAccumulator::new(),
+            class_rmse: BTreeMap::new(),
+            ego_rmse: BTreeMap::new(),
+            ego_identity: BTreeMap::new(),
         }
     }
 
@@ -94,6 +108,15 @@ impl MethodResult {
             self.missed_detection.entry(*percent).or_default().merge(counts);
         }
         self.modes.merge(&other.modes);
+        for (class, acc) in &other.class_rmse {
+            self.class_rmse.entry(*class).or_default().merge(acc);
+        }
+        for (motion, acc) in &other.ego_rmse {
+            self.ego_rmse.entry(*motion).or_default().merge(acc);
+        }
+        for (motion, counts) in &other.ego_identity {
+            self.ego_identity.entry(*motion).or_default().merge(counts);
+        }
     }
 
     /// RMSE accumulator of a motion scenario (empty if none was seen).
@@ -143,6 +166,7 @@ impl MethodEvaluator {
         let result = &mut self.result;
         for (record, label) in records.iter().zip(&labels) {
             result.rmse.push_record(record);
+            result.class_rmse.entry(record.class).or_default().push_record(record);
             result.modes.push_record(record);
             if let Some(label) = label {
                 let category = label.category();
@@ -156,6 +180,26 @@ impl MethodEvaluator {
         let crossing: Vec<bool> = flags.iter().map(|flag| flag.crossing).collect();
         result.crossing.merge(&identity_counts_subset(records, &crossing));
         result.sequences += 1;
+    }
+
+    /// Adds the rows of one nominal sequence (as given to [`add_sequence`](Self::add_sequence))
+    /// to the per-ego-motion results, with each row's ego motion (`None`: unknown, not counted).
+    pub fn add_ego_motion(&mut self, records: &[AssociationRecord], labels: &[Option<EgoMotion>]) {
+        for motion in EgoMotion::ALL {
+            let selected: Vec<bool> = labels.iter().map(|label| *label == Some(motion)).collect();
+            if !selected.contains(&true) {
+                continue;
+            }
+            let acc = self.result.ego_rmse.entry(motion).or_default();
+            for (record, _) in records.iter().zip(&selected).filter(|(_, &s)| s) {
+                acc.push_record(record);
+            }
+            self.result
+                .ego_identity
+                .entry(motion)
+                .or_default()
+                .merge(&identity_counts_subset(records, &selected));
+        }
     }
 
     /// Adds the rows of one sequence re-run with `drop_percent` % of its measurements removed
@@ -261,6 +305,38 @@ impl EvaluationReport {
             .collect::<Vec<_>>();
         let mut text = render_table("Table II. One-step prior prediction RMSE", &header, &rows);
         self.append_notes(&mut text, "* lowest value in its column");
+        text
+    }
+
+    /// Table II by object class: RMSE_xy per class (rows) and method (columns), for the classes
+    /// with rows.
+    pub fn table_class_rmse(&self) -> String {
+        let mut header = vec!["Class (prior samples)".to_string()];
+        header.extend(Method::ALL.iter().map(|m| m.label().to_string()));
+        let classes: Vec<ObjectClass> = ObjectClass::ALL
+            .into_iter()
+            .filter(|class| {
+                Method::ALL.iter().any(|m| self.result(*m).is_some_and(|r| r.class_rmse.contains_key(class)))
+            })
+            .collect();
+        let rows = classes
+            .iter()
+            .map(|class| {
+                let values: Vec<Option<f64>> = Method::ALL
+                    .iter()
+                    .map(|m| {
+                        self.result(*m).and_then(|r| r.class_rmse.get(class)).and_then(|acc| acc.rmse_xy())
+                    })
+                    .collect();
+                let count = self.common_count(|r| r.class_rmse.get(class).map_or(0, |acc| acc.count()));
+                let mut line = vec![format!("{} ({count})", class.name())];
+                line.extend(mark_best(&values, Better::Lower, 3).iter().map(Cell::to_string));
+                line
+            })
+            .collect::<Vec<_>>();
+        let mut text =
+            render_table("Table II by class. One-step prior prediction RMSE_xy [m]", &header, &rows);
+        self.append_notes(&mut text, "* lowest value in its row");
         text
     }
 
@@ -380,15 +456,64 @@ impl EvaluationReport {
         text
     }
 
-    /// All tables, separated by blank lines.
+    /// Tables II and IV split by ego motion: RMSE_xy, IDSW and IDF1 per ego state (rows) and
+    /// method (columns). Empty when no method has rows with a known ego motion.
+    pub fn table_ego_motion(&self) -> String {
+        let present = |motion: EgoMotion| {
+            Method::ALL.iter().any(|m| self.result(*m).is_some_and(|r| r.ego_identity.contains_key(&motion)))
+        };
+        if !EgoMotion::ALL.into_iter().any(present) {
+            return String::new();
+        }
+        let mut header = vec!["Ego motion (GT object frames)".to_string(), "Metric".to_string()];
+        header.extend(Method::ALL.iter().map(|m| m.label().to_string()));
+        let mut rows = Vec::new();
+        for motion in EgoMotion::ALL.into_iter().filter(|motion| present(*motion)) {
+            let results: Vec<Option<&MethodResult>> = Method::ALL.iter().map(|m| self.result(*m)).collect();
+            let rmse: Vec<Option<f64>> = results
+                .iter()
+                .map(|r| r.and_then(|r| r.ego_rmse.get(&motion)).and_then(|acc| acc.rmse_xy()))
+                .collect();
+            let counts: Vec<Option<IdentityCounts>> =
+                results.iter().map(|r| r.and_then(|r| r.ego_identity.get(&motion).copied())).collect();
+            let frames: Vec<u64> = counts.iter().flatten().map(|c| c.gt_object_frames).collect();
+            let idsw: Vec<Option<f64>> = counts.iter().map(|c| c.map(|c| c.idsw as f64)).collect();
+            let idf1: Vec<Option<f64>> = counts.iter().map(|c| c.and_then(|c| c.idf1())).collect();
+            let mut line =
+                vec![format!("{} ({})", motion.label(), count_text(&frames)), "RMSE_xy".to_string()];
+            line.extend(mark_best(&rmse, Better::Lower, 3).iter().map(Cell::to_string));
+            rows.push(line);
+            let mut line = vec![String::new(), "IDSW".to_string()];
+            line.extend(mark_best(&idsw, Better::Lower, 0).iter().map(Cell::to_string));
+            rows.push(line);
+            let mut line = vec![String::new(), "IDF1".to_string()];
+            line.extend(mark_best(&idf1, Better::Higher, 4).iter().map(Cell::to_string));
+            rows.push(line);
+        }
+        let mut text = render_table_aligned(
+            "Table VI. Prior RMSE and identity by ego motion (|yaw rate| above 0.1 rad/s: turning)",
+            &header,
+            &rows,
+            2,
+        );
+        self.append_notes(&mut text, "* best value in its row");
+        text
+    }
+
+    /// All tables, separated by blank lines (Table VI only with ego poses).
     pub fn to_text(&self) -> String {
         [
             self.table_prior_rmse(),
+            self.table_class_rmse(),
             self.table_scenario_rmse(),
             self.table_overall_mot(),
             self.table_scenario_mot(),
+            self.table_ego_motion(),
             self.mode_probability_table(),
         ]
+        .into_iter()
+        .filter(|table| !table.is_empty())
+        .collect::<Vec<_>>()
         .join("\n")
     }
 
@@ -458,6 +583,24 @@ impl EvaluationReport {
         }
         for (percent, counts) in &result.missed_detection {
             scenarios.insert(format!("miss_{percent}"), identity_json(counts));
+        }
+        for (class, acc) in &result.class_rmse {
+            scenarios.insert(
+                format!("class_{}", class.name()),
+                json!({ "rmse_xy": acc.rmse_xy(), "rmse_samples": acc.count() }),
+            );
+        }
+        for (motion, counts) in &result.ego_identity {
+            let key = match motion {
+                EgoMotion::Straight => "ego_straight",
+                EgoMotion::Turning => "ego_turning",
+            };
+            let mut value = identity_json(counts);
+            if let (Some(object), Some(acc)) = (value.as_object_mut(), result.ego_rmse.get(motion)) {
+                object.insert("rmse_xy".into(), json!(acc.rmse_xy()));
+                object.insert("rmse_samples".into(), json!(acc.count()));
+            }
+            scenarios.insert(key.to_string(), value);
         }
         json!({
             "available": true,

@@ -7,38 +7,8 @@ use crate::eval::record::AssociationRecord;
 use primm_core::measurement::{Frame, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 
 /// Pose of the ego vehicle's reference point (centre of the rear axle, as in RadarScenes) in a
-/// fixed world frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct EgoPose {
-    /// World x of the reference point, metres.
-    pub x_m: f64,
-    /// World y of the reference point, metres.
-    pub y_m: f64,
-    /// Heading of the vehicle's x axis, radians, counter-clockwise from the world x axis.
-    pub yaw_rad: f64,
-}
-
-impl EgoPose {
-    /// The reference point as a vector, metres.
-    pub fn position(&self) -> DVec2 {
-        DVec2::new(self.x_m, self.y_m)
-    }
-
-    /// Maps a point from the car frame (x forward, y left) into the world frame.
-    pub fn car_to_world(&self, point_car: DVec2) -> DVec2 {
-        self.position() + DVec2::from_angle(self.yaw_rad).rotate(point_car)
-    }
-
-    /// Maps a point from the world frame into the car frame.
-    pub fn world_to_car(&self, point_world: DVec2) -> DVec2 {
-        DVec2::from_angle(-self.yaw_rad).rotate(point_world - self.position())
-    }
-
-    /// Rotates a world-frame direction or velocity into the car frame (no translation).
-    pub fn rotate_to_car(&self, vector_world: DVec2) -> DVec2 {
-        DVec2::from_angle(-self.yaw_rad).rotate(vector_world)
-    }
-}
+/// fixed world frame (defined in primm-core, which transforms measurements with it).
+pub use primm_core::pose::EgoPose;
 
 /// One object-level measurement of a recorded frame, with its true position where known.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -99,13 +69,14 @@ impl RecordedFrame {
     }
 
     /// Converts into the library's fixed-capacity [`Frame`]. Ground-truth ids, classes and
-    /// sensor ids are carried through unchanged; true positions are dropped.
+    /// sensor ids and the ego pose are carried through unchanged; true positions are dropped.
     pub fn to_frame(&self) -> Result<Frame, TooManyMeasurements> {
         if self.measurements.len() > MAX_MEASUREMENTS_PER_FRAME {
             return Err(TooManyMeasurements { frame: self.index, count: self.measurements.len() });
         }
         let mut frame = Frame::new(self.timestamp_s);
         frame.measurements.extend(self.measurements.iter().map(|m| m.measurement));
+        frame.ego_pose = self.ego_pose;
         Ok(frame)
     }
 
@@ -125,6 +96,11 @@ pub struct Sequence {
 }
 
 impl Sequence {
+    /// Whether any frame carries an ego pose.
+    pub fn has_ego_pose(&self) -> bool {
+        self.frames.iter().any(|frame| frame.ego_pose.is_some())
+    }
+
     /// An empty sequence called `name`.
     pub fn new(name: impl Into<String>) -> Self {
         Self { name: name.into(), frames: Vec::new() }

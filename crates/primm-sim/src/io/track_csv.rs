@@ -5,12 +5,22 @@
 //! `prior_*` the fused one-step prior before the update (m; empty for a track started in that
 //! frame), `gt_id` the ground-truth id of the measurement (-1 when unknown), `mu_*` the posterior
 //! mode probabilities (0 for modes the method does not use).
+//!
+//! A file of frames tracked in the world frame (they carried an ego pose) adds the columns
+//! `world_x,world_y,world_vx,world_vy`: the fused position (m) and velocity over ground (m/s) in
+//! the world frame, empty in a row of a frame tracked in the vehicle frame. `x`, `y` and the
+//! prior stay in the vehicle frame of their frame, so every scorer reads both kinds of file.
 
+use super::recording::Sequence;
+use primm_core::config::TrackingFrame;
 use primm_core::track::TrackOutput;
 use std::io::Write;
 
 /// The header line.
 pub const TRACK_CSV_HEADER: &str = "frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct";
+
+/// The columns a file with world-frame estimates adds to [`TRACK_CSV_HEADER`].
+pub const WORLD_COLUMNS: &str = "world_x,world_y,world_vx,world_vy";
 
 /// One row of the track file.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,6 +41,9 @@ pub struct TrackRow<'a> {
     pub ground_truth_id: Option<u64>,
     /// Mode probabilities, order PR, CV, CA, CT.
     pub mode_probabilities: [f64; 4],
+    /// World-frame position (m) and velocity (m/s), `[x, y, vx, vy]`, when the frame was
+    /// tracked in the world frame.
+    pub world: Option<[f64; 4]>,
 }
 
 /// Writes track rows. Floats are written in the shortest form that reads back exactly.
@@ -38,13 +51,30 @@ pub struct TrackRow<'a> {
 pub struct TrackCsvWriter<W: Write> {
     out: W,
     rows: u64,
+    world_columns: bool,
 }
 
 impl<W: Write> TrackCsvWriter<W> {
     /// A writer that starts with the header.
     pub fn new(mut out: W) -> std::io::Result<Self> {
         writeln!(out, "{TRACK_CSV_HEADER}")?;
-        Ok(Self { out, rows: 0 })
+        Ok(Self { out, rows: 0, world_columns: false })
+    }
+
+    /// The writer for a file tracked with `tracking_frame` from `sequence`: with the world-frame
+    /// columns when the tracker keeps world-frame tracks and the sequence carries ego poses.
+    pub fn for_sequence(out: W, sequence: &Sequence, tracking_frame: TrackingFrame) -> std::io::Result<Self> {
+        if tracking_frame == TrackingFrame::World && sequence.has_ego_pose() {
+            Self::with_world_columns(out)
+        } else {
+            Self::new(out)
+        }
+    }
+
+    /// A writer whose header and rows have the world-frame columns [`WORLD_COLUMNS`].
+    pub fn with_world_columns(mut out: W) -> std::io::Result<Self> {
+        writeln!(out, "{TRACK_CSV_HEADER},{WORLD_COLUMNS}")?;
+        Ok(Self { out, rows: 0, world_columns: true })
     }
 
     /// Writes the rows of one frame (tracks updated by a measurement only).
@@ -71,6 +101,10 @@ impl<W: Write> TrackCsvWriter<W> {
             prior_position_m: output.prior_position_m.map(|p| [p.x, p.y]),
             ground_truth_id: output.ground_truth_id,
             mode_probabilities: output.mode_probabilities,
+            world: output
+                .world_position_m
+                .zip(output.world_velocity_mps)
+                .map(|(position, velocity)| [position.x, position.y, velocity.x, velocity.y]),
         })
     }
 
@@ -83,11 +117,16 @@ impl<W: Write> TrackCsvWriter<W> {
         let gt = row.ground_truth_id.map_or(-1, |id| id as i64);
         let [mu_pr, mu_cv, mu_ca, mu_ct] = row.mode_probabilities;
         let [x, y] = row.position_m;
-        writeln!(
+        write!(
             self.out,
             "{},{},{},{},{x},{y},{prior_x},{prior_y},{gt},{mu_pr},{mu_cv},{mu_ca},{mu_ct}",
             row.frame, row.timestamp_s, row.track_id, row.class
         )?;
+        match (self.world_columns, row.world) {
+            (false, _) => writeln!(self.out)?,
+            (true, Some([x, y, vx, vy])) => writeln!(self.out, ",{x},{y},{vx},{vy}")?,
+            (true, None) => writeln!(self.out, ",,,,")?,
+        }
         self.rows += 1;
         Ok(())
     }

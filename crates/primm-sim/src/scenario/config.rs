@@ -174,6 +174,12 @@ pub struct EgoConfig {
     /// recording, had it driven the warm-up at its initial speed (the start position is chosen
     /// accordingly and kept within its block), metres.
     pub start_distance_to_junction_m: Interval,
+    /// Probability that the ego vehicle turns left at a junction; absent: the cars'
+    /// `car.turn_left_probability`.
+    pub turn_left_probability: Option<f64>,
+    /// Probability that the ego vehicle turns right at a junction; absent: the cars'
+    /// `car.turn_right_probability`.
+    pub turn_right_probability: Option<f64>,
 }
 
 /// Cars: sizes, physical limits and driving behaviour.
@@ -442,6 +448,8 @@ impl Default for EgoConfig {
             desired_speed_mps: [8.0, 13.0],
             initial_standstill_probability: 0.15,
             start_distance_to_junction_m: [20.0, 80.0],
+            turn_left_probability: None,
+            turn_right_probability: None,
         }
     }
 }
@@ -596,17 +604,21 @@ pub enum Preset {
     /// A harder configuration for robustness checks: faster and more aggressive cars, more
     /// erratic and faster pedestrians, denser traffic, noisier sensors with more misses.
     Robustness,
+    /// The default scene seen from an ego vehicle that turns at most junctions of a denser
+    /// road grid, at town speeds: ego yaw rates up to about 0.5 rad/s.
+    Turning,
 }
 
 impl Preset {
     /// All presets.
-    pub const ALL: [Preset; 2] = [Preset::Default, Preset::Robustness];
+    pub const ALL: [Preset; 3] = [Preset::Default, Preset::Robustness, Preset::Turning];
 
     /// The preset's name (`default`, `robustness`).
     pub fn name(self) -> &'static str {
         match self {
             Preset::Default => "default",
             Preset::Robustness => "robustness",
+            Preset::Turning => "turning",
         }
     }
 
@@ -620,6 +632,7 @@ impl Preset {
         match self {
             Preset::Default => ScenarioConfig::default(),
             Preset::Robustness => ScenarioConfig::robustness(),
+            Preset::Turning => ScenarioConfig::turning(),
         }
     }
 }
@@ -633,11 +646,24 @@ impl std::fmt::Display for Preset {
 impl std::str::FromStr for Preset {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::from_name(s).ok_or_else(|| format!("unknown preset `{s}` (expected `default` or `robustness`)"))
+        Self::from_name(s)
+            .ok_or_else(|| format!("unknown preset `{s}` (expected `default`, `robustness` or `turning`)"))
     }
 }
 
 impl ScenarioConfig {
+    /// The ego-turning preset: see [`Preset::Turning`].
+    pub fn turning() -> Self {
+        let mut config = Self::default();
+        config.splits.seed_base = 0x5455_524e_494e;
+        config.road.block_length_m = 90.0;
+        config.ego.desired_speed_mps = [6.0, 10.0];
+        config.ego.start_distance_to_junction_m = [15.0, 40.0];
+        config.ego.turn_left_probability = Some(0.45);
+        config.ego.turn_right_probability = Some(0.45);
+        config
+    }
+
     /// The robustness preset: see [`Preset::Robustness`].
     pub fn robustness() -> Self {
         let mut config = Self::default();
@@ -885,6 +911,16 @@ impl ScenarioConfig {
             return Err(ConfigError::new("ego.desired_speed_mps", "must not exceed car.max_speed_mps"));
         }
         probability("ego.initial_standstill_probability", e.initial_standstill_probability)?;
+        let left = e.turn_left_probability.unwrap_or(0.0);
+        let right = e.turn_right_probability.unwrap_or(0.0);
+        probability("ego.turn_left_probability", left)?;
+        probability("ego.turn_right_probability", right)?;
+        if left + right > 1.0 {
+            return Err(ConfigError::new(
+                "ego.turn_left_probability",
+                "plus ego.turn_right_probability must not exceed 1",
+            ));
+        }
         interval("ego.start_distance_to_junction_m", e.start_distance_to_junction_m, false)?;
         Ok(())
     }

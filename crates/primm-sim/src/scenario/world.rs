@@ -421,7 +421,7 @@ impl<'c> World<'c> {
                     agent.path.marks.pop_front();
                 }
                 while agent.path.end_s() - agent.s < CAR_PLAN_AHEAD_M {
-                    plan_car(&self.grid, cfg, &mut self.rng, brain, &mut agent.path);
+                    plan_car(&self.grid, cfg, &mut self.rng, brain, &mut agent.path, agent.is_ego);
                 }
                 agent.path.prune(agent.s, 20.0);
             }
@@ -517,7 +517,7 @@ impl<'c> World<'c> {
         };
         if let Brain::Car(brain) = &mut agent.brain {
             while agent.path.end_s() < CAR_PLAN_AHEAD_M {
-                plan_car(&self.grid, cfg, &mut self.rng, brain, &mut agent.path);
+                plan_car(&self.grid, cfg, &mut self.rng, brain, &mut agent.path, true);
             }
         }
         agent.kin.speed = feasible_start_speed(cfg, &agent.path, agent.kin.speed);
@@ -620,7 +620,7 @@ impl<'c> World<'c> {
         };
         let mut path = Path::default();
         while path.end_s() < CAR_PLAN_AHEAD_M {
-            plan_car(&self.grid, cfg, &mut self.rng, &mut brain, &mut path);
+            plan_car(&self.grid, cfg, &mut self.rng, &mut brain, &mut path, false);
         }
         let speed = feasible_start_speed(cfg, &path, speed);
         let id = self.next_id;
@@ -758,20 +758,29 @@ impl<'c> World<'c> {
 // Route planning
 
 /// Appends the route up to and through the next junction: an optional lane change, the
-/// approach with its stop line, and the manoeuvre (straight on, right or left turn).
+/// approach with its stop line, and the manoeuvre (straight on, right or left turn); the ego
+/// vehicle turns with its own probabilities where configured.
 fn plan_car(
     grid: &RoadGrid,
     cfg: &ScenarioConfig,
     rng: &mut ChaCha12Rng,
     brain: &mut CarBrain,
     path: &mut Path,
+    is_ego: bool,
 ) {
     let cursor = brain.cursor;
     let d = cursor.dir;
     let junction = junction_ahead(grid, &cursor);
     let lane_change_m = (cfg.car.lane_change_duration_s * brain.desired_speed.max(5.0)).clamp(15.0, 60.0);
+    let mut turn = [cfg.car.turn_left_probability, cfg.car.turn_right_probability];
+    if is_ego {
+        turn = [
+            cfg.ego.turn_left_probability.unwrap_or(turn[0]),
+            cfg.ego.turn_right_probability.unwrap_or(turn[1]),
+        ];
+    }
     let (manoeuvre, target_lane) =
-        choose_manoeuvre(grid, &cfg.car, rng, &cursor, junction.distance_m, lane_change_m);
+        choose_manoeuvre(grid, &cfg.car, turn, rng, &cursor, junction.distance_m, lane_change_m);
     let current = push_lane_change(grid, path, &cursor, target_lane, lane_change_m);
     let stop_point = junction.centre - d * grid.stop_distance_m;
     let stop_ahead = (stop_point - cursor.pos).dot(d);
@@ -822,6 +831,7 @@ enum Manoeuvre {
 fn choose_manoeuvre(
     grid: &RoadGrid,
     c: &CarConfig,
+    [turn_left_probability, turn_right_probability]: [f64; 2],
     rng: &mut ChaCha12Rng,
     cursor: &LaneCursor,
     dist_j: f64,
@@ -834,9 +844,9 @@ fn choose_manoeuvre(
     let feasible = |entry: f64, lane: u32| entry >= if lane == cursor.lane { 1.0 } else { lane_change_room };
 
     let u: f64 = rng.random();
-    let mut manoeuvre = if u < c.turn_left_probability {
+    let mut manoeuvre = if u < turn_left_probability {
         Manoeuvre::Left
-    } else if u < c.turn_left_probability + c.turn_right_probability {
+    } else if u < turn_left_probability + turn_right_probability {
         Manoeuvre::Right
     } else {
         Manoeuvre::Straight

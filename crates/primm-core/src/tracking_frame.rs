@@ -1,0 +1,159 @@
+//! Which coordinate frame the tracker keeps its tracks in, and where the radars sit on the
+//! vehicle (the `frame` section of the configuration).
+//!
+//! Measurement positions arrive in the vehicle frame, which moves and turns with the ego
+//! vehicle, while their radial velocities are ego-motion compensated: they are radial
+//! velocities over ground. Tracking in the vehicle frame therefore starts a parked car ahead of
+//! a moving ego with the wrong velocity and sees stationary objects sweep arcs while the ego
+//! turns. When a frame carries the ego pose ([`FrameView::ego_pose`]) and the configuration
+//! asks for [`TrackingFrame::World`], the tracker maps every measurement into the world
+//! (odometry) frame with that pose and keeps its tracks there; the line of sight of a radial
+//! velocity then starts at the world position of the sensor that measured it.
+//!
+//! [`FrameView::ego_pose`]: crate::measurement::FrameView::ego_pose
+
+use crate::limits::MAX_SENSORS;
+use crate::measurement::{FrameView, Measurement, UnknownClass};
+use crate::pose::{EgoPose, RigidTransform, SensorMount};
+use arrayvec::ArrayVec;
+
+/// Largest distance of a sensor mount from the vehicle's reference point, m.
+pub const MAX_MOUNT_DISTANCE_M: f64 = 100.0;
+
+/// The coordinate frame of the tracks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum TrackingFrame {
+    /// The world (odometry) frame of the frames' ego poses; frames without a pose are tracked
+    /// in the vehicle frame (see the tracker's documentation for a stream that switches).
+    #[default]
+    World,
+    /// The vehicle frame of each frame, whatever the frames carry; line of sight from the
+    /// vehicle's reference point.
+    Vehicle,
+}
+
+impl TrackingFrame {
+    /// The short name used in configuration and output (`world`, `vehicle`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TrackingFrame::World => "world",
+            TrackingFrame::Vehicle => "vehicle",
+        }
+    }
+
+    /// Parses the short name; `None` for anything else.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [TrackingFrame::World, TrackingFrame::Vehicle].into_iter().find(|frame| frame.name() == name)
+    }
+}
+
+/// The `frame` section: the tracking frame and the sensors' mounting poses.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct FrameConfig {
+    /// The frame the tracks are kept in when frames carry an ego pose.
+    pub tracking_frame: TrackingFrame,
+    /// Mounting pose of every sensor, by sensor id. A measurement of a sensor not listed here
+    /// (or without a sensor id) is seen from the vehicle's reference point, and counted.
+    pub sensors: ArrayVec<SensorMount, MAX_SENSORS>,
+}
+
+impl Default for FrameConfig {
+    /// World frame; RadarScenes' four front and side radars (ids 1–4), as the scenario
+    /// generator mounts them.
+    fn default() -> Self {
+        let mount = |id, x_m, y_m, yaw_deg: f64| SensorMount { id, x_m, y_m, yaw_rad: yaw_deg.to_radians() };
+        let mut sensors = ArrayVec::new();
+        sensors.push(mount(1, 3.66, -0.87, -85.0));
+        sensors.push(mount(2, 3.86, -0.70, -25.0));
+        sensors.push(mount(3, 3.86, 0.70, 25.0));
+        sensors.push(mount(4, 3.66, 0.87, 85.0));
+        FrameConfig { tracking_frame: TrackingFrame::World, sensors }
+    }
+}
+
+impl FrameConfig {
+    /// The mount of sensor `id`, if configured.
+    pub fn sensor(&self, id: u16) -> Option<&SensorMount> {
+        self.sensors.iter().find(|mount| mount.id == id)
+    }
+
+    /// The first problem of the section, as (key, reason).
+    pub(crate) fn problem(&self) -> Option<(&'static str, &'static str)> {
+        for (index, mount) in self.sensors.iter().enumerate() {
+            if !(mount.x_m.is_finite() && mount.y_m.is_finite() && mount.yaw_rad.is_finite()) {
+                return Some(("frame.sensors", "every x_m, y_m and yaw_rad must be finite"));
+            }
+            if mount.x_m * mount.x_m + mount.y_m * mount.y_m > MAX_MOUNT_DISTANCE_M * MAX_MOUNT_DISTANCE_M {
+                return Some((
+                    "frame.sensors",
+                    "a sensor is mounted more than 100 m from the reference point",
+                ));
+            }
+            if self.sensors[..index].iter().any(|other| other.id == mount.id) {
+                return Some(("frame.sensors", "sensor ids must be unique"));
+            }
+        }
+        None
+    }
+}
+
+/// A frame whose measurement positions are read in the tracking frame: mapped by
+/// `vehicle_to_tracking` (the frame's vehicle-to-world transform), or as they are when `None`.
+/// Everything else is read through unchanged.
+pub(crate) struct InTrackingFrame<'a, F: FrameView + ?Sized> {
+    /// The frame as received.
+    pub frame: &'a F,
+    /// The map of positions into the tracking frame.
+    pub vehicle_to_tracking: Option<RigidTransform>,
+}
+
+impl<F: FrameView + ?Sized> FrameView for InTrackingFrame<'_, F> {
+    fn timestamp_s(&self) -> f64 {
+        self.frame.timestamp_s()
+    }
+    fn len(&self) -> usize {
+        self.frame.len()
+    }
+    fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
+        let mut measurement = self.frame.measurement(index)?;
+        if let Some(transform) = &self.vehicle_to_tracking {
+            let position = transform.apply_point(measurement.position());
+            measurement.x_m = position.x;
+            measurement.y_m = position.y;
+        }
+        Ok(measurement)
+    }
+    fn ego_pose(&self) -> Option<EgoPose> {
+        self.frame.ego_pose()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_mounts_are_valid_and_found_by_id() {
+        let config = FrameConfig::default();
+        assert_eq!(config.problem(), None);
+        assert_eq!(config.sensor(3).map(|mount| mount.y_m), Some(0.70));
+        assert_eq!(config.sensor(0), None);
+    }
+
+    #[test]
+    fn duplicate_ids_and_non_finite_mounts_are_problems() {
+        let mut config = FrameConfig::default();
+        config.sensors[1].id = 1;
+        assert_eq!(config.problem().map(|p| p.1), Some("sensor ids must be unique"));
+        let mut config = FrameConfig::default();
+        config.sensors[0].yaw_rad = f64::NAN;
+        assert!(config.problem().is_some());
+        let mut config = FrameConfig::default();
+        config.sensors[0].x_m = 1e3;
+        assert!(config.problem().is_some());
+    }
+}
