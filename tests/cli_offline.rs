@@ -41,12 +41,17 @@ fn track_writes_one_row_per_measurement_with_consistent_columns() {
     let sequence = primm_sim::io::read_sequence_file(&input).unwrap();
     let text = std::fs::read_to_string(&output).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some(primm_sim::io::track_csv::TRACK_CSV_HEADER));
+    // The generated sequence carries ego poses: tracked in the world frame, with its columns.
+    let header =
+        format!("{},{}", primm_sim::io::track_csv::TRACK_CSV_HEADER, primm_sim::io::track_csv::WORLD_COLUMNS);
+    assert_eq!(lines.next(), Some(header.as_str()));
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     // Every measurement updated or started exactly one track.
     assert_eq!(rows.len(), sequence.measurement_count());
     for row in &rows {
-        assert_eq!(row.len(), 13);
+        assert_eq!(row.len(), 17);
+        let world: Vec<f64> = row[13..17].iter().map(|v| v.parse::<f64>().unwrap()).collect();
+        assert!(world.iter().all(|v| v.is_finite()), "world columns {world:?}");
         let mu: f64 = row[9..13].iter().map(|v| v.parse::<f64>().unwrap()).sum();
         assert!((mu - 1.0).abs() < 1e-9, "mode probabilities sum to {mu}");
         assert_eq!(row[9], "0", "the IMM method has no PR mode");

@@ -1,6 +1,7 @@
 //! The shipped PR model is useful: on generated validation sequences (never seen in training),
 //! its one-step displacement is far closer to the truth than a constant-velocity extrapolation
-//! from the last two measurements, and closer than predicting no motion at all.
+//! from the last two measurements, and closer than predicting no motion at all. Positions are
+//! taken in the world frame (each frame's ego pose applied), where the tracker runs the model.
 
 use glam::DVec2;
 use primm_core::measurement::ObjectClass;
@@ -11,25 +12,27 @@ use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// One object's measurements in time order: (history entry, true centre).
+/// One object's measurements in time order: (history entry, true centre), in the world frame.
 fn objects(sequence: &Sequence) -> BTreeMap<u64, Vec<(HistoryEntry, DVec2, ObjectClass)>> {
     let mut objects: BTreeMap<u64, Vec<_>> = BTreeMap::new();
     for frame in &sequence.frames {
+        let pose = frame.ego_pose.expect("generated frames carry the ego pose");
         for recorded in &frame.measurements {
             let (Some(id), Some(truth)) = (recorded.measurement.ground_truth_id, recorded.true_position)
             else {
                 continue;
             };
             let m = &recorded.measurement;
+            let position = pose.car_to_world(m.position());
             objects.entry(id).or_default().push((
                 HistoryEntry {
-                    x_m: m.x_m,
-                    y_m: m.y_m,
+                    x_m: position.x,
+                    y_m: position.y,
                     radial_velocity_mps: m.radial_velocity_mps,
                     rcs_dbsm: m.rcs_dbsm,
                     timestamp_s: frame.timestamp_s,
                 },
-                truth,
+                pose.car_to_world(truth),
                 m.class,
             ));
         }

@@ -189,6 +189,17 @@ fn a_demo_killed_with_sigkill_leaves_no_processes_and_the_next_start_cleans_up()
             .unwrap(),
     );
     wait_until("the demo's processes come up", HANG_GUARD, || domain.processes() >= 3);
+    // Kill it once it is running, not while a process is still creating its services: a
+    // service a process dies in the middle of creating has no owner yet for the dead-node
+    // cleanup to find. Running: its shared-memory resources stop changing for a second.
+    let mut previous = domain.resources();
+    wait_until("the demo's resources settle", HANG_GUARD, || {
+        std::thread::sleep(Duration::from_secs(1));
+        let now = domain.resources();
+        let settled = now == previous && !now.is_empty();
+        previous = now;
+        settled
+    });
     demo.signal(libc::SIGKILL);
     let (status, _) = demo.wait(HANG_GUARD);
     assert!(!status.success());
