@@ -94,7 +94,7 @@ class MeasurementFrame(ctypes.Structure):
 
 
 class WireTrack(ctypes.Structure):
-    """One track's fused state (152 bytes)."""
+    """One track's fused state (184 bytes)."""
 
     _fields_ = [
         ("id", ctypes.c_uint64),
