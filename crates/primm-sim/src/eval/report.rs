@@ -409,12 +409,8 @@ impl EvaluationReport {
             };
             let idsw: Vec<Option<f64>> = counts.iter().map(|c| c.map(|c| c.idsw as f64)).collect();
             let idf1: Vec<Option<f64>> = counts.iter().map(|c| c.and_then(|c| c.idf1())).collect();
-            let mut line = vec![format!("{label} ({frames})"), "IDSW".to_string()];
-            line.extend(mark_best(&idsw, Better::Lower, 0).iter().map(Cell::to_string));
-            rows.push(line);
-            let mut line = vec![String::new(), "IDF1".to_string()];
-            line.extend(mark_best(&idf1, Better::Higher, 4).iter().map(Cell::to_string));
-            rows.push(line);
+            rows.push(metric_row(format!("{label} ({frames})"), "IDSW", &idsw, Better::Lower, 0));
+            rows.push(metric_row(String::new(), "IDF1", &idf1, Better::Higher, 4));
         }
         let mut text = render_table_aligned(
             "Table V. Scenario-wise multiple-object-tracking performance",
@@ -479,16 +475,10 @@ impl EvaluationReport {
             let frames: Vec<u64> = counts.iter().flatten().map(|c| c.gt_object_frames).collect();
             let idsw: Vec<Option<f64>> = counts.iter().map(|c| c.map(|c| c.idsw as f64)).collect();
             let idf1: Vec<Option<f64>> = counts.iter().map(|c| c.and_then(|c| c.idf1())).collect();
-            let mut line =
-                vec![format!("{} ({})", motion.label(), count_text(&frames)), "RMSE_xy".to_string()];
-            line.extend(mark_best(&rmse, Better::Lower, 3).iter().map(Cell::to_string));
-            rows.push(line);
-            let mut line = vec![String::new(), "IDSW".to_string()];
-            line.extend(mark_best(&idsw, Better::Lower, 0).iter().map(Cell::to_string));
-            rows.push(line);
-            let mut line = vec![String::new(), "IDF1".to_string()];
-            line.extend(mark_best(&idf1, Better::Higher, 4).iter().map(Cell::to_string));
-            rows.push(line);
+            let label = format!("{} ({})", motion.label(), count_text(&frames));
+            rows.push(metric_row(label, "RMSE_xy", &rmse, Better::Lower, 3));
+            rows.push(metric_row(String::new(), "IDSW", &idsw, Better::Lower, 0));
+            rows.push(metric_row(String::new(), "IDF1", &idf1, Better::Higher, 4));
         }
         let mut text = render_table_aligned(
             "Table VI. Prior RMSE and identity by ego motion (|yaw rate| above 0.1 rad/s: turning)",
@@ -653,6 +643,20 @@ impl EvaluationReport {
             }
         }
     }
+}
+
+/// One row of a scenario table: `first` (the scenario, or empty under it), the metric's name
+/// and each method's value, the best one marked.
+fn metric_row(
+    first: String,
+    metric: &str,
+    values: &[Option<f64>],
+    better: Better,
+    digits: usize,
+) -> Vec<String> {
+    let mut line = vec![first, metric.to_string()];
+    line.extend(mark_best(values, better, digits).iter().map(Cell::to_string));
+    line
 }
 
 fn identity_json(counts: &IdentityCounts) -> Value {
