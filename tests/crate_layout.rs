@@ -83,7 +83,15 @@ fn dependencies_between_primm_crates_point_one_way() {
 
 #[test]
 fn no_library_crate_depends_on_the_fuzz_targets_or_a_fuzzing_crate() {
-    let packages = ["primm-core", "primm-config", "primm-predictor", "primm-wire", "primm-service", "primm-sim", "primm-ffi"];
+    let packages = [
+        "primm-core",
+        "primm-config",
+        "primm-predictor",
+        "primm-wire",
+        "primm-service",
+        "primm-sim",
+        "primm-ffi",
+    ];
     for package in packages {
         let names = dependency_names(package, &[]);
         for forbidden in ["primm-fuzz-targets", "arbitrary", "libfuzzer-sys"] {

@@ -67,4 +67,5 @@ pub mod track;
 pub mod track_loops;
 pub mod track_table;
 pub mod tracker;
+mod validated_frame;
 pub mod validation;

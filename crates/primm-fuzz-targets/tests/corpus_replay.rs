@@ -32,7 +32,12 @@ fn replay_corpus(name: &str) {
             catch_unwind(AssertUnwindSafe(|| run(&data))).err().map(|_| path.display().to_string())
         })
         .collect();
-    assert!(failures.is_empty(), "{name}: {} of {} corpus files panic: {failures:#?}", failures.len(), files.len());
+    assert!(
+        failures.is_empty(),
+        "{name}: {} of {} corpus files panic: {failures:#?}",
+        failures.len(),
+        files.len()
+    );
 }
 
 #[test]
