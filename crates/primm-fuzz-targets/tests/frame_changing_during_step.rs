@@ -34,7 +34,13 @@ struct ChangingFrame {
 impl ChangingFrame {
     fn new(timestamp_s: f64, honest: Vec<Measurement>) -> Self {
         let measurement_reads = honest.iter().map(|_| Cell::new(0)).collect();
-        Self { timestamp_s, honest, length_reads: Cell::new(0), timestamp_reads: Cell::new(0), measurement_reads }
+        Self {
+            timestamp_s,
+            honest,
+            length_reads: Cell::new(0),
+            timestamp_reads: Cell::new(0),
+            measurement_reads,
+        }
     }
 
     fn first_read(counter: &Cell<usize>) -> bool {
@@ -87,7 +93,8 @@ fn a_frame_rewritten_after_validation_is_tracked_as_it_was_validated() {
     assert_eq!(changing.timestamp_reads.get(), 1, "the timestamp is read once");
     assert!(changing.measurement_reads.iter().all(|reads| reads.get() == 1), "each measurement is read once");
     assert_eq!(check_tracker(&tracker), Ok(()));
-    let latest_update_s = tracker.tracks().iter().map(|track| track.last_update_s).fold(f64::NEG_INFINITY, f64::max);
+    let latest_update_s =
+        tracker.tracks().iter().map(|track| track.last_update_s).fold(f64::NEG_INFINITY, f64::max);
     assert_eq!(latest_update_s, 0.15, "tracks updated at the time read during validation");
     assert_eq!(tracker.tracks().len(), 3, "two updated tracks and one new one");
 }
