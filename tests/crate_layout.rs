@@ -1,6 +1,7 @@
 //! The crate layout holds: `primm-core` stays free of I/O, runtime and CLI crates and builds
 //! as a real `no_std` library, and every dependency between primm's crates points the way
-//! `ARCHITECTURE.md` draws it (core ← predictor, core ← wire ← service, core ← sim).
+//! `ARCHITECTURE.md` draws it (core ← predictor, core ← wire ← service, core ← sim), with the
+//! fuzz targets' crate on top of them and nothing depending on it.
 
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -66,6 +67,37 @@ fn dependencies_between_primm_crates_point_one_way() {
     assert_eq!(primm("primm-service"), set(&["primm-service", "primm-wire", "primm-core"]));
     assert_eq!(primm("primm-sim"), set(&["primm-sim", "primm-core"]));
     assert_eq!(primm("primm-ffi"), set(&["primm-ffi", "primm-config", "primm-predictor", "primm-core"]));
+    assert_eq!(
+        primm("primm-fuzz-targets"),
+        set(&[
+            "primm-fuzz-targets",
+            "primm-config",
+            "primm-predictor",
+            "primm-wire",
+            "primm-service",
+            "primm-sim",
+            "primm-core"
+        ])
+    );
+}
+
+#[test]
+fn no_library_crate_depends_on_the_fuzz_targets_or_a_fuzzing_crate() {
+    let packages = [
+        "primm-core",
+        "primm-config",
+        "primm-predictor",
+        "primm-wire",
+        "primm-service",
+        "primm-sim",
+        "primm-ffi",
+    ];
+    for package in packages {
+        let names = dependency_names(package, &[]);
+        for forbidden in ["primm-fuzz-targets", "arbitrary", "libfuzzer-sys"] {
+            assert!(!names.contains(forbidden), "{package} depends on {forbidden}");
+        }
+    }
 }
 
 #[test]

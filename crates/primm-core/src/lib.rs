@@ -71,4 +71,5 @@ pub mod track_loops;
 pub mod track_table;
 pub mod tracker;
 pub mod tracking_frame;
+mod validated_frame;
 pub mod validation;

@@ -23,7 +23,8 @@ use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput, TrackStatus};
 use crate::track_loops;
 use crate::track_table::{TrackTable, MAX_TRACKS};
-use crate::tracking_frame::{InTrackingFrame, TrackingFrame};
+use crate::tracking_frame::TrackingFrame;
+use crate::validated_frame::ValidatedFrame;
 use crate::validation::{validate_frame, validate_measurement, FrameError, MeasurementRejection};
 use alloc::boxed::Box;
 use alloc::vec;
@@ -221,6 +222,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     rows: Box<[RowRecord; MAX_TRACKS]>,
     fates: Box<[MeasurementFate; MAX_MEASUREMENTS_PER_FRAME]>,
     accepted: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// The current frame as read once during validation; every later stage reads this copy.
+    validated: Box<ValidatedFrame>,
     outputs: Box<ArrayVec<TrackOutput, MAX_TRACKS>>,
 }
 
@@ -258,6 +261,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
             accepted: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
+            validated: Box::new(ValidatedFrame::new()),
             outputs: Box::new(ArrayVec::new()),
         })
     }
@@ -325,22 +329,22 @@ impl<P: DisplacementPredictor> Tracker<P> {
     ) -> Result<(), StepError> {
         let dt_s = self.validate(frame)?;
         observer.stage_finished(Stage::Validate);
-        let t = frame.timestamp_s();
-        self.enter_tracking_frame(frame.ego_pose());
-        let frame = &InTrackingFrame {
-            frame,
-            vehicle_to_tracking: self.step_pose.map(|pose| pose.vehicle_to_world()),
-        };
+        // From here on only the validated copy is read, never `frame` again.
+        let t = self.validated.timestamp_s();
+        self.enter_tracking_frame(self.validated.ego_pose());
+        if let Some(vehicle_to_world) = self.step_pose.map(|pose| pose.vehicle_to_world()) {
+            self.validated.move_positions(&vehicle_to_world);
+        }
         self.request_learned_predictions(t);
         self.predict_physics(dt_s);
         observer.stage_finished(Stage::Predict);
         self.fuse_priors();
         observer.stage_finished(Stage::LearnedWait);
-        self.associate(frame)?;
+        self.associate()?;
         observer.stage_finished(Stage::Associate);
-        self.update(frame, t);
+        self.update(t);
         self.coast();
-        self.initiate(frame, t);
+        self.initiate(t);
         self.delete(t);
         observer.stage_finished(Stage::Update);
         self.last_timestamp_s = Some(t);
@@ -380,10 +384,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Frame checks, then per-measurement checks; counts every rejection.
+    /// Frame checks, then per-measurement checks; counts every rejection. Reads each field of
+    /// `frame` once, into [`ValidatedFrame`], and checks that copy.
     fn validate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<f64, StepError> {
+        self.validated.read_header(frame);
         if self.config.frame.tracking_frame == TrackingFrame::World {
-            if let Some(pose) = frame.ego_pose().filter(|pose| !pose.is_valid()) {
+            if let Some(pose) = self.validated.ego_pose().filter(|pose| !pose.is_valid()) {
                 self.stats.frames_rejected_invalid_ego_pose += 1;
                 return Err(StepError::InvalidFrame(FrameError::InvalidEgoPose {
                     x_m: pose.x_m,
@@ -392,8 +398,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }));
             }
         }
-        let dt_s =
-            validate_frame(frame, self.last_timestamp_s, &self.config.tracker).inspect_err(|error| {
+        let dt_s = validate_frame(&*self.validated, self.last_timestamp_s, &self.config.tracker)
+            .inspect_err(|error| {
                 let counter = match error {
                     FrameError::NonFiniteTimestamp { .. } => {
                         &mut self.stats.frames_rejected_non_finite_timestamp
@@ -409,8 +415,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 };
                 *counter += 1;
             })?;
-        for index in 0..frame.len() {
+        for index in 0..self.validated.len() {
             let verdict = validate_measurement(frame, index);
+            self.validated.set(index, verdict.ok());
             self.accepted[index] = verdict.is_ok();
             self.fates[index] =
                 if verdict.is_ok() { MeasurementFate::Unassigned } else { MeasurementFate::Rejected };
@@ -499,12 +506,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// Per-class gated optimal assignment (`eq:association_cost`).
-    fn associate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<(), StepError> {
+    fn associate(&mut self) -> Result<(), StepError> {
         self.associator.associate(
             self.table.tracks(),
             &self.priors[..self.table.len()],
-            frame,
-            &self.accepted[..frame.len()],
+            &*self.validated,
+            &self.accepted[..self.validated.len()],
             &self.config,
             &mut self.track_to_measurement[..],
         )?;
@@ -512,13 +519,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// Kalman and mode-probability update of every assigned track.
-    fn update<F: FrameView + ?Sized>(&mut self, frame: &F, t: f64) {
+    fn update(&mut self, t: f64) {
         let count = self.table.len();
         for i in 0..count {
             // An accepted measurement always reads back; if one did not, the track coasts rather
             // than keep a stale state.
             self.assigned_measurements[i] =
-                self.track_to_measurement[i].and_then(|index| frame.measurement(usize::from(index)).ok());
+                self.track_to_measurement[i].and_then(|index| self.validated.accepted(usize::from(index)));
             if self.assigned_measurements[i].is_none() {
                 self.track_to_measurement[i] = None;
             }
@@ -572,13 +579,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// Every accepted, unassigned measurement starts a tentative track.
-    fn initiate<F: FrameView + ?Sized>(&mut self, frame: &F, t: f64) {
+    fn initiate(&mut self, t: f64) {
         let confirmation_hits = self.config.tracker.confirmation_hits;
-        for index in 0..frame.len() {
+        for index in 0..self.validated.len() {
             if self.fates[index] != MeasurementFate::Unassigned {
                 continue;
             }
-            let Ok(measurement) = frame.measurement(index) else { continue };
+            let Some(measurement) = self.validated.accepted(index) else { continue };
             let sensor_position_m = self.sensor_position(&measurement);
             let estimate = self.imm.initiate_seen_from(
                 &self.models[measurement.class.index()],

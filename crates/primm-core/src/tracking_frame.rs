@@ -13,8 +13,7 @@
 //! [`FrameView::ego_pose`]: crate::measurement::FrameView::ego_pose
 
 use crate::limits::MAX_SENSORS;
-use crate::measurement::{FrameView, Measurement, UnknownClass};
-use crate::pose::{EgoPose, RigidTransform, SensorMount};
+use crate::pose::SensorMount;
 use arrayvec::ArrayVec;
 
 /// Largest distance of a sensor mount from the vehicle's reference point, m.
@@ -98,37 +97,6 @@ impl FrameConfig {
             }
         }
         None
-    }
-}
-
-/// A frame whose measurement positions are read in the tracking frame: mapped by
-/// `vehicle_to_tracking` (the frame's vehicle-to-world transform), or as they are when `None`.
-/// Everything else is read through unchanged.
-pub(crate) struct InTrackingFrame<'a, F: FrameView + ?Sized> {
-    /// The frame as received.
-    pub frame: &'a F,
-    /// The map of positions into the tracking frame.
-    pub vehicle_to_tracking: Option<RigidTransform>,
-}
-
-impl<F: FrameView + ?Sized> FrameView for InTrackingFrame<'_, F> {
-    fn timestamp_s(&self) -> f64 {
-        self.frame.timestamp_s()
-    }
-    fn len(&self) -> usize {
-        self.frame.len()
-    }
-    fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
-        let mut measurement = self.frame.measurement(index)?;
-        if let Some(transform) = &self.vehicle_to_tracking {
-            let position = transform.apply_point(measurement.position());
-            measurement.x_m = position.x;
-            measurement.y_m = position.y;
-        }
-        Ok(measurement)
-    }
-    fn ego_pose(&self) -> Option<EgoPose> {
-        self.frame.ego_pose()
     }
 }
 

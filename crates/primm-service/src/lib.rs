@@ -8,6 +8,7 @@
 //!
 //! - [`catalog`]: service names and QoS, shared by every primm program.
 //! - [`tracking`]: the tracking loop.
+//! - [`frame_step`]: one received frame through the tracker, as the loop does it.
 //! - [`latency`]: latency histograms, reports and tables.
 //! - [`clock`]: the monotonic clock the latencies are measured with.
 //! - [`shutdown`]: SIGINT/SIGTERM handling.
@@ -37,6 +38,7 @@
 
 pub mod catalog;
 pub mod clock;
+pub mod frame_step;
 pub mod latency;
 pub mod log_limit;
 pub mod logging;

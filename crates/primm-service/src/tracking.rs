@@ -18,6 +18,7 @@
 
 use super::catalog::{self, ConnectError, Ipc, ServiceNames};
 use super::clock::monotonic_ns;
+use super::frame_step::{starts_stream, step_received_frame};
 use super::latency::{LatencyHistograms, StageTimer};
 use super::log_limit::LogLimiter;
 use super::shutdown::ShutdownFlag;
@@ -35,11 +36,10 @@ use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::stage_timing::Stage;
 use primm_core::tracker::{StepError, StepSummary, Tracker};
-use primm_core::validation::FrameError;
 use primm_wire::{
     FrameStatus, LatencyReport, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
-    TrackFrameWriter, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START, STAGE_CAPACITY,
-    TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
+    TrackFrameWriter, FRAME_FLAG_STREAM_END, STAGE_CAPACITY, TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END,
+    TRACK_FLAG_TRACKER_RESET,
 };
 use std::mem::MaybeUninit;
 use std::time::{Duration, Instant};
@@ -299,26 +299,12 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         flags: &mut u8,
     ) -> Result<StepSummary, StepError> {
         let mut timer = StageTimer::new(&mut self.histograms, receive_ns);
-        let mut result = self.tracker.step_observed(frame, &mut timer, |output| {
-            if let Some(writer) = writer.as_mut() {
-                writer.push(output);
-            }
-        });
-        if let Err(StepError::InvalidFrame(FrameError::IntervalTooLong { .. })) = result {
-            // Tracks cannot be bridged over the gap: start afresh with this frame.
-            self.tracker.reset();
+        let stepped = step_received_frame(&mut self.tracker, frame, &mut timer, writer);
+        if stepped.reset_for_interval {
             self.counters.resets_interval_too_long += 1;
             *flags |= TRACK_FLAG_TRACKER_RESET;
-            if let Some(writer) = writer.as_mut() {
-                writer.clear();
-            }
-            result = self.tracker.step_observed(frame, &mut timer, |output| {
-                if let Some(writer) = writer.as_mut() {
-                    writer.push(output);
-                }
-            });
         }
-        result
+        stepped.result
     }
 
     /// Counts (and logs, for a rejected frame) the outcome of tracking `frame`; returns the
@@ -403,7 +389,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         let mut flags = 0;
         let first_from_publisher = self.stream.origin != Some(origin);
         let new_publisher = self.stream.origin.is_some() && first_from_publisher;
-        let stream_start = frame.flags & FRAME_FLAG_STREAM_START != 0;
+        let stream_start = starts_stream(frame);
         if (stream_start || new_publisher) && self.stream.tracker_dirty {
             self.tracker.reset();
             self.stream.tracker_dirty = false;
