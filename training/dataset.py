@@ -66,6 +66,13 @@ class Windows:
     def subset(self, mask: np.ndarray) -> "Windows":
         return Windows(**{name: getattr(self, name)[mask] for name in self.__dataclass_fields__})
 
+    @staticmethod
+    def concatenate(parts: list["Windows"]) -> "Windows":
+        """The windows of all ``parts``, in order (``sequence`` keeps each part's file index)."""
+        return Windows(
+            **{name: np.concatenate([getattr(p, name) for p in parts]) for name in Windows.__dataclass_fields__}
+        )
+
 
 def to_world(row: dict, x: float, y: float) -> tuple[float, float]:
     """A vehicle-frame point of ``row`` in the world frame of the row's ego pose (unchanged without
@@ -254,6 +261,16 @@ def vectors_to_model_frame(vectors: np.ndarray, cos: np.ndarray, sin: np.ndarray
     """``[N, 2]`` displacements rotated like :func:`to_model_frame`."""
     x, y = vectors[:, 0].astype(np.float64), vectors[:, 1].astype(np.float64)
     return np.stack([cos * x + sin * y, -sin * x + cos * y], axis=1).astype(np.float32)
+
+
+def scale_time(features: np.ndarray, k: np.ndarray) -> np.ndarray:
+    """Windows of the same paths travelled ``k`` times slower: times ``t_l - tau`` times ``k`` and
+    radial velocities divided by ``k`` (positions, RCS and the displacement label unchanged; the
+    horizon becomes ``k`` times longer). Padding rows stay zero."""
+    out = features.copy()
+    out[:, :, 2] = (features[:, :, 2] / k[:, None]).astype(np.float32)
+    out[:, :, 4] = (features[:, :, 4] * k[:, None]).astype(np.float32)
+    return out
 
 
 def vectors_from_model_frame(vectors: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> np.ndarray:

@@ -5,8 +5,9 @@
 
 Reads the weights back from the ONNX file (either graph form), writes the new graph, and checks
 it three ways before anything is overwritten: the NumPy reference forward pass and onnxruntime on
-the new file against the PyTorch outputs of ``models/pr_parity.json`` (at most 1e-5 m), and the
-new file against the old one on the same inputs. Then updates ``model_sha256`` and the format
+the new file against the PyTorch outputs of ``models/pr_parity.json`` (at most 1e-5 m; the
+displacement and, for a model with the uncertainty head, its Cholesky factor), and the new file
+against the old one on the same inputs (every output). Then updates ``model_sha256`` and the format
 notes in ``models/pr.json``. Needs numpy and onnx (onnxruntime for the runtime checks).
 """
 
@@ -45,8 +46,13 @@ def main() -> int:
     features = np.asarray(parity["features"], np.float32)
     valid = np.asarray(parity["valid"], np.float32)
     expected = np.asarray(parity["displacement"], np.float64)
-    reference = onnx_graph.reference_forward(weights, features, valid, args.heads)
+    reference, reference_cholesky = onnx_graph.reference_forward(weights, features, valid, args.heads)
     difference = float(np.abs(reference - expected).max())
+    if reference_cholesky is not None:
+        if "cholesky" not in parity:
+            raise SystemExit(f"{args.parity} has no cholesky outputs for this model's uncertainty head")
+        expected_cholesky = np.asarray(parity["cholesky"], np.float64)
+        difference = max(difference, float(np.abs(reference_cholesky - expected_cholesky).max()))
     print(f"weights read from {args.source}: reference forward vs PyTorch {difference:.2e} m")
     if difference > TOLERANCE_M:
         raise SystemExit("the weights read back do not reproduce the PyTorch outputs")
@@ -64,12 +70,16 @@ def main() -> int:
         if onnxruntime is not None:
             def run(path):
                 session = onnxruntime.InferenceSession(str(path), providers=["CPUExecutionProvider"])
-                return session.run(None, {"features": features, "valid": valid})[0]
+                return session.run(None, {"features": features, "valid": valid})
 
             new = run(candidate)
             old = run(args.source)
-            to_torch = float(np.abs(new - expected).max())
-            to_old = float(np.abs(new - old).max())
+            if len(new) != len(old):
+                raise SystemExit("the new graph has different outputs")
+            to_torch = float(np.abs(new[0] - expected).max())
+            if len(new) > 1:
+                to_torch = max(to_torch, float(np.abs(new[1] - expected_cholesky).max()))
+            to_old = max(float(np.abs(a - b).max()) for a, b in zip(new, old))
             print(f"onnxruntime, new graph vs PyTorch: {to_torch:.2e} m; new vs old graph: {to_old:.2e} m")
             if to_torch > TOLERANCE_M or to_old > TOLERANCE_M:
                 raise SystemExit("the new graph does not compute the same function")

@@ -6,9 +6,15 @@ Inputs (batch axis ``batch`` is the only dynamic one):
   valid, rows ``len..`` zero (right padding), as ``primm_core::predictor::PredictionRequest``.
 * ``valid`` ``[batch, 5]`` float32: 1 for rows ``0..len``, 0 for padding.
 
-Output ``displacement`` ``[batch, 2]`` float32: ``[dx, dy]`` in metres, the displacement of the
-object from the latest history measurement to the prediction time (the time the feature
-``t_l - t_k`` is relative to).
+Outputs:
+
+* ``displacement`` ``[batch, 2]`` float32: ``[dx, dy]`` in metres, the displacement of the object
+  from the latest history measurement to the prediction time (the time the feature ``t_l - t_k``
+  is relative to);
+* ``displacement_cholesky`` ``[batch, 3]`` float32: ``[l_xx, l_yx, l_yy]``, the lower-triangular
+  Cholesky factor ``L`` of the covariance ``Sigma = L L^T`` (m^2) of the error of that
+  displacement (true minus predicted), in the same frame; ``l_xx`` and ``l_yy`` are at least
+  ``CHOLESKY_FLOOR_M``.
 
 :class:`PRModel` is the network as trained:
 
@@ -25,7 +31,10 @@ object from the latest history measurement to the prediction time (the time the 
    residuals for those two tokens only (keys and values still come from all seven): the same
    function as the full layer restricted to the outputs that are used;
 5. a final LayerNorm, ``dx`` from ``q_x``'s output and ``dy`` from ``q_y``'s output (one linear
-   head each), scaled to metres.
+   head each), scaled to metres;
+6. the uncertainty head: one linear layer from both query outputs to three raw values ``r``,
+   ``l_xx = softplus(r_0) s_x + floor``, ``l_yx = r_1 s_y``, ``l_yy = softplus(r_2) s_y + floor``
+   with ``s`` the label's RMS per axis (``output_scale``) and ``floor = CHOLESKY_FLOOR_M``.
 
 :class:`ExportGraph` computes the same function from the same weights with the heads merged
 and the softmax rewritten; ``train.py`` uses it for the weight-derived attention-score bound.
@@ -46,6 +55,8 @@ FEATURES = 5
 QUERIES = 2
 TOKENS = MAX_HISTORY + QUERIES
 MASK_VALUE = -1.0e9
+# Smallest diagonal element of the Cholesky factor of the displacement covariance, metres.
+CHOLESKY_FLOOR_M = 0.005
 
 
 class Attention(nn.Module):
@@ -127,9 +138,14 @@ class PRModel(nn.Module):
         self.final_norm = nn.LayerNorm(d_model)
         self.head_x = nn.Linear(d_model, 1)
         self.head_y = nn.Linear(d_model, 1)
+        # [l_xx, l_yx, l_yy] before the softplus and scaling, from both query outputs.
+        self.head_cholesky = nn.Linear(QUERIES * d_model, 3)
+        self.register_buffer("cholesky_scale", torch.stack([scale[0], scale[1], scale[1]]).clone())
+        self.register_buffer("cholesky_floor", torch.tensor([CHOLESKY_FLOOR_M, 0.0, CHOLESKY_FLOOR_M]))
         self.d_model = d_model
 
-    def forward(self, features: torch.Tensor, valid: torch.Tensor) -> torch.Tensor:
+    def forward(self, features: torch.Tensor, valid: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """``(displacement [B, 2], displacement_cholesky [B, 3])``, metres."""
         x = (features - self.feature_mean) * self.feature_inv_std  # [B, 5, 5]
         x = F.pad(x, (0, 0, 0, QUERIES))  # [B, 7, 5], query rows zero
         tokens = self.embedding(x) + self.token_table  # [B, 7, d]
@@ -144,7 +160,11 @@ class PRModel(nn.Module):
             [torch.cat([self.head_x.weight[0], zeros]), torch.cat([zeros, self.head_y.weight[0]])], dim=1
         )  # [2d, 2], block diagonal
         bias = torch.cat([self.head_x.bias, self.head_y.bias])
-        return (out @ head + bias) * self.output_scale
+        displacement = (out @ head + bias) * self.output_scale
+        raw = self.head_cholesky(out)
+        diagonal = torch.tensor([True, False, True])
+        positive = torch.where(diagonal, F.softplus(raw), raw)
+        return displacement, positive * self.cholesky_scale + self.cholesky_floor
 
     def parameter_count(self) -> int:
         return sum(p.numel() for p in self.parameters() if p.requires_grad)
@@ -207,6 +227,7 @@ class ExportGraph(nn.Module):
         return F.linear(mixed, output_w, attention.output.bias)
 
     def forward(self, features: torch.Tensor, valid: torch.Tensor) -> torch.Tensor:
+        """The displacement only (this form is kept for the score bound)."""
         m = self.model
         x = (features - m.feature_mean) * m.feature_inv_std
         x = F.pad(x, (0, 0, 0, QUERIES))

@@ -26,6 +26,15 @@ with ``cargo bench --bench inference_profile`` (``benches/results/pr_inference_c
   straight into the embedding product.
 * Embedding, feed-forward blocks, residuals and the two heads as in the trained model; the last
   layer computes only the two query tokens.
+* **Uncertainty output** ``displacement_cholesky`` ``[batch, 3]`` (models trained with the
+  uncertainty head, ``head_cholesky.*``): ``[l_xx, l_yx, l_yy]`` of the lower-triangular Cholesky
+  factor of the displacement error covariance, metres. A linear layer on both query outputs gives
+  raw values ``r``; the graph computes ``softplus(r)`` in the overflow-free form
+  ``max(r, 0) + log(1 + exp(-|r|))`` (``Relu``, ``Abs``, ``Neg``, ``Exp``, ``Add``, ``Log``, ``Add``:
+  ONNX's ``Softplus`` is ``log(exp(r) + 1)``, which tract also computes literally and which
+  overflows for ``r > 88``), then ``softplus(r) * [s_x, 0, s_y] + r * [0, s_y, 0] + [floor, 0,
+  floor]``, so ``l_xx, l_yy >= floor > 0`` for any input. A model without that head gets the
+  displacement output only.
 
 ``weights_from_onnx`` reads the weights back from an exported file of either graph form (from
 this one, in their folded but equivalent form), so a model can be re-exported without
@@ -50,7 +59,14 @@ GRAPH_DESCRIPTION = (
     "following linear layers; see training/onnx_graph.py"
 )
 INPUT_NAMES = ["features", "valid"]
-OUTPUT_NAMES = ["displacement"]
+OUTPUT_NAMES = ["displacement", "displacement_cholesky"]
+# [l_xx, l_yx, l_yy]: which of the Cholesky factor's elements go through the softplus.
+CHOLESKY_DIAGONAL = np.array([1.0, 0.0, 1.0])
+
+
+def has_cholesky(weights: dict) -> bool:
+    """Whether the weights include the uncertainty head (``displacement_cholesky``)."""
+    return "head_cholesky.weight" in weights
 
 
 def layer_count(weights: dict) -> int:
@@ -78,6 +94,12 @@ def fold_normalisations(weights: dict) -> dict:
         p = f"layers.{index}"
         fold(f"{p}.norm_attention", [f"{p}.attention.query", f"{p}.attention.key", f"{p}.attention.value"])
         fold(f"{p}.norm_ff", [f"{p}.ff_in"])
+    if has_cholesky(weights):
+        # The uncertainty head reads both query tokens' normalised outputs side by side ([2d]).
+        scale, shift = np.tile(w["final_norm.weight"], QUERIES), np.tile(w["final_norm.bias"], QUERIES)
+        matrix = w["head_cholesky.weight"]  # [3, 2d]
+        w["head_cholesky.bias"] = w["head_cholesky.bias"] + matrix @ shift
+        w["head_cholesky.weight"] = matrix * scale[None, :]
     fold("final_norm", ["head_x", "head_y"])
     mean, inv_std = w["feature_mean"], w["feature_inv_std"]
     embedding = w["embedding.weight"]  # [d, features]
@@ -87,8 +109,15 @@ def fold_normalisations(weights: dict) -> dict:
     return w
 
 
-def reference_forward(weights: dict, features: np.ndarray, valid: np.ndarray, heads: int) -> np.ndarray:
-    """The trained model's forward pass in float64 NumPy (``model.PRModel.forward``)."""
+def softplus(x: np.ndarray) -> np.ndarray:
+    """``log(1 + exp(x))`` without overflow, as the graph computes it."""
+    return np.maximum(x, 0.0) + np.log1p(np.exp(-np.abs(x)))
+
+
+def reference_forward(weights: dict, features: np.ndarray, valid: np.ndarray, heads: int):
+    """The trained model's forward pass in float64 NumPy (``model.PRModel.forward``):
+    ``(displacement [B, 2], displacement_cholesky [B, 3])``, the second ``None`` for weights
+    without the uncertainty head."""
     w = {k: np.asarray(v, np.float64) for k, v in weights.items()}
     x = (features.astype(np.float64) - w["feature_mean"]) * w["feature_inv_std"]
     x = np.concatenate([x, np.zeros((x.shape[0], QUERIES, FEATURES))], axis=1)
@@ -131,7 +160,24 @@ def reference_forward(weights: dict, features: np.ndarray, valid: np.ndarray, he
     head[:d, 0] = w["head_x.weight"][0]
     head[d:, 1] = w["head_y.weight"][0]
     bias = np.array([w["head_x.bias"][0], w["head_y.bias"][0]])
-    return (out @ head + bias) * w["output_scale"]
+    displacement = (out @ head + bias) * w["output_scale"]
+    if not has_cholesky(weights):
+        return displacement, None
+    raw = out @ w["head_cholesky.weight"].T + w["head_cholesky.bias"]
+    return displacement, cholesky_from_raw(w, raw)
+
+
+def cholesky_scale(w: dict) -> np.ndarray:
+    """Per-element scale of ``[l_xx, l_yx, l_yy]``: the label RMS of x, y, y."""
+    scale = np.asarray(w["output_scale"], np.float64)
+    return np.array([scale[0], scale[1], scale[1]])
+
+
+def cholesky_from_raw(w: dict, raw: np.ndarray) -> np.ndarray:
+    """``[l_xx, l_yx, l_yy]`` from the head's raw values (``model.PRModel.forward``)."""
+    scale = cholesky_scale(w)
+    floor = np.asarray(w["cholesky_floor"], np.float64)
+    return softplus(raw) * (scale * CHOLESKY_DIAGONAL) + raw * (scale * (1.0 - CHOLESKY_DIAGONAL)) + floor
 
 
 class GraphBuilder:
@@ -213,9 +259,14 @@ class GraphBuilder:
         head[:d, 0] = w["head_x.weight"][0]
         head[d:, 1] = w["head_y.weight"][0]
         bias = np.array([w["head_x.bias"][0], w["head_y.bias"][0]], np.float32)
+        flat = out
         out = self.linear(out, "head", "head_output", head, bias)
         self.node("Mul", [out, self.const("output_scale", w["output_scale"])], "displacement")
         batch = "batch"
+        outputs = [helper.make_tensor_value_info("displacement", TensorProto.FLOAT, [batch, 2])]
+        if has_cholesky(w):
+            self.cholesky(flat)
+            outputs.append(helper.make_tensor_value_info("displacement_cholesky", TensorProto.FLOAT, [batch, 3]))
         graph = helper.make_graph(
             self.nodes,
             "pr",
@@ -223,13 +274,33 @@ class GraphBuilder:
                 helper.make_tensor_value_info("features", TensorProto.FLOAT, [batch, MAX_HISTORY, FEATURES]),
                 helper.make_tensor_value_info("valid", TensorProto.FLOAT, [batch, MAX_HISTORY]),
             ],
-            [helper.make_tensor_value_info("displacement", TensorProto.FLOAT, [batch, 2])],
+            outputs,
             self.initializers,
         )
         model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="primm training/onnx_graph.py", doc_string=doc)
         model.ir_version = 8
         onnx.checker.check_model(model, full_check=True)
         return model
+
+
+    def cholesky(self, flat):
+        """``displacement_cholesky`` from the flattened, normalised query outputs ``[B, 2d]``:
+        the uncertainty head's raw values ``r``, a softplus that cannot overflow, and
+        ``softplus(r) * diag_scale + r * off_scale + floor``."""
+        w, node, const = self.w, self.node, self.const
+        raw = self.linear(flat, "head_cholesky", "cholesky_raw")
+        positive = node("Relu", [raw], "cholesky_raw_positive")
+        magnitude = node("Abs", [raw], "cholesky_raw_abs")
+        negative = node("Neg", [magnitude], "cholesky_raw_minus_abs")
+        small = node("Exp", [negative], "cholesky_exp")
+        small = node("Add", [small, const("cholesky_one", np.float32(1.0))], "cholesky_one_plus_exp")
+        small = node("Log", [small], "cholesky_log")
+        soft = node("Add", [positive, small], "cholesky_softplus")
+        scale = cholesky_scale(w)
+        soft = node("Mul", [soft, const("cholesky_diagonal_scale", scale * CHOLESKY_DIAGONAL)], "cholesky_diagonal")
+        off = node("Mul", [raw, const("cholesky_off_diagonal_scale", scale * (1.0 - CHOLESKY_DIAGONAL))], "cholesky_off_diagonal")
+        total = node("Add", [soft, off], "cholesky_unfloored")
+        return node("Add", [total, const("cholesky_floor", w["cholesky_floor"])], "displacement_cholesky")
 
 
 def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str = ""):
@@ -325,6 +396,15 @@ def _weights_from_this_graph(init: dict, heads: int) -> dict:
     head = init["head.weight_t"]
     w["head_x.weight"], w["head_y.weight"] = head[:d, 0][None, :], head[d:, 1][None, :]
     w["head_x.bias"], w["head_y.bias"] = init["head.bias_row"][:1], init["head.bias_row"][1:]
+    if "head_cholesky.weight_t" in init:
+        w["head_cholesky.weight"] = init["head_cholesky.weight_t"].T
+        w["head_cholesky.bias"] = init["head_cholesky.bias_row"]
+        w["cholesky_floor"] = init["cholesky_floor"]
+        # cholesky_scale is rebuilt from output_scale; a file whose constants disagree is not
+        # this graph form.
+        stored = init["cholesky_diagonal_scale"] + init["cholesky_off_diagonal_scale"]
+        if not np.allclose(stored, cholesky_scale(w), rtol=1e-6):
+            raise ValueError("displacement_cholesky scale does not match output_scale")
     return w
 
 
