@@ -85,7 +85,11 @@ fn association_scene(
         };
         let models = primm_core::motion::ModeModels::from_config(config.classes.get(class));
         let state = imm.initiate(&models, &measurement);
-        let context = primm_core::motion::PredictContext { dt_s: 0.05, displacement_m: None };
+        let context = primm_core::motion::PredictContext {
+            dt_s: 0.05,
+            displacement_m: None,
+            displacement_covariance_m2: None,
+        };
         let mut prior = imm.predict(&models, &state, &context);
         prior.fused.mean = glam::DVec2::new(measurement.x_m + 0.3, measurement.y_m - 0.2);
         tracks.push(primm_core::track::Track::new(i as u64, &measurement, 0.0, state));

@@ -85,7 +85,11 @@ fn imm_cycle(c: &mut Criterion) {
         group.bench_function(method.id(), |b| {
             b.iter(|| {
                 t += 0.04;
-                let context = PredictContext { dt_s: 0.04, displacement_m: Some(DVec2::new(0.2, 0.0)) };
+                let context = PredictContext {
+                    dt_s: 0.04,
+                    displacement_m: Some(DVec2::new(0.2, 0.0)),
+                    displacement_covariance_m2: None,
+                };
                 let prior = imm.predict(&models, &state, &context);
                 state = imm.update(&models, &prior, DVec2::new(20.0 + 5.0 * t, 1.0)).unwrap();
                 black_box(imm.fuse_posterior(&state, prior.available))

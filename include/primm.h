@@ -270,6 +270,9 @@ typedef struct PrimmStats {
   // Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
   // (included in `learned_predictions_missing`).
   uint64_t learned_predictions_rejected_implausible;
+  // Learned displacements rejected for a covariance that is not finite, symmetric, positive
+  // definite and of plausible size (included in `learned_predictions_missing`).
+  uint64_t learned_predictions_rejected_invalid_covariance;
   // Kalman updates refused for numerical reasons (the track coasted instead).
   uint64_t update_failures;
   // Calls to `primm_tracker_reset`.

@@ -49,7 +49,11 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
         let first = measurement(rng, spots[i % spots.len()], spread, class);
         let models = ModeModels::from_config(config.classes.get(class));
         let state = imm.initiate(&models, &first);
-        let mut prior = imm.predict(&models, &state, &PredictContext { dt_s: 0.05, displacement_m: None });
+        let mut prior = imm.predict(
+            &models,
+            &state,
+            &PredictContext { dt_s: 0.05, displacement_m: None, displacement_covariance_m2: None },
+        );
         prior.fused.mean = measurement(rng, spots[i % spots.len()], spread, class).position();
         tracks.push(Track::new(i as u64, &first, 0.0, state));
         priors.push(prior);
@@ -176,7 +180,11 @@ fn tracks_far_apart_are_paired_without_the_solver() {
         let mut first = measurement(&mut rng, position, 0.1, ObjectClass::Car);
         first.radial_velocity_mps = 1.0;
         let state = imm.initiate(&models, &first);
-        let mut prior = imm.predict(&models, &state, &PredictContext { dt_s: 0.05, displacement_m: None });
+        let mut prior = imm.predict(
+            &models,
+            &state,
+            &PredictContext { dt_s: 0.05, displacement_m: None, displacement_covariance_m2: None },
+        );
         prior.fused.mean = position;
         tracks.push(Track::new(i, &first, 0.0, state));
         priors.push(prior);

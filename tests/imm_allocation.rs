@@ -21,8 +21,11 @@ fn ten_thousand_imm_cycles_allocate_nothing() {
         for step in 0..10_000u32 {
             let dt = 0.02 + 0.01 * f64::from(step % 5);
             let displacement = (step % 7 != 0).then_some(DVec2::new(0.2, 0.05));
-            let prior =
-                imm.predict(&models, &state, &PredictContext { dt_s: dt, displacement_m: displacement });
+            let prior = imm.predict(
+                &models,
+                &state,
+                &PredictContext { dt_s: dt, displacement_m: displacement, displacement_covariance_m2: None },
+            );
             let z = DVec2::new(20.0 + 0.2 * f64::from(step) * dt, 1.0);
             state = if step % 11 == 0 { imm.coast(&prior) } else { imm.update(&models, &prior, z).unwrap() };
             std::hint::black_box(imm.fuse_posterior(&state, prior.available));

@@ -57,7 +57,7 @@ proptest! {
             let displacement = if step % 4 < missing_predictions { None } else {
                 Some(velocity * dt + DVec2::new(common::standard_normal(&mut rng), common::standard_normal(&mut rng)) * 0.3)
             };
-            let prior = imm.predict(&models, &state, &PredictContext { dt_s: dt, displacement_m: displacement });
+            let prior = imm.predict(&models, &state, &PredictContext { dt_s: dt, displacement_m: displacement, displacement_covariance_m2: None });
             // Occasionally coast, occasionally a wild outlier.
             state = if step % 17 == 0 {
                 imm.coast(&prior)

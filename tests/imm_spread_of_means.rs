@@ -194,7 +194,7 @@ fn the_fused_prior_covariance_includes_the_spread_of_the_mode_priors() {
         // A prior whose physics modes are already predicted (the hand-built positions) and whose
         // PR mode waits at its starting point.
         let mut prior = ImmPrior { state: state(c), available: ModeSet::ALL, ..ImmPrior::default() };
-        let given = with_displacement.then_some(displacement);
+        let given = with_displacement.then_some(displacement.into());
         imm.complete_prior_in_place(&models, &mut prior, 0.05, given);
 
         let mut positions = POSITIONS;

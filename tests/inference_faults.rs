@@ -15,7 +15,7 @@ use primm_core::config::Config;
 use primm_core::invariants::check_tracker;
 use primm_core::measurement::Frame;
 use primm_core::mode::Method;
-use primm_core::predictor::{DisplacementPredictor, PredictionRequest};
+use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
 use primm_core::tracker::{StepSummary, Tracker};
 use primm_predictor::threaded::{ShutdownOutcome, ThreadedPredictor};
 use std::sync::mpsc::{channel, Receiver};
@@ -119,7 +119,7 @@ enum Behaviour {
 struct FaultyPredictor {
     behaviour: Behaviour,
     selection: Selection,
-    answers: Vec<Option<DVec2>>,
+    answers: Vec<Option<Displacement>>,
     wrong_in_latest_batch: Arc<Mutex<usize>>,
 }
 
@@ -153,12 +153,12 @@ impl DisplacementPredictor for FaultyPredictor {
                 }
                 _ => plausible(request),
             };
-            self.answers.push(Some(answer));
+            self.answers.push(Some(answer.into()));
         }
         *self.wrong_in_latest_batch.lock().unwrap() = wrong;
     }
 
-    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+    fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
         displacements.copy_from_slice(&self.answers[..displacements.len()]);
     }
 }
@@ -273,15 +273,17 @@ fn absurd_displacements_are_rejected_as_implausible_for_every_track_or_some() {
 fn a_displacement_just_above_the_configured_speed_bound_is_implausible_and_one_below_is_used() {
     // Every answer moves 30 m/s over its step; a bound of 29 m/s rejects all, 31 m/s none.
     #[derive(Default)]
-    struct Speed(Vec<Option<DVec2>>);
+    struct Speed(Vec<Option<Displacement>>);
     impl DisplacementPredictor for Speed {
         fn submit(&mut self, requests: &[PredictionRequest]) {
             self.0.clear();
             for request in requests {
-                self.0.push(Some(DVec2::new(30.0 * (request.prediction_time_s - request.step_start_s), 0.0)));
+                self.0.push(Some(
+                    DVec2::new(30.0 * (request.prediction_time_s - request.step_start_s), 0.0).into(),
+                ));
             }
         }
-        fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+        fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
             displacements.copy_from_slice(&self.0);
         }
     }
@@ -437,7 +439,7 @@ fn shutdown_joins_a_healthy_inference_thread_and_detaches_a_hung_one() {
     hung.set_shutdown_wait(Duration::from_millis(50));
     hung.set_deadline(SHORT_DEADLINE);
     let request = PredictionRequest { len: 1, prediction_time_s: 1.0, ..Default::default() };
-    let mut out = [Some(DVec2::ZERO)];
+    let mut out = [Some(Displacement::new(DVec2::ZERO))];
     hung.predict(&[request], &mut out);
     assert_eq!(out, [None]);
     assert_eq!(hung.stats().deadline_misses, 1);
@@ -455,13 +457,13 @@ fn a_predictor_that_hangs_from_its_first_call_does_not_block_construction_and_is
                 std::thread::park();
             }
         }
-        fn collect(&mut self, _displacements: &mut [Option<DVec2>]) {}
+        fn collect(&mut self, _displacements: &mut [Option<Displacement>]) {}
     }
     let mut threaded = ThreadedPredictor::new(HangsAlways, SHORT_DEADLINE).unwrap();
     assert!(threaded.is_inference_thread_hung());
     assert_eq!(threaded.stats().inference_hangs_detected, 1);
     let request = PredictionRequest { len: 1, prediction_time_s: 1.0, ..Default::default() };
-    let mut out = [Some(DVec2::ZERO)];
+    let mut out = [Some(Displacement::new(DVec2::ZERO))];
     threaded.predict(&[request], &mut out);
     assert_eq!(out, [None], "the frame goes without and does not wait for the hung thread");
     assert_eq!(threaded.stats().inference_hangs_detected, 1, "still the same episode");

@@ -28,6 +28,7 @@ mod imm_behaviour;
 mod imm_properties;
 mod imm_spread_of_means;
 mod inference_faults;
+mod learned_covariance;
 mod logging;
 mod motion_models;
 mod predictor_allocation;

@@ -143,7 +143,10 @@ fn constant_velocity_converges_to_the_true_state_on_noise_free_straight_motion()
         let dt = 0.03 + 0.04 * ((k * 7) % 5) as f64 / 4.0;
         t += dt;
         let truth = DVec2::new(start[0] + velocity_x * t, start[1] + velocity_y * t);
-        let prior = model.predict(&estimate, &PredictContext { dt_s: dt, displacement_m: None });
+        let prior = model.predict(
+            &estimate,
+            &PredictContext { dt_s: dt, displacement_m: None, displacement_covariance_m2: None },
+        );
         estimate = kalman_update(&prior, truth, &model.measurement_noise()).unwrap().posterior;
     }
     let truth = Vector4::new(start[0] + velocity_x * t, start[1] + velocity_y * t, velocity_x, velocity_y);
@@ -223,7 +226,7 @@ fn linear_predictions_equal_the_dense_textbook_products() {
     let config = common::config();
     let models = ModeModels::from_config(&config.classes.car);
     for dt in [0.0, 0.015, 0.07, 0.4] {
-        let context = PredictContext { dt_s: dt, displacement_m: None };
+        let context = PredictContext { dt_s: dt, displacement_m: None, displacement_covariance_m2: None };
         let cv = Gaussian::new(Vector4::new(1.0, -2.0, 3.0, 0.5), spd::<4>(&mut rng));
         let f = ConstantVelocity::transition(dt);
         let expected = f * cv.covariance * f.transpose() + models.constant_velocity.process_noise(dt);
@@ -247,11 +250,34 @@ fn coordinated_turn_prediction_equals_the_dense_jacobian_product() {
     let models = ModeModels::from_config(&config.classes.car);
     for (omega, dt) in [(0.0, 0.05), (1e-5, 0.05), (0.4, 0.015), (-1.2, 0.3)] {
         let posterior = Gaussian::new(Vector5::new(1.0, -2.0, 8.0, 1.5, omega), spd::<5>(&mut rng));
-        let context = PredictContext { dt_s: dt, displacement_m: None };
+        let context = PredictContext { dt_s: dt, displacement_m: None, displacement_covariance_m2: None };
         let j = CoordinatedTurn::jacobian(&posterior.mean, dt);
         let expected = j * posterior.covariance * j.transpose() + models.coordinated_turn.process_noise(dt);
         let predicted = models.coordinated_turn.predict(&posterior, &context);
         assert!((predicted.covariance - expected).abs().max() < 1e-12, "omega {omega} dt {dt}");
         assert_eq!(predicted.mean, CoordinatedTurn::transition(&posterior.mean, dt));
     }
+}
+
+#[test]
+fn coordinated_turn_predicts_an_absurd_turn_rate_at_its_configured_bound() {
+    let config = common::config();
+    let models = ModeModels::from_config(&config.classes.car);
+    let bound = config.classes.car.coordinated_turn.max_turn_rate_radps;
+    assert!(bound.is_finite() && bound > 0.0);
+    let mut rng = common::rng(79);
+    let context = PredictContext { dt_s: 0.05, displacement_m: None, displacement_covariance_m2: None };
+    for (omega, expected_omega) in [(50.0, bound), (-1e6, -bound), (0.5 * bound, 0.5 * bound)] {
+        let posterior = Gaussian::new(Vector5::new(1.0, -2.0, 8.0, 1.5, omega), spd::<5>(&mut rng));
+        let predicted = models.coordinated_turn.predict(&posterior, &context);
+        let mut clamped = posterior.mean;
+        clamped[ct::OMEGA] = expected_omega;
+        // The mean moves as from the clamped turn rate, and the turn rate stays at the bound.
+        assert_eq!(predicted.mean, CoordinatedTurn::transition(&clamped, 0.05), "omega {omega}");
+        assert_eq!(predicted.mean[ct::OMEGA], expected_omega);
+    }
+    // Without a bound (the model built by hand) the turn rate is used as it is.
+    let unbounded = CoordinatedTurn { max_turn_rate_radps: f64::INFINITY, ..models.coordinated_turn };
+    let posterior = Gaussian::new(Vector5::new(1.0, -2.0, 8.0, 1.5, 50.0), spd::<5>(&mut rng));
+    assert_eq!(unbounded.predict(&posterior, &context).mean[ct::OMEGA], 50.0);
 }

@@ -5,10 +5,9 @@ use crate::common;
 use crate::common::counting_allocator;
 
 use counting_allocator::{allocations, count_allocations};
-use glam::DVec2;
 use primm_core::config::Config;
 use primm_core::measurement::Frame;
-use primm_core::predictor::{DisplacementPredictor, PredictionRequest};
+use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::OnnxPredictor;
 use primm_predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
@@ -27,8 +26,8 @@ struct CountingPredictor {
 
 impl DisplacementPredictor for CountingPredictor {
     fn submit(&mut self, _requests: &[PredictionRequest]) {}
-    fn collect(&mut self, _displacements: &mut [Option<DVec2>]) {}
-    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+    fn collect(&mut self, _displacements: &mut [Option<Displacement>]) {}
+    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<Displacement>]) {
         let before = allocations();
         self.inner.predict(requests, displacements);
         self.allocations.fetch_add(allocations() - before, Ordering::Relaxed);

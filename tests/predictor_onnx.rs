@@ -176,7 +176,7 @@ fn a_rotated_history_gets_the_rotated_displacement() {
             .collect();
         let mut out = [None];
         predictor.predict(&[PredictionRequest::from_history(&history(&rotated), 0.105)], &mut out);
-        out[0].unwrap()
+        out[0].unwrap().mean_m
     };
     let base = predict(&mut predictor, 0.0);
     assert!(base.length() > 1e-3, "the model predicts motion: {base}");
@@ -205,13 +205,13 @@ fn a_track_measured_in_the_previous_frame_gets_the_model_output_and_a_coasting_t
     predictor.predict(&[fresh, coasting], &mut out);
     let fresh_expected = run_one(&mut model, &fresh);
     let coasting_expected = run_one(&mut model, &coasting) - run_one(&mut model, &coasting.at_time(0.12));
-    assert!((out[0].unwrap() - fresh_expected).length() < 1e-6);
-    assert!((out[1].unwrap() - coasting_expected).length() < 1e-6);
+    assert!((out[0].unwrap().mean_m - fresh_expected).length() < 1e-6);
+    assert!((out[1].unwrap().mean_m - coasting_expected).length() < 1e-6);
     // Telescoping: the coasted steps add up to the displacement from the latest measurement.
     let to_first_frame = PredictionRequest::from_history(&entries, 0.12).with_step_start(0.09);
     let mut first = [None];
     predictor.predict(&[to_first_frame], &mut first);
-    let total = first[0].unwrap() + out[1].unwrap();
+    let total = first[0].unwrap().mean_m + out[1].unwrap().mean_m;
     let direct = run_one(&mut model, &PredictionRequest::from_history(&entries, 0.135));
     assert!((total - direct).length() < 1e-4, "{total} vs {direct}");
     assert_eq!(predictor.stats().rows, 3 + 1);
@@ -225,7 +225,7 @@ fn unusable_requests_get_none_and_the_rest_of_the_batch_is_predicted() {
     let empty = PredictionRequest::default();
     let mut broken = good;
     broken.features[0][2] = f32::NAN;
-    let mut out = [Some(DVec2::ZERO); 3];
+    let mut out = [Some(DVec2::ZERO.into()); 3];
     predictor.predict(&[good, empty, broken], &mut out);
     assert!(out[0].is_some());
     assert_eq!(out[1], None);

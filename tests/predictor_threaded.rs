@@ -8,7 +8,7 @@
 //! Frames that must get their results wait [`PATIENT`], a deadline no loaded machine reaches.
 
 use glam::DVec2;
-use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest};
+use primm_core::predictor::{Displacement, DisplacementPredictor, HistoryEntry, PredictionRequest};
 use primm_predictor::onnx::OnnxPredictor;
 use primm_predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
 use std::path::Path;
@@ -78,8 +78,8 @@ impl Gate {
 
 impl DisplacementPredictor for Echo {
     fn submit(&mut self, _requests: &[PredictionRequest]) {}
-    fn collect(&mut self, _displacements: &mut [Option<DVec2>]) {}
-    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+    fn collect(&mut self, _displacements: &mut [Option<Displacement>]) {}
+    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<Displacement>]) {
         let batch = self.batches;
         self.batches += 1;
         self.thread_names.lock().unwrap().push(std::thread::current().name().unwrap_or("").to_string());
@@ -96,7 +96,7 @@ impl DisplacementPredictor for Echo {
             panic!("inference blew up (deliberately, batch {batch})");
         }
         for (request, out) in requests.iter().zip(displacements.iter_mut()) {
-            *out = Some(request.anchor_m / 1000.0);
+            *out = Some((request.anchor_m / 1000.0).into());
         }
     }
 }
@@ -116,8 +116,8 @@ fn requests(frame: usize, count: usize) -> Vec<PredictionRequest> {
         .collect()
 }
 
-fn expected(frame: usize, i: usize) -> Option<DVec2> {
-    Some(DVec2::new((frame * 100 + i) as f64, 1.0) / 1000.0)
+fn expected(frame: usize, i: usize) -> Option<Displacement> {
+    Some((DVec2::new((frame * 100 + i) as f64, 1.0) / 1000.0).into())
 }
 
 #[test]
@@ -151,7 +151,7 @@ fn a_missed_deadline_costs_that_frame_only_and_its_late_results_are_discarded() 
     let mut outcomes = Vec::new();
     for frame in 0..4 {
         let batch = requests(frame, 3);
-        let mut out = vec![Some(DVec2::splat(-1.0)); 3];
+        let mut out = vec![Some(DVec2::splat(-1.0).into()); 3];
         if frame == 1 {
             predictor.set_deadline(Duration::from_millis(40));
         }
@@ -191,7 +191,7 @@ fn with_both_buffers_held_by_a_stalled_inference_frames_go_without_and_recover()
     // queue behind the held one: missed too. Frame 2: no free buffer, nothing submitted.
     for frame in 0..3 {
         let batch = requests(frame, 2);
-        let mut out = vec![Some(DVec2::ZERO); 2];
+        let mut out = vec![Some(DVec2::ZERO.into()); 2];
         predictor.predict(&batch, &mut out);
         assert_eq!(out, vec![None, None], "frame {frame}");
     }
@@ -235,7 +235,7 @@ fn a_panicking_inference_retires_the_predictor_and_later_frames_go_without() {
     let mut results = Vec::new();
     for frame in 0..4 {
         let batch = requests(frame, 2);
-        let mut out = vec![Some(DVec2::ZERO); 2];
+        let mut out = vec![Some(DVec2::ZERO.into()); 2];
         predictor.predict(&batch, &mut out);
         results.push(out);
     }
@@ -250,7 +250,7 @@ fn a_panicking_inference_retires_the_predictor_and_later_frames_go_without() {
 #[test]
 fn a_batch_larger_than_the_buffers_goes_without() {
     let mut predictor = ThreadedPredictor::with_capacity(Echo::new(), PATIENT, 4).unwrap();
-    let mut out = vec![Some(DVec2::ZERO); 5];
+    let mut out = vec![Some(DVec2::ZERO.into()); 5];
     predictor.predict(&requests(0, 5), &mut out);
     assert!(out.iter().all(Option::is_none));
     assert_eq!(predictor.stats().frames_too_large, 1);
@@ -272,10 +272,10 @@ fn dropping_the_predictor_stops_its_thread() {
         fn submit(&mut self, r: &[PredictionRequest]) {
             self.0.submit(r)
         }
-        fn collect(&mut self, d: &mut [Option<DVec2>]) {
+        fn collect(&mut self, d: &mut [Option<Displacement>]) {
             self.0.collect(d)
         }
-        fn predict(&mut self, r: &[PredictionRequest], d: &mut [Option<DVec2>]) {
+        fn predict(&mut self, r: &[PredictionRequest], d: &mut [Option<Displacement>]) {
             self.0.predict(r, d)
         }
     }

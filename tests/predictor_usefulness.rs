@@ -89,7 +89,7 @@ fn the_model_predicts_the_next_displacement_far_better_than_constant_velocity_fr
                 let velocity = DVec2::new(latest.x_m - previous.x_m, latest.y_m - previous.y_m)
                     / (latest.timestamp_s - previous.timestamp_s);
                 let extrapolated = velocity * (next.timestamp_s - latest.timestamp_s);
-                let prediction = prediction.expect("every request is answered");
+                let prediction = prediction.expect("every request is answered").mean_m;
                 model.push(prediction - truth);
                 two_point.push(extrapolated - truth);
                 still.push(-truth);

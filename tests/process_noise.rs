@@ -111,7 +111,12 @@ fn noise_added_by_prediction<const N: usize>(
     dt: f64,
 ) -> SMatrix<f64, N, N> {
     let certain = Gaussian::new(mean, SMatrix::zeros());
-    model.predict(&certain, &PredictContext { dt_s: dt, displacement_m: None }).covariance
+    model
+        .predict(
+            &certain,
+            &PredictContext { dt_s: dt, displacement_m: None, displacement_covariance_m2: None },
+        )
+        .covariance
 }
 
 #[test]

@@ -19,6 +19,7 @@ use primm_core::imm::{Imm, ImmPrior};
 use primm_core::measurement::{Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::motion::ModeModels;
+use primm_core::predictor::Displacement;
 use primm_core::track::Track;
 use primm_core::track_loops::{self, ClassModels, LoopVersion};
 use primm_core::tracker::Tracker;
@@ -93,8 +94,8 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
         assert_eq!(bits(&dispatched), bits(&baseline), "{method}: predict_physics, wide vs baseline");
 
         // Every third track without a learned displacement.
-        let displacements: Vec<Option<DVec2>> = (0..tracks.len())
-            .map(|i| (i % 3 != 0).then(|| DVec2::new(0.4 + 0.01 * i as f64, -0.05)))
+        let displacements: Vec<Option<Displacement>> = (0..tracks.len())
+            .map(|i| (i % 3 != 0).then(|| DVec2::new(0.4 + 0.01 * i as f64, -0.05).into()))
             .collect();
         track_loops::complete_priors(&imm, &models, &tracks, dt_s, &displacements, &mut dispatched);
         for ((track, prior), displacement) in tracks.iter().zip(plain.iter_mut()).zip(&displacements) {

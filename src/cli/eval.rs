@@ -1,6 +1,6 @@
 //! `primm eval`: every method on every sequence of a data set, printed as the paper's tables.
 
-use clap::Args as ClapArgs;
+use clap::{Args as ClapArgs, ValueEnum};
 use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_core::predictor::DisplacementPredictor;
@@ -20,6 +20,29 @@ use std::path::{Path, PathBuf};
 
 /// Seed of the measurement removal for the missed-detection rows of Table V.
 pub const DEFAULT_MISS_SEED: u64 = 2024;
+
+/// What the one-step prior is scored against (RMSE, Tables II to VI).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum Truth {
+    /// The true object centre, where the data knows it (simulated data); the measurement
+    /// elsewhere.
+    #[default]
+    Centre,
+    /// The measurement that updated the track, i.e. the next measurement after the prior: the
+    /// paper's protocol on RadarScenes, where object-level measurements are the only truth.
+    /// True positions in the data are ignored altogether (also for the scenario subsets).
+    Measurement,
+}
+
+impl Truth {
+    /// The name used on the command line and in the JSON.
+    pub fn key(self) -> &'static str {
+        match self {
+            Truth::Centre => "centre",
+            Truth::Measurement => "measurement",
+        }
+    }
+}
 
 /// Arguments of `primm eval`.
 #[derive(Debug, Clone, ClapArgs)]
@@ -56,6 +79,10 @@ pub struct Args {
     /// Seed of the measurement removal for the missed-detection rows.
     #[arg(long, default_value_t = DEFAULT_MISS_SEED)]
     pub miss_seed: u64,
+    /// Reference of the RMSE: `centre` (the true object centre where the data has it) or
+    /// `measurement` (the next measurement, the paper's RadarScenes protocol).
+    #[arg(long, value_enum, default_value_t = Truth::Centre)]
+    pub truth: Truth,
 }
 
 /// Why `primm eval` failed.
@@ -103,9 +130,12 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
         },
         args.tracking_frame,
     );
-    let sequences = read_dataset_dir(&args.data)?;
+    let mut sequences = read_dataset_dir(&args.data)?;
     if sequences.is_empty() {
         return Err(EvaluateError::NoData { dir: args.data.clone() });
+    }
+    if args.truth == Truth::Measurement {
+        forget_true_positions(&mut sequences);
     }
     let measurements: usize = sequences.iter().map(Sequence::measurement_count).sum();
     eprintln!("{} sequences, {} measurements from {}", sequences.len(), measurements, args.data.display());
@@ -162,15 +192,35 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
         eprintln!("{method}: {} sequences in {:.1} s", sequences.len(), started.elapsed().as_secs_f64());
     }
 
+    println!("RMSE reference: {}\n", truth_description(args.truth));
     println!("{}", report.to_text());
     if let Some(path) = &args.json {
-        report.write_json(path)?;
+        let mut json = report.to_json();
+        json["truth"] = serde_json::Value::from(args.truth.key());
+        let text = serde_json::to_string_pretty(&json).map_err(EvalError::from)?;
+        std::fs::write(path, text + "\n")?;
         eprintln!("wrote {}", path.display());
     }
     if let Some(dir) = &args.plots {
         write_plots(dir, &report, &ground_truth, &panels, &sequences[plot_sequence].name)?;
     }
     Ok(())
+}
+
+/// Drops every true position, so that every measurement is its own reference.
+fn forget_true_positions(sequences: &mut [Sequence]) {
+    for frame in sequences.iter_mut().flat_map(|sequence| sequence.frames.iter_mut()) {
+        for measurement in &mut frame.measurements {
+            measurement.true_position = None;
+        }
+    }
+}
+
+fn truth_description(truth: Truth) -> &'static str {
+    match truth {
+        Truth::Centre => "the true object centre where the data has it (--truth centre)",
+        Truth::Measurement => "the next measurement of the object (--truth measurement)",
+    }
 }
 
 /// Re-tracks `sequence` with `percent` % of its measurements removed (the same removal for every

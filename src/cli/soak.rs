@@ -260,10 +260,11 @@ fn print_report<P: DisplacementPredictor>(
         max_tracks
     );
     println!(
-        "  learned predictions: {} missing, {} rejected non-finite, {} rejected implausible",
+        "  learned predictions: {} missing, {} rejected non-finite, {} rejected implausible, {} rejected for their covariance",
         stats.learned_predictions_missing,
         stats.learned_predictions_rejected_non_finite,
-        stats.learned_predictions_rejected_implausible
+        stats.learned_predictions_rejected_implausible,
+        stats.learned_predictions_rejected_invalid_covariance
     );
     if let Some(report) = tracker.predictor().report() {
         println!("  {report}");

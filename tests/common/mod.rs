@@ -186,11 +186,11 @@ pub struct LaneOracle {
 
 impl primm_core::predictor::DisplacementPredictor for LaneOracle {
     fn submit(&mut self, _requests: &[primm_core::predictor::PredictionRequest]) {}
-    fn collect(&mut self, _displacements: &mut [Option<glam::DVec2>]) {}
+    fn collect(&mut self, _displacements: &mut [Option<primm_core::predictor::Displacement>]) {}
     fn predict(
         &mut self,
         requests: &[primm_core::predictor::PredictionRequest],
-        displacements: &mut [Option<glam::DVec2>],
+        displacements: &mut [Option<primm_core::predictor::Displacement>],
     ) {
         for (request, out) in requests.iter().zip(displacements.iter_mut()) {
             let step = -f64::from(request.features[request.len - 1][4]);
@@ -200,7 +200,7 @@ impl primm_core::predictor::DisplacementPredictor for LaneOracle {
                 let db = (glam::DVec2::from(b.position(t)) - request.anchor_m).length();
                 da.total_cmp(&db)
             });
-            *out = nearest.map(|o| glam::DVec2::from(o.velocity) * step);
+            *out = nearest.map(|o| (glam::DVec2::from(o.velocity) * step).into());
         }
     }
 }

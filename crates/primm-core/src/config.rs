@@ -47,6 +47,9 @@ pub struct Config {
 /// * `max_displacement_speed_mps` applies wherever the tracker runs: every displacement a
 ///   predictor returns is checked against it before the PR mode uses it
 ///   (`crates/primm-core/src/displacement_check.rs`).
+/// * `process_noise` and `learned_process_noise_scale` choose the PR mode's `Q_PR`
+///   (`eq:pr_cov`): the model's own covariance of each displacement, scaled, or the per-class
+///   constant `classes.*.learned.process_noise_m2` of the paper.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
@@ -59,12 +62,36 @@ pub struct PredictorConfig {
     /// speed times the step's duration (`prediction_time_s − step_start_s` of its request) is
     /// rejected as implausible and counted, and the PR mode sits the frame out for that track.
     pub max_displacement_speed_mps: f64,
+    /// Where the PR mode's `Q_PR` comes from.
+    pub process_noise: LearnedProcessNoise,
+    /// Factor on the model's covariance when `process_noise` is
+    /// [`Learned`](LearnedProcessNoise::Learned), dimensionless (> 0).
+    pub learned_process_noise_scale: f64,
 }
 
 impl Default for PredictorConfig {
     fn default() -> Self {
-        Self { deadline_ms: 5.0, max_displacement_speed_mps: 100.0 }
+        Self {
+            deadline_ms: 5.0,
+            max_displacement_speed_mps: 100.0,
+            process_noise: LearnedProcessNoise::Learned,
+            learned_process_noise_scale: 1.0,
+        }
     }
+}
+
+/// The source of the PR mode's process noise `Q_PR` (`eq:pr_cov`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum LearnedProcessNoise {
+    /// The model's covariance of each displacement, times `learned_process_noise_scale`: a
+    /// per-track, per-step `Q_PR`. A model without an uncertainty output, or an answer without
+    /// one, falls back to the constant.
+    #[default]
+    Learned,
+    /// The per-class constant `classes.*.learned.process_noise_m2`, as in the paper.
+    Constant,
 }
 
 impl PredictorConfig {
@@ -199,6 +226,19 @@ pub struct CoordinatedTurnConfig {
     pub turn_rate_psd_rad2_per_s3: f64,
     /// Standard deviation of the initial turn rate, rad/s.
     pub initial_turn_rate_std_radps: f64,
+    /// Largest turn rate the model predicts with, rad/s: a larger estimate is clamped to it
+    /// before each prediction (absent: [`DEFAULT_MAX_TURN_RATE_RADPS`]).
+    #[cfg_attr(feature = "serde", serde(default = "default_max_turn_rate_radps"))]
+    pub max_turn_rate_radps: f64,
+}
+
+/// The default of `coordinated_turn.max_turn_rate_radps`, rad/s: a car turning on a 3 m radius
+/// at 6 m/s, and well above what pedestrians and two-wheelers sustain over a radar frame.
+pub const DEFAULT_MAX_TURN_RATE_RADPS: f64 = 2.0;
+
+#[cfg(feature = "serde")]
+fn default_max_turn_rate_radps() -> f64 {
+    DEFAULT_MAX_TURN_RATE_RADPS
 }
 
 /// Learned-predictor (PR) noise (`eq:pr_cov`).
@@ -267,6 +307,7 @@ impl Default for Config {
                         acceleration_psd_m2_per_s3: 0.5,
                         turn_rate_psd_rad2_per_s3: 0.3,
                         initial_turn_rate_std_radps: 0.3,
+                        max_turn_rate_radps: DEFAULT_MAX_TURN_RATE_RADPS,
                     },
                     learned: LearnedConfig {
                         process_noise_covariance_m2: diagonal(0.011, 0.011),
@@ -287,6 +328,7 @@ impl Default for Config {
                         acceleration_psd_m2_per_s3: 0.25,
                         turn_rate_psd_rad2_per_s3: 0.25,
                         initial_turn_rate_std_radps: 0.5,
+                        max_turn_rate_radps: DEFAULT_MAX_TURN_RATE_RADPS,
                     },
                     learned: LearnedConfig {
                         process_noise_covariance_m2: diagonal(0.0006, 0.0006),
@@ -307,6 +349,7 @@ impl Default for Config {
                         acceleration_psd_m2_per_s3: 1.5,
                         turn_rate_psd_rad2_per_s3: 0.5,
                         initial_turn_rate_std_radps: 0.4,
+                        max_turn_rate_radps: DEFAULT_MAX_TURN_RATE_RADPS,
                     },
                     learned: LearnedConfig {
                         process_noise_covariance_m2: diagonal(0.05, 0.05),
@@ -463,6 +506,7 @@ fn validate_tracker_and_predictor(
         return Err(invalid("predictor.deadline_ms", "must be at most 1000 ms (one second)"));
     }
     positive("predictor.max_displacement_speed_mps", predictor.max_displacement_speed_mps)?;
+    positive("predictor.learned_process_noise_scale", predictor.learned_process_noise_scale)?;
     positive("tracker.max_coast_s", tracker.max_coast_s)?;
     positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
     if tracker.confirmation_hits == 0 {
@@ -502,6 +546,7 @@ fn validate_class(class: ObjectClass, section: &ClassConfig) -> Result<(), Confi
         &key("coordinated_turn.initial_turn_rate_std_radps"),
         section.coordinated_turn.initial_turn_rate_std_radps,
     )?;
+    positive(&key("coordinated_turn.max_turn_rate_radps"), section.coordinated_turn.max_turn_rate_radps)?;
     covariance(&key("learned.process_noise_covariance_m2"), &section.learned.process_noise_covariance_m2)?;
     covariance(
         &key("learned.measurement_noise_covariance_m2"),

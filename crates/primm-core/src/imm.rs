@@ -20,7 +20,9 @@
 //! way), the others sharing `1 − c_PR`.
 
 use crate::config::ImmConfig;
-use crate::gaussian::{kalman_update_into, replace_position, Gaussian, PositionEstimate, UpdateError};
+use crate::gaussian::{
+    kalman_update_into, replace_position, to_glam, to_nalgebra, Gaussian, PositionEstimate, UpdateError,
+};
 use crate::measurement::Measurement;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
 use crate::motion::constant_acceleration::index as ca;
@@ -31,6 +33,7 @@ use crate::motion::{
     PredictContext,
 };
 use crate::pose::RigidTransform;
+use crate::predictor::Displacement;
 use glam::{DMat2, DVec2};
 
 /// Mode probabilities in primm's mode order (PR, CV, CA, CT); inactive modes hold 0.
@@ -426,7 +429,11 @@ impl Imm {
     pub fn predict(&self, models: &ModeModels, posterior: &ImmState, context: &PredictContext) -> ImmPrior {
         let mut prior = ImmPrior::default();
         self.predict_physics_into(models, posterior, context.dt_s, &mut prior);
-        self.complete_prior_in_place(models, &mut prior, context.dt_s, context.displacement_m);
+        let displacement = context.displacement_m.map(|mean_m| Displacement {
+            mean_m,
+            covariance_m2: context.displacement_covariance_m2.as_ref().map(to_glam),
+        });
+        self.complete_prior_in_place(models, &mut prior, context.dt_s, displacement);
         prior
     }
 
@@ -446,7 +453,7 @@ impl Imm {
     ) {
         let c = self.prior_probabilities(&posterior.probabilities);
         let positions = mode_positions(posterior, self.modes);
-        let context = &PredictContext { dt_s, displacement_m: None };
+        let context = &PredictContext { dt_s, displacement_m: None, displacement_covariance_m2: None };
         let state = &mut prior.state;
         state.probabilities = c;
         state.learned_velocity_mps = posterior.learned_velocity_mps;
@@ -473,18 +480,24 @@ impl Imm {
         models: &ModeModels,
         prior: &mut ImmPrior,
         dt_s: f64,
-        displacement_m: Option<DVec2>,
+        displacement: Option<Displacement>,
     ) {
         let state = &mut prior.state;
         if self.modes.contains(Mode::Learned) {
-            let context = PredictContext { dt_s, displacement_m };
+            let context = PredictContext {
+                dt_s,
+                displacement_m: displacement.map(|d| d.mean_m),
+                displacement_covariance_m2: displacement
+                    .and_then(|d| d.covariance_m2)
+                    .map(|q| to_nalgebra(&q)),
+            };
             state.learned = models.learned.predict(&state.learned, &context);
-            if let Some(displacement) = displacement_m {
-                state.learned_velocity_mps = displacement / dt_s;
+            if let Some(displacement) = displacement {
+                state.learned_velocity_mps = displacement.mean_m / dt_s;
             }
         }
         let mut available = self.modes;
-        if displacement_m.is_none() && self.modes.len() > 1 {
+        if displacement.is_none() && self.modes.len() > 1 {
             available = available.without(Mode::Learned);
         }
         prior.available = available;

@@ -20,7 +20,7 @@
 
 use alloc::boxed::Box;
 use alloc::string::String;
-use glam::DVec2;
+use glam::{DMat2, DVec2};
 
 pub use crate::limits::MAX_HISTORY;
 /// Features per history step: `[x − x_{k−1}, y − y_{k−1}, v_r, RCS, t − t_k]`.
@@ -111,6 +111,36 @@ impl PredictionRequest {
     }
 }
 
+/// A predictor's answer for one track and step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Displacement {
+    /// The displacement over the tracker step (see the module documentation), m.
+    pub mean_m: DVec2,
+    /// The covariance of the displacement's error as the model estimates it, m² (symmetric,
+    /// positive definite), or `None` from a model without an uncertainty output. With one, and
+    /// `predictor.process_noise = "learned"`, it is the PR mode's `Q_PR` of this track and step
+    /// (`eq:pr_cov`); otherwise the configured constant `Q_PR` is used.
+    pub covariance_m2: Option<DMat2>,
+}
+
+impl Displacement {
+    /// A displacement without an uncertainty.
+    pub fn new(mean_m: DVec2) -> Self {
+        Self { mean_m, covariance_m2: None }
+    }
+
+    /// A displacement with the model's covariance of its error.
+    pub fn with_covariance(mean_m: DVec2, covariance_m2: DMat2) -> Self {
+        Self { mean_m, covariance_m2: Some(covariance_m2) }
+    }
+}
+
+impl From<DVec2> for Displacement {
+    fn from(mean_m: DVec2) -> Self {
+        Self::new(mean_m)
+    }
+}
+
 /// Predicts the displacement of many tracks over one tracker step (see the module
 /// documentation), in two steps so that an implementation may run the batch elsewhere (another
 /// thread) while the tracker predicts its physics modes.
@@ -120,9 +150,9 @@ pub trait DisplacementPredictor {
     /// Delivers the batch submitted last: fills `displacements[i]` for the `i`-th request
     /// (`displacements.len()` equals the batch size); `None` where no prediction is available,
     /// e.g. after a missed deadline.
-    fn collect(&mut self, displacements: &mut [Option<DVec2>]);
+    fn collect(&mut self, displacements: &mut [Option<Displacement>]);
     /// [`submit`](Self::submit) then [`collect`](Self::collect).
-    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<DVec2>]) {
+    fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<Displacement>]) {
         self.submit(requests);
         self.collect(displacements);
     }
@@ -139,7 +169,7 @@ pub struct NoPredictor;
 
 impl DisplacementPredictor for NoPredictor {
     fn submit(&mut self, _requests: &[PredictionRequest]) {}
-    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+    fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
         displacements.fill(None);
     }
 }
@@ -148,7 +178,7 @@ impl<P: DisplacementPredictor + ?Sized> DisplacementPredictor for Box<P> {
     fn submit(&mut self, requests: &[PredictionRequest]) {
         (**self).submit(requests)
     }
-    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+    fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
         (**self).collect(displacements)
     }
     fn report(&self) -> Option<String> {

@@ -17,8 +17,8 @@ use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
 use crate::measurement::{Measurement, ObjectClass};
 use crate::motion::ModeModels;
+use crate::predictor::Displacement;
 use crate::track::Track;
-use glam::DVec2;
 #[cfg(feature = "std")]
 use multiversion::multiversion;
 
@@ -58,10 +58,10 @@ pub fn complete_priors(
     models: &ClassModels,
     tracks: &[Track],
     dt_s: f64,
-    displacements_m: &[Option<DVec2>],
+    displacements: &[Option<Displacement>],
     priors: &mut [ImmPrior],
 ) {
-    complete_priors_loop(imm, models, tracks, dt_s, displacements_m, priors);
+    complete_priors_loop(imm, models, tracks, dt_s, displacements, priors);
 }
 
 #[inline(always)]
@@ -70,10 +70,10 @@ fn complete_priors_loop(
     models: &ClassModels,
     tracks: &[Track],
     dt_s: f64,
-    displacements_m: &[Option<DVec2>],
+    displacements: &[Option<Displacement>],
     priors: &mut [ImmPrior],
 ) {
-    for ((track, prior), displacement) in tracks.iter().zip(priors.iter_mut()).zip(displacements_m) {
+    for ((track, prior), displacement) in tracks.iter().zip(priors.iter_mut()).zip(displacements) {
         imm.complete_prior_in_place(&models[track.class.index()], prior, dt_s, *displacement);
     }
 }
@@ -171,10 +171,10 @@ pub mod baseline {
         models: &ClassModels,
         tracks: &[Track],
         dt_s: f64,
-        displacements_m: &[Option<DVec2>],
+        displacements: &[Option<Displacement>],
         priors: &mut [ImmPrior],
     ) {
-        complete_priors_loop(imm, models, tracks, dt_s, displacements_m, priors);
+        complete_priors_loop(imm, models, tracks, dt_s, displacements, priors);
     }
 
     /// [`update`](super::update), baseline build.

@@ -10,15 +10,15 @@
 
 use crate::association::assignment::AssignmentError;
 use crate::association::associator::{AssociationStats, Associator};
-use crate::config::{Config, ConfigError};
-use crate::displacement_check::{check_displacement, DisplacementRejection};
+use crate::config::{Config, ConfigError, LearnedProcessNoise};
+use crate::displacement_check::{check_answer, DisplacementRejection};
 use crate::gaussian::UpdateError;
 use crate::imm::{Imm, ImmPrior};
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::mode::{Mode, ModeSet};
 use crate::motion::ModeModels;
 use crate::pose::{EgoPose, RigidTransform};
-use crate::predictor::{DisplacementPredictor, NoPredictor, PredictionRequest};
+use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput, TrackStatus};
 use crate::track_loops;
@@ -101,6 +101,9 @@ pub struct TrackerStats {
     /// Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
     /// (included in `learned_predictions_missing`).
     pub learned_predictions_rejected_implausible: u64,
+    /// Learned displacements rejected for a covariance that is not finite, symmetric, positive
+    /// definite and of plausible size (included in `learned_predictions_missing`).
+    pub learned_predictions_rejected_invalid_covariance: u64,
     /// Kalman updates refused for numerical reasons (the track coasted instead).
     pub update_failures: u64,
     /// Calls to [`Tracker::reset`].
@@ -131,12 +134,14 @@ pub struct StepSummary {
     /// Tracks deleted.
     pub deleted: usize,
     /// Tracks for which the PR mode had no usable learned displacement and sat out (none given,
-    /// or rejected: the next two counts).
+    /// or rejected: the next three counts).
     pub predictions_missing: usize,
     /// Learned displacements rejected for a NaN or infinite component.
     pub predictions_rejected_non_finite: usize,
     /// Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`.
     pub predictions_rejected_implausible: usize,
+    /// Learned displacements rejected for an invalid covariance.
+    pub predictions_rejected_invalid_covariance: usize,
     /// Live tracks after the step: the number of outputs reported.
     pub live_tracks: usize,
     /// Confirmed tracks among the live ones.
@@ -163,6 +168,8 @@ impl TrackerStats {
         self.frames_with_learned_predictions_missing += u64::from(step.predictions_missing > 0);
         self.learned_predictions_rejected_non_finite += count(step.predictions_rejected_non_finite);
         self.learned_predictions_rejected_implausible += count(step.predictions_rejected_implausible);
+        self.learned_predictions_rejected_invalid_covariance +=
+            count(step.predictions_rejected_invalid_covariance);
         self.update_failures += count(step.update_failures);
         self.initiations_from_unknown_sensor += count(step.initiations_from_unknown_sensor);
         self.tracking_frame_changes += u64::from(step.tracking_frame_changed);
@@ -209,7 +216,7 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     last_pose: Option<EgoPose>,
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
-    displacements: Box<[Option<DVec2>; MAX_TRACKS]>,
+    displacements: Box<[Option<Displacement>; MAX_TRACKS]>,
     /// Each track's prior of the current frame (the first `table.len()` entries).
     priors: Box<[ImmPrior]>,
     /// Interval of the current frame, s.
@@ -478,20 +485,31 @@ impl<P: DisplacementPredictor> Tracker<P> {
             displacements.fill(None);
         } else {
             self.predictor.collect(displacements);
-            let max_speed_mps = self.config.predictor.max_displacement_speed_mps;
+            let predictor = &self.config.predictor;
             for (displacement, request) in displacements.iter_mut().zip(self.requests.iter()) {
-                let Some(value) = *displacement else { continue };
-                match check_displacement(request, value, max_speed_mps) {
-                    Ok(_) => {}
+                let Some(answer) = displacement.as_mut() else { continue };
+                let counter = match check_answer(request, answer, predictor.max_displacement_speed_mps) {
+                    Ok(()) => {
+                        answer.covariance_m2 = match predictor.process_noise {
+                            LearnedProcessNoise::Learned => {
+                                answer.covariance_m2.map(|q| q * predictor.learned_process_noise_scale)
+                            }
+                            LearnedProcessNoise::Constant => None,
+                        };
+                        continue;
+                    }
                     Err(DisplacementRejection::NonFinite) => {
-                        self.last_step.predictions_rejected_non_finite += 1;
-                        *displacement = None;
+                        &mut self.last_step.predictions_rejected_non_finite
                     }
                     Err(DisplacementRejection::Implausible) => {
-                        self.last_step.predictions_rejected_implausible += 1;
-                        *displacement = None;
+                        &mut self.last_step.predictions_rejected_implausible
                     }
-                }
+                    Err(DisplacementRejection::InvalidCovariance) => {
+                        &mut self.last_step.predictions_rejected_invalid_covariance
+                    }
+                };
+                *counter += 1;
+                *displacement = None;
             }
             self.last_step.predictions_missing = displacements.iter().filter(|d| d.is_none()).count();
         }

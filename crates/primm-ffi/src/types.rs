@@ -393,6 +393,9 @@ pub struct PrimmStats {
     /// Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
     /// (included in `learned_predictions_missing`).
     pub learned_predictions_rejected_implausible: u64,
+    /// Learned displacements rejected for a covariance that is not finite, symmetric, positive
+    /// definite and of plausible size (included in `learned_predictions_missing`).
+    pub learned_predictions_rejected_invalid_covariance: u64,
     /// Kalman updates refused for numerical reasons (the track coasted instead).
     pub update_failures: u64,
     /// Calls to `primm_tracker_reset`.
@@ -425,6 +428,7 @@ impl From<&TrackerStats> for PrimmStats {
             frames_with_learned_predictions_missing,
             learned_predictions_rejected_non_finite,
             learned_predictions_rejected_implausible,
+            learned_predictions_rejected_invalid_covariance,
             update_failures,
             resets,
         } = *stats;
@@ -451,6 +455,7 @@ impl From<&TrackerStats> for PrimmStats {
             frames_with_learned_predictions_missing,
             learned_predictions_rejected_non_finite,
             learned_predictions_rejected_implausible,
+            learned_predictions_rejected_invalid_covariance,
             update_failures,
             resets,
         }

@@ -20,7 +20,7 @@ pub fn run(data: &[u8]) {
     let Ok(config) = primm_config::from_toml_str(text) else { return };
     assert_eq!(config.validate(), Ok(()), "a parsed configuration validates again");
     let interval_s = (config.tracker.max_frame_interval_s / 2.0).min(0.05);
-    let predictor = ScriptedPredictor::new(vec![Some(DVec2::new(0.4, 0.0)), None]);
+    let predictor = ScriptedPredictor::new(vec![Some(DVec2::new(0.4, 0.0).into()), None]);
     let mut tracker = match Tracker::with_predictor(config, predictor) {
         Ok(tracker) => tracker,
         Err(error) => panic!("a validated configuration is refused by the tracker: {error}"),

@@ -12,13 +12,18 @@
 //! | [`tracker_steps::run`] | a frame sequence built with `arbitrary` | IMM and PR-IMM steps |
 //! | [`measurement_frame_bytes::run`] | raw `MeasurementFrame` images | the service's frame path |
 //! | [`config_toml::run`] | bytes of a TOML file | `primm_config`, `Config::validate`, tracker |
-//! | [`onnx_model_bytes::run`] | bytes of an ONNX file | `PrModel::from_bytes`, a prediction |
+//! | `onnx_model_bytes::run` | bytes of an ONNX file | `PrModel::from_bytes`, a prediction |
+//!
+//! The ONNX target needs tract, whose instrumented build is the bulk of the fuzz build's time;
+//! it sits behind the `onnx` feature (on by default, so the test suite replays its corpus), and
+//! the fuzz crate builds it only with `--features onnx`.
 
 pub mod config_toml;
 pub mod extrapolating_predictor;
 pub mod invariant_check;
 pub mod measurement_csv;
 pub mod measurement_frame_bytes;
+#[cfg(feature = "onnx")]
 pub mod onnx_model_bytes;
 pub mod scripted_predictor;
 pub mod tracker_steps;
@@ -28,10 +33,11 @@ pub type Target = fn(&[u8]);
 
 /// Every target with its name, which is also the name of its corpus directory
 /// (`fuzz/corpus/NAME/`) and of its cargo-fuzz binary.
-pub const TARGETS: [(&str, Target); 5] = [
+pub const TARGETS: &[(&str, Target)] = &[
     ("measurement_csv", measurement_csv::run),
     ("tracker_steps", tracker_steps::run),
     ("measurement_frame_bytes", measurement_frame_bytes::run),
     ("config_toml", config_toml::run),
+    #[cfg(feature = "onnx")]
     ("onnx_model_bytes", onnx_model_bytes::run),
 ];

@@ -4,13 +4,14 @@
 use crate::invariant_check::assert_tracker_invariants;
 use crate::scripted_predictor::ScriptedPredictor;
 use arbitrary::{Arbitrary, Unstructured};
-use glam::DVec2;
+use glam::{DMat2, DVec2};
 use primm_core::config::Config;
 use primm_core::measurement::{
     FrameView, Measurement, ObjectClass, UnknownClass, MAX_MEASUREMENTS_PER_FRAME,
 };
 use primm_core::mode::Method;
 use primm_core::pose::EgoPose;
+use primm_core::predictor::Displacement;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::tracker::Tracker;
 
@@ -129,11 +130,35 @@ pub struct FuzzFrame {
     pub ego_pose: Option<(FuzzValue, FuzzValue, FuzzValue)>,
 }
 
+/// One answer of the scripted predictor.
+#[derive(Debug, Clone, Copy, Arbitrary)]
+pub struct FuzzDisplacement {
+    /// x component, m.
+    pub dx: FuzzValue,
+    /// y component, m.
+    pub dy: FuzzValue,
+    /// The covariance's entries `[xx, yx, xy, yy]`, m², if the answer has one: any values,
+    /// asymmetric and indefinite included.
+    pub covariance: Option<[FuzzValue; 4]>,
+}
+
+impl FuzzDisplacement {
+    /// The predictor's answer.
+    pub fn displacement(self) -> Displacement {
+        Displacement {
+            mean_m: DVec2::new(self.dx.value(), self.dy.value()),
+            covariance_m2: self.covariance.map(|[xx, yx, xy, yy]| {
+                DMat2::from_cols(DVec2::new(xx.value(), yx.value()), DVec2::new(xy.value(), yy.value()))
+            }),
+        }
+    }
+}
+
 /// A whole input: the predictor's script, the start time and the frames.
 #[derive(Debug, Clone, Arbitrary)]
 pub struct FuzzScenario {
     /// The PR-IMM tracker's predictor answers, cycled; `None` entries mean "no prediction".
-    pub displacements: Vec<Option<(FuzzValue, FuzzValue)>>,
+    pub displacements: Vec<Option<FuzzDisplacement>>,
     /// The first frame's time, s.
     pub start: FuzzValue,
     /// The frames, at most [`MAX_FRAMES`] used.
@@ -173,11 +198,8 @@ impl FrameView for CodedFrame {
 /// step, rejected or not.
 pub fn run(data: &[u8]) {
     let Ok(scenario) = FuzzScenario::arbitrary_take_rest(Unstructured::new(data)) else { return };
-    let script = scenario
-        .displacements
-        .iter()
-        .map(|answer| answer.map(|(dx, dy)| DVec2::new(dx.value(), dy.value())))
-        .collect();
+    let script =
+        scenario.displacements.iter().map(|answer| answer.map(FuzzDisplacement::displacement)).collect();
     let imm_config = Config::default().with_modes(Method::Imm.modes());
     let pr_imm_config = Config::default().with_modes(Method::PrImm.modes());
     let limit_s = imm_config.tracker.max_frame_interval_s;

@@ -42,9 +42,9 @@
 //! `f(t_k) − f(t_{k−1})` otherwise. [`OnnxPredictor`] evaluates both rows in the same batch, so a
 //! frame in which `n` of `N` tracks coasted runs a batch of `N + n` rows.
 
-use glam::DVec2;
+use glam::{DMat2, DVec2};
 use primm_core::limits::MAX_TRACKS;
-use primm_core::predictor::{DisplacementPredictor, PredictionRequest, FEATURES, MAX_HISTORY};
+use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest, FEATURES, MAX_HISTORY};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -92,6 +92,21 @@ impl MotionFrame {
     pub fn from_model(&self, vector: DVec2) -> DVec2 {
         DVec2::new(self.cos * vector.x - self.sin * vector.y, self.sin * vector.x + self.cos * vector.y)
     }
+
+    /// A covariance from the model's frame back into the request's frame: `R Σ Rᵀ` with `R` the
+    /// rotation of [`from_model`](Self::from_model).
+    pub fn covariance_from_model(&self, covariance: DMat2) -> DMat2 {
+        let rotation = DMat2::from_cols(DVec2::new(self.cos, self.sin), DVec2::new(-self.sin, self.cos));
+        rotation * covariance * rotation.transpose()
+    }
+}
+
+/// The covariance `L Lᵀ` of a model's Cholesky output `[l_xx, l_yx, l_yy]` (lower triangular,
+/// m), in the model's frame.
+pub fn covariance_from_cholesky(factor: [f32; 3]) -> DMat2 {
+    let [l_xx, l_yx, l_yy] = factor.map(f64::from);
+    let lower = DMat2::from_cols(DVec2::new(l_xx, l_yx), DVec2::new(0.0, l_yy));
+    lower * lower.transpose()
 }
 
 /// Name of the model's first input.
@@ -100,6 +115,11 @@ pub const FEATURES_INPUT: &str = "features";
 pub const VALID_INPUT: &str = "valid";
 /// Name of the model's output.
 pub const DISPLACEMENT_OUTPUT: &str = "displacement";
+/// Name of the model's optional second output, the Cholesky factor of the displacement's
+/// error covariance.
+pub const CHOLESKY_OUTPUT: &str = "displacement_cholesky";
+/// Values per row of [`CHOLESKY_OUTPUT`]: `[l_xx, l_yx, l_yy]`.
+pub const CHOLESKY_VALUES: usize = 3;
 /// Name of the symbolic batch dimension (the ONNX `dim_param` of the exported model).
 pub const BATCH_SYMBOL: &str = "batch";
 
@@ -146,8 +166,8 @@ pub enum ModelError {
         /// tract's description of the problem.
         reason: String,
     },
-    /// The model's inputs are not `features` and `valid` (in this order), or it has not exactly
-    /// one output.
+    /// The model's inputs are not `features` and `valid` (in this order), or its outputs are
+    /// not `displacement`, optionally followed by `displacement_cholesky`.
     #[error("PR model {model}: expected {expected}, found {found}")]
     Signature {
         /// The model.
@@ -212,6 +232,14 @@ pub enum InferenceError {
         /// The batch size of the run.
         batch: usize,
     },
+    /// The covariance output is missing or does not have the shape `[batch, 3]`.
+    #[error("PR inference failed: covariance output shape {found:?}, expected [{batch}, 3]")]
+    CholeskyShape {
+        /// The shape the model returned (empty when the output is missing).
+        found: Vec<usize>,
+        /// The batch size of the run.
+        batch: usize,
+    },
 }
 
 impl From<TractError> for InferenceError {
@@ -236,6 +264,8 @@ struct BatchPlan {
 /// The loaded, optimised PR model: one plan per size of [`PLAN_BATCH_SIZES`].
 pub struct PrModel {
     source: ModelSource,
+    /// Whether the model has the [`CHOLESKY_OUTPUT`].
+    has_uncertainty: bool,
     /// Ascending batch sizes, as [`PLAN_BATCH_SIZES`].
     plans: Vec<BatchPlan>,
 }
@@ -285,7 +315,7 @@ impl PrModel {
         let mut model = tract_onnx::onnx()
             .model_for_read(&mut &bytes[..])
             .map_err(|error| ModelError::NotOnnx { model: source.clone(), reason: format!("{error:#}") })?;
-        check_signature(&source, &model)?;
+        let has_uncertainty = check_signature(&source, &model)?;
         let batch = model.symbols.sym(BATCH_SYMBOL).to_dim();
         let prepare = |error: TractError| ModelError::Preparation {
             model: source.clone(),
@@ -296,7 +326,10 @@ impl PrModel {
             .map_err(prepare)?;
         model.set_input_fact(1, f32::fact([batch, MAX_HISTORY.to_dim()]).into()).map_err(prepare)?;
         let typed = model.into_typed().map_err(prepare)?;
-        check_output(&source, &typed)?;
+        check_output(&source, &typed, 0, DISPLACEMENT_OUTPUT, 2)?;
+        if has_uncertainty {
+            check_output(&source, &typed, 1, CHOLESKY_OUTPUT, CHOLESKY_VALUES)?;
+        }
         let symbol = typed.symbols.sym(BATCH_SYMBOL);
         let mut plans = Vec::with_capacity(PLAN_BATCH_SIZES.len());
         for batch in PLAN_BATCH_SIZES {
@@ -310,14 +343,20 @@ impl PrModel {
             let state = plan.spawn().map_err(prepare)?;
             plans.push(BatchPlan { batch, plan, state });
         }
-        let mut loaded = PrModel { source, plans };
+        let mut loaded = PrModel { source, has_uncertainty, plans };
         // A trial run: a model that loads but cannot run fails here, at start-up.
         let mut out = [0.0f32; 2];
+        let mut factor = [0.0f32; CHOLESKY_VALUES];
         let mut features = [0.0f32; MAX_HISTORY * FEATURES];
         features[4] = -0.05;
         let mut valid = [0.0f32; MAX_HISTORY];
         valid[0] = 1.0;
-        loaded.run(&features, &valid, &mut out).map_err(|error| ModelError::Preparation {
+        let trial = if has_uncertainty {
+            loaded.run_with_uncertainty(&features, &valid, &mut out, &mut factor)
+        } else {
+            loaded.run(&features, &valid, &mut out)
+        };
+        trial.map_err(|error| ModelError::Preparation {
             model: loaded.source.clone(),
             reason: error.to_string(),
         })?;
@@ -329,6 +368,12 @@ impl PrModel {
         &self.source
     }
 
+    /// Whether the model also estimates the covariance of its displacements
+    /// ([`CHOLESKY_OUTPUT`]).
+    pub fn has_uncertainty(&self) -> bool {
+        self.has_uncertainty
+    }
+
     /// Runs one batch: `features` holds `batch × 5 × 5` values (row-major, the layout of
     /// [`PredictionRequest::features`]), `valid` `batch × 5` and `displacements` receives
     /// `batch × 2` values `[dx, dy]` in metres. A batch of zero rows does nothing.
@@ -338,10 +383,35 @@ impl PrModel {
         valid: &[f32],
         displacements: &mut [f32],
     ) -> Result<(), InferenceError> {
+        self.run_outputs(features, valid, displacements, None)
+    }
+
+    /// [`run`](Self::run), also writing the covariance output: `cholesky` receives `batch × 3`
+    /// values `[l_xx, l_yx, l_yy]` in metres (see [`covariance_from_cholesky`]). Fails with
+    /// [`InferenceError::CholeskyShape`] on a model without that output.
+    pub fn run_with_uncertainty(
+        &mut self,
+        features: &[f32],
+        valid: &[f32],
+        displacements: &mut [f32],
+        cholesky: &mut [f32],
+    ) -> Result<(), InferenceError> {
+        self.run_outputs(features, valid, displacements, Some(cholesky))
+    }
+
+    fn run_outputs(
+        &mut self,
+        features: &[f32],
+        valid: &[f32],
+        displacements: &mut [f32],
+        mut cholesky: Option<&mut [f32]>,
+    ) -> Result<(), InferenceError> {
         let batch = valid.len() / MAX_HISTORY;
+        let cholesky_ok = cholesky.as_ref().is_none_or(|values| values.len() == batch * CHOLESKY_VALUES);
         if valid.len() != batch * MAX_HISTORY
             || features.len() != batch * MAX_HISTORY * FEATURES
             || displacements.len() != batch * 2
+            || !cholesky_ok
         {
             return Err(InferenceError::InconsistentBuffers {
                 features: features.len(),
@@ -358,6 +428,7 @@ impl PrModel {
                 &features[done * MAX_HISTORY * FEATURES..],
                 &valid[done * MAX_HISTORY..],
                 &mut displacements[done * 2..],
+                cholesky.as_deref_mut().map(|values| &mut values[done * CHOLESKY_VALUES..]),
             )?;
             done += rows;
         }
@@ -371,6 +442,7 @@ impl PrModel {
         features: &[f32],
         valid: &[f32],
         displacements: &mut [f32],
+        cholesky: Option<&mut [f32]>,
     ) -> Result<usize, InferenceError> {
         let remaining = valid.len() / MAX_HISTORY;
         let index = self.plans.iter().position(|p| p.batch >= remaining).unwrap_or(self.plans.len() - 1);
@@ -385,6 +457,18 @@ impl PrModel {
         }
         let view = output.try_as_plain_ram()?;
         displacements[..rows * 2].copy_from_slice(&view.as_slice::<f32>()?[..rows * 2]);
+        if let Some(cholesky) = cholesky {
+            let output = outputs
+                .get(1)
+                .filter(|output| output.shape() == [size, CHOLESKY_VALUES])
+                .ok_or_else(|| InferenceError::CholeskyShape {
+                    found: outputs.get(1).map(|output| output.shape().to_vec()).unwrap_or_default(),
+                    batch: size,
+                })?;
+            let view = output.try_as_plain_ram()?;
+            let values = rows * CHOLESKY_VALUES;
+            cholesky[..values].copy_from_slice(&view.as_slice::<f32>()?[..values]);
+        }
         Ok(rows)
     }
 }
@@ -407,9 +491,19 @@ fn describe(fact: &InferenceFact) -> String {
     format!("type {:?}, shape [{}{open}]", fact.datum_type, dims.join(", "))
 }
 
-fn check_signature(source: &ModelSource, model: &InferenceModel) -> Result<(), ModelError> {
+/// Checks the inputs and outputs by name and the inputs' shapes; returns whether the model has
+/// the covariance output.
+fn check_signature(source: &ModelSource, model: &InferenceModel) -> Result<bool, ModelError> {
+    // An outlet's ONNX tensor name where tract kept it, else the name of the node producing it.
     let names = |outlets: &[OutletId]| -> Vec<String> {
-        outlets.iter().map(|outlet| model.node(outlet.node).name.clone()).collect()
+        outlets
+            .iter()
+            .map(|outlet| {
+                model
+                    .outlet_label(*outlet)
+                    .map_or_else(|| model.node(outlet.node).name.clone(), str::to_string)
+            })
+            .collect()
     };
     let inputs = names(model.input_outlets().unwrap_or(&[]));
     if inputs != [FEATURES_INPUT, VALID_INPUT] {
@@ -420,13 +514,19 @@ fn check_signature(source: &ModelSource, model: &InferenceModel) -> Result<(), M
         });
     }
     let outputs = names(model.output_outlets().unwrap_or(&[]));
-    if outputs.len() != 1 {
-        return Err(ModelError::Signature {
-            model: source.clone(),
-            expected: format!("one output ({DISPLACEMENT_OUTPUT})"),
-            found: format!("outputs {outputs:?}"),
-        });
-    }
+    let has_uncertainty = match outputs.len() {
+        1 => false,
+        2 if outputs[1] == CHOLESKY_OUTPUT => true,
+        _ => {
+            return Err(ModelError::Signature {
+                model: source.clone(),
+                expected: format!(
+                    "outputs [{DISPLACEMENT_OUTPUT}] or [{DISPLACEMENT_OUTPUT}, {CHOLESKY_OUTPUT}]"
+                ),
+                found: format!("outputs {outputs:?}"),
+            });
+        }
+    };
     for (index, (name, fixed)) in
         [(FEATURES_INPUT, &[MAX_HISTORY, FEATURES][..]), (VALID_INPUT, &[MAX_HISTORY][..])]
             .into_iter()
@@ -455,25 +555,32 @@ fn check_signature(source: &ModelSource, model: &InferenceModel) -> Result<(), M
             });
         }
     }
-    Ok(())
+    Ok(has_uncertainty)
 }
 
-fn check_output(source: &ModelSource, model: &TypedModel) -> Result<(), ModelError> {
+/// Checks that output `index`, called `name`, is F32 of shape `[batch, columns]`.
+fn check_output(
+    source: &ModelSource,
+    model: &TypedModel,
+    index: usize,
+    name: &str,
+    columns: usize,
+) -> Result<(), ModelError> {
     let fact = model
-        .output_fact(0)
+        .output_fact(index)
         .map_err(|e| ModelError::Preparation { model: source.clone(), reason: format!("{e:#}") })?;
     let dims = fact.shape.dims();
     let ok = fact.datum_type == DatumType::F32
         && dims.len() == 2
-        && dims[1] == 2.to_dim()
+        && dims[1] == columns.to_dim()
         && dims[0] == model.symbols.sym(BATCH_SYMBOL).to_dim();
     if ok {
         return Ok(());
     }
     Err(ModelError::Shape {
         model: source.clone(),
-        name: DISPLACEMENT_OUTPUT.to_string(),
-        expected: format!("type F32, shape [{BATCH_SYMBOL}, 2]"),
+        name: name.to_string(),
+        expected: format!("type F32, shape [{BATCH_SYMBOL}, {columns}]"),
         found: format!(
             "type {:?}, shape [{}]",
             fact.datum_type,
@@ -506,10 +613,12 @@ pub struct OnnxPredictor {
     features: Vec<f32>,
     valid: Vec<f32>,
     output: Vec<f32>,
+    /// The covariance output of the last batch (empty for a model without one).
+    cholesky: Vec<f32>,
     /// Model row of each request (`None`: refused), of its step-start row if it has one, and
     /// the request's input frame.
     rows: Vec<(Option<usize>, Option<usize>, MotionFrame)>,
-    results: Vec<Option<DVec2>>,
+    results: Vec<Option<Displacement>>,
     stats: OnnxPredictorStats,
     last_error: Option<InferenceError>,
 }
@@ -534,6 +643,7 @@ impl OnnxPredictor {
             features: Vec::with_capacity(rows * MAX_HISTORY * FEATURES),
             valid: Vec::with_capacity(rows * MAX_HISTORY),
             output: Vec::with_capacity(rows * 2),
+            cholesky: Vec::with_capacity(rows * CHOLESKY_VALUES),
             rows: Vec::with_capacity(MAX_TRACKS),
             results: Vec::with_capacity(MAX_TRACKS),
             stats: OnnxPredictorStats::default(),
@@ -560,10 +670,17 @@ impl OnnxPredictor {
     /// [module documentation](self)) to `displacements` (same length): `None` for a refused
     /// request or a non-finite output. On an inference failure every entry is `None` and the
     /// error is returned.
+    ///
+    /// With a model that estimates its uncertainty, each displacement carries the covariance
+    /// of the model's answer at the prediction time, rotated back like the displacement. For
+    /// a track that coasted (the displacement is the difference of two answers) that is the
+    /// covariance of the displacement from the latest measurement, which bounds the one of the
+    /// step from above: the two answers' errors are strongly correlated and no model output
+    /// describes their difference.
     pub fn predict_batch(
         &mut self,
         requests: &[PredictionRequest],
-        displacements: &mut [Option<DVec2>],
+        displacements: &mut [Option<Displacement>],
     ) -> Result<(), InferenceError> {
         displacements.fill(None);
         self.features.clear();
@@ -596,15 +713,26 @@ impl OnnxPredictor {
         }
         self.output.clear();
         self.output.resize(row_count * 2, 0.0);
+        self.cholesky.clear();
         self.stats.batches += 1;
         self.stats.rows += row_count as u64;
-        if let Err(error) = self.model.run(&self.features, &self.valid, &mut self.output) {
+        let run = if self.model.has_uncertainty() {
+            self.cholesky.resize(row_count * CHOLESKY_VALUES, 0.0);
+            self.model.run_with_uncertainty(&self.features, &self.valid, &mut self.output, &mut self.cholesky)
+        } else {
+            self.model.run(&self.features, &self.valid, &mut self.output)
+        };
+        if let Err(error) = run {
             self.stats.failed_batches += 1;
             self.last_error = Some(error.clone());
             return Err(error);
         }
         let at =
             |row: usize| DVec2::new(f64::from(self.output[2 * row]), f64::from(self.output[2 * row + 1]));
+        let covariance_at = |row: usize| {
+            let values = self.cholesky.get(CHOLESKY_VALUES * row..CHOLESKY_VALUES * (row + 1))?;
+            Some(covariance_from_cholesky([values[0], values[1], values[2]]))
+        };
         for (out, &(row, start_row, frame)) in displacements.iter_mut().zip(&self.rows) {
             let Some(row) = row else { continue };
             let displacement = frame.from_model(match start_row {
@@ -612,7 +740,11 @@ impl OnnxPredictor {
                 None => at(row),
             });
             if displacement.is_finite() {
-                *out = Some(displacement);
+                *out = Some(Displacement {
+                    mean_m: displacement,
+                    covariance_m2: covariance_at(row)
+                        .map(|covariance| frame.covariance_from_model(covariance)),
+                });
                 self.stats.predictions += 1;
             } else {
                 self.stats.non_finite_outputs += 1;
@@ -657,7 +789,7 @@ impl DisplacementPredictor for OnnxPredictor {
         self.results = results;
     }
 
-    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+    fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
         displacements.fill(None);
         for (out, result) in displacements.iter_mut().zip(&self.results) {
             *out = *result;

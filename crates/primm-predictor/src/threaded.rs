@@ -49,9 +49,8 @@
 //! frame gets its learned displacements depends on timing. Offline tracking and evaluation use
 //! the synchronous predictor instead.
 
-use glam::DVec2;
 use primm_core::limits::MAX_TRACKS;
-use primm_core::predictor::{DisplacementPredictor, PredictionRequest};
+use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TryRecvError, TrySendError};
 use std::thread::JoinHandle;
@@ -85,7 +84,7 @@ struct Batch {
     sequence: u64,
     len: usize,
     requests: Box<[PredictionRequest]>,
-    displacements: Box<[Option<DVec2>]>,
+    displacements: Box<[Option<Displacement>]>,
     /// Whether the inference completed (a panic leaves every displacement `None`).
     completed: bool,
 }
@@ -448,7 +447,7 @@ impl DisplacementPredictor for ThreadedPredictor {
         }
     }
 
-    fn collect(&mut self, displacements: &mut [Option<DVec2>]) {
+    fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
         displacements.fill(None);
         let Some((sequence, deadline)) = self.awaited else { return };
         loop {

@@ -136,7 +136,8 @@ struct LogLimits {
     publish: LogLimiter,
     latency: LogLimiter,
     notify: LogLimiter,
-    /// Frames in which learned displacements were rejected (NaN, infinite or implausible).
+    /// Frames in which learned displacements were rejected (NaN, infinite, implausible or with
+    /// an invalid covariance).
     learned_rejected: LogLimiter,
 }
 
@@ -318,12 +319,15 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             Ok(step) => {
                 self.counters.frames_tracked += 1;
                 self.stream.tracker_dirty = true;
-                let rejected = step.predictions_rejected_non_finite + step.predictions_rejected_implausible;
+                let rejected = step.predictions_rejected_non_finite
+                    + step.predictions_rejected_implausible
+                    + step.predictions_rejected_invalid_covariance;
                 if rejected > 0 && self.logs.learned_rejected.occur() {
                     tracing::warn!(
                         sequence = frame.sequence,
                         non_finite = step.predictions_rejected_non_finite,
                         implausible = step.predictions_rejected_implausible,
+                        invalid_covariance = step.predictions_rejected_invalid_covariance,
                         occurrences = self.logs.learned_rejected.occurrences(),
                         "learned displacements rejected; the PR mode sat out for those tracks"
                     );
@@ -506,7 +510,8 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         format!(
             "frames: {} received, {} tracked, {} rejected, {} lost; resets: {} (stream start {}, new publisher {}, interval too long {}); \
              measurements: {} accepted, {} rejected; tracks: {} started, {} confirmed, {} deleted; \
-             learned predictions: {} missing ({} rejected non-finite, {} rejected implausible); publish failures: {}\n{}",
+             learned predictions: {} missing ({} rejected non-finite, {} rejected implausible, {} rejected for their covariance); \
+             publish failures: {}\n{}",
             c.frames_received,
             c.frames_tracked,
             c.frames_rejected,
@@ -523,6 +528,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             s.learned_predictions_missing,
             s.learned_predictions_rejected_non_finite,
             s.learned_predictions_rejected_implausible,
+            s.learned_predictions_rejected_invalid_covariance,
             c.publish_failures,
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()

@@ -31,6 +31,12 @@ pub enum BoundViolation {
         track_id: u64,
         /// The mode (the PR mode's velocity is the one implied by its last displacement).
         mode: Mode,
+        /// The mode's velocity, m/s.
+        velocity_mps: [f64; 2],
+        /// The CT mode's turn rate, rad/s (`None` for the other modes).
+        turn_rate_radps: Option<f64>,
+        /// The mode's probability.
+        probability: f64,
     },
     /// A mode's covariance trace is beyond [`MAX_COVARIANCE_TRACE`].
     CovarianceTrace {
@@ -56,8 +62,19 @@ impl std::fmt::Display for BoundViolation {
             BoundViolation::Position { track_id, mode } => {
                 write!(f, "track {track_id}: the {} position is beyond {MAX_POSITION_M} m", mode.id())
             }
-            BoundViolation::Velocity { track_id, mode } => {
-                write!(f, "track {track_id}: the {} velocity is beyond {MAX_VELOCITY_MPS} m/s", mode.id())
+            BoundViolation::Velocity { track_id, mode, velocity_mps, turn_rate_radps, probability } => {
+                write!(
+                    f,
+                    "track {track_id}: the {} velocity ({:.4e}, {:.4e}) m/s is beyond {MAX_VELOCITY_MPS} m/s \
+                     (mode probability {probability:.3e}",
+                    mode.id(),
+                    velocity_mps[0],
+                    velocity_mps[1],
+                )?;
+                if let Some(omega) = turn_rate_radps {
+                    write!(f, ", turn rate {omega:.4e} rad/s")?;
+                }
+                write!(f, ")")
             }
             BoundViolation::CovarianceTrace { track_id, mode, trace } => {
                 write!(f, "track {track_id}: the {} covariance trace is {trace:.3e}", mode.id())
@@ -102,7 +119,15 @@ pub fn check_bounds(tracks: &[Track], modes: ModeSet, max_tracks: usize) -> Resu
                 return Err(BoundViolation::Position { track_id, mode });
             }
             if velocity.iter().any(|v| !within(*v, MAX_VELOCITY_MPS)) {
-                return Err(BoundViolation::Velocity { track_id, mode });
+                let turn_rate_radps = (mode == Mode::CoordinatedTurn).then(|| state.coordinated_turn.mean[4]);
+                let probability = state.probabilities[mode.index()];
+                return Err(BoundViolation::Velocity {
+                    track_id,
+                    mode,
+                    velocity_mps: velocity,
+                    turn_rate_radps,
+                    probability,
+                });
             }
             if !within(trace, MAX_COVARIANCE_TRACE) {
                 return Err(BoundViolation::CovarianceTrace { track_id, mode, trace });

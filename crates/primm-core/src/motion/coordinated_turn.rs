@@ -45,6 +45,8 @@ pub struct CoordinatedTurn {
     pub measurement_noise_m2: Matrix2<f64>,
     /// Velocity initiation.
     pub initial_velocity: InitialVelocity,
+    /// Largest turn rate predicted with, rad/s (see [`predict_in_place`](MotionModel::predict_in_place)).
+    pub max_turn_rate_radps: f64,
 }
 
 /// `s(φ) = sin φ/φ`, `g(φ) = (1 − cos φ)/φ` and their derivatives `s'`, `g'`, choosing the
@@ -193,7 +195,14 @@ impl CoordinatedTurn {
             initial_turn_rate_std_radps,
             measurement_noise_m2,
             initial_velocity,
+            max_turn_rate_radps: f64::INFINITY,
         }
+    }
+
+    /// The model with its turn rate limited to `max_turn_rate_radps` (rad/s).
+    pub fn with_max_turn_rate(mut self, max_turn_rate_radps: f64) -> Self {
+        self.max_turn_rate_radps = max_turn_rate_radps;
+        self
     }
 
     /// The transition `f(x, Δt)`.
@@ -240,9 +249,16 @@ impl MotionModel<5> for CoordinatedTurn {
         prior
     }
 
+    /// The EKF prediction. The turn rate is first clamped to `±max_turn_rate_radps`
+    /// (projection of the mean onto the plausible set; the covariance stays): an estimate far
+    /// beyond any real turn, left over from a manoeuvre or a bad association while the mode had
+    /// little weight, makes `x⁺` nearly independent of the velocity (`sin φ / φ → 0`), so that
+    /// position measurements no longer correct the velocity and it can drift without bound.
     #[inline(always)]
     fn predict_in_place(&self, estimate: &mut Gaussian<5>, context: &PredictContext) {
         let dt = context.dt_s;
+        let omega = &mut estimate.mean[index::OMEGA];
+        *omega = omega.clamp(-self.max_turn_rate_radps, self.max_turn_rate_radps);
         // One evaluation of sin/cos serves both the mean and the Jacobian.
         let terms = TurnTerms::new(&estimate.mean, dt);
         let jacobian = terms.jacobian_rows(&estimate.mean, dt);

@@ -1,7 +1,9 @@
 //! The PR mode's filter (paper, Section III-C "PR Filter"), state `[x, y]`.
 //!
 //! The prior is the posterior plus the displacement predicted by the learned model
-//! (`eq:pr_prior`); the covariance grows by `Q_PR` (`eq:pr_cov`). The displacement itself comes
+//! (`eq:pr_prior`); the covariance grows by `Q_PR` (`eq:pr_cov`): the constant of the
+//! configuration, or the predictor's own covariance of this displacement when it gives one
+//! ([`PredictContext::displacement_covariance_m2`]). The displacement itself comes
 //! from a [`DisplacementPredictor`](crate::predictor::DisplacementPredictor) and reaches the
 //! mode through [`PredictContext::displacement_m`]. Without a displacement the mean stays put and
 //! the IMM leaves the mode out of that step's fusion.
@@ -40,7 +42,8 @@ impl MotionModel<2> for LearnedDisplacement {
 
     fn predict(&self, posterior: &Gaussian<2>, context: &PredictContext) -> Gaussian<2> {
         let displacement = context.displacement_m.map_or(Vector2::zeros(), |d| Vector2::new(d.x, d.y));
-        Gaussian::new(posterior.mean + displacement, posterior.covariance + self.process_noise_m2)
+        let process_noise = context.displacement_covariance_m2.unwrap_or(self.process_noise_m2);
+        Gaussian::new(posterior.mean + displacement, posterior.covariance + process_noise)
     }
 
     fn measurement_noise(&self) -> Matrix2<f64> {

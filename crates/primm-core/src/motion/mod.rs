@@ -50,6 +50,9 @@ pub struct PredictContext {
     /// Displacement predicted by the learned predictor for this track and step, m; `None` when
     /// no prediction is available (the PR mode then sits this step out).
     pub displacement_m: Option<DVec2>,
+    /// The learned predictor's covariance of that displacement, m², to be used as this track's
+    /// `Q_PR` for this step (`eq:pr_cov`); `None`: the PR model's configured constant.
+    pub displacement_covariance_m2: Option<Matrix2<f64>>,
 }
 
 /// A stateless motion model of state size `N` (position first).
@@ -116,7 +119,8 @@ impl ModeModels {
                 class.coordinated_turn.initial_turn_rate_std_radps,
                 r,
                 initial_velocity,
-            ),
+            )
+            .with_max_turn_rate(class.coordinated_turn.max_turn_rate_radps),
         }
     }
 }
