@@ -20,6 +20,9 @@ struct Parity {
     valid: Vec<[f32; MAX_HISTORY]>,
     length: Vec<usize>,
     displacement: Vec<[f32; 2]>,
+    /// PyTorch's covariance output, for a model that has one.
+    #[serde(default)]
+    cholesky: Option<Vec<[f32; 3]>>,
 }
 
 fn parity() -> Parity {
@@ -55,6 +58,33 @@ fn tract_matches_pytorch_on_the_parity_fixture_within_a_tenth_of_a_millimetre() 
     let spread = parity.displacement.iter().map(|d| d[0]).fold(f32::NEG_INFINITY, f32::max)
         - parity.displacement.iter().map(|d| d[0]).fold(f32::INFINITY, f32::min);
     assert!(spread > 0.05, "outputs hardly vary: {spread} m");
+}
+
+#[test]
+fn tract_matches_pytorch_on_the_covariance_output_within_a_tenth_of_a_millimetre() {
+    let parity = parity();
+    let mut model = model();
+    // The shipped model estimates its uncertainty, and the fixture has PyTorch's answers.
+    assert!(model.has_uncertainty(), "the shipped model has the displacement_cholesky output");
+    let expected = parity.cholesky.expect("the parity fixture has the covariance output");
+    let (features, valid) = flatten(&parity.features, &parity.valid);
+    let mut out = vec![0.0f32; 2 * parity.features.len()];
+    let mut factors = vec![0.0f32; 3 * parity.features.len()];
+    model.run_with_uncertainty(&features, &valid, &mut out, &mut factors).unwrap();
+    let mut max_difference = 0.0f32;
+    for (got, want) in factors.chunks(3).zip(&expected) {
+        for axis in 0..3 {
+            max_difference = max_difference.max((got[axis] - want[axis]).abs());
+        }
+        // Positive diagonal: a valid Cholesky factor.
+        assert!(got[0] > 0.0 && got[2] > 0.0, "{got:?}");
+    }
+    println!("max abs difference of the Cholesky factors tract vs PyTorch: {max_difference:e} m");
+    assert!(max_difference <= 1e-4, "max abs difference {max_difference} m");
+    // The model's confidence varies between inputs.
+    let smallest = expected.iter().map(|f| f[0]).fold(f32::INFINITY, f32::min);
+    let largest = expected.iter().map(|f| f[0]).fold(f32::NEG_INFINITY, f32::max);
+    assert!(largest > 1.5 * smallest, "the uncertainty hardly varies: {smallest} .. {largest} m");
 }
 
 #[test]
@@ -176,14 +206,23 @@ fn a_rotated_history_gets_the_rotated_displacement() {
             .collect();
         let mut out = [None];
         predictor.predict(&[PredictionRequest::from_history(&history(&rotated), 0.105)], &mut out);
-        out[0].unwrap().mean_m
+        out[0].unwrap()
     };
-    let base = predict(&mut predictor, 0.0);
+    let answer = predict(&mut predictor, 0.0);
+    let base = answer.mean_m;
+    let base_covariance = answer.covariance_m2.expect("the shipped model gives a covariance");
     assert!(base.length() > 1e-3, "the model predicts motion: {base}");
     for angle in [0.4, 1.9, -2.6, std::f64::consts::PI] {
         let expected = DVec2::from_angle(angle).rotate(base);
-        let got = predict(&mut predictor, angle);
+        let answer = predict(&mut predictor, angle);
+        let got = answer.mean_m;
         assert!((got - expected).length() < 1e-4, "at {angle} rad: {got} vs {expected}");
+        // The covariance turns with the history: R Σ Rᵀ.
+        let rotation = glam::DMat2::from_angle(angle);
+        let expected_covariance = rotation * base_covariance * rotation.transpose();
+        let covariance = answer.covariance_m2.unwrap();
+        let difference = covariance.abs_diff_eq(expected_covariance, 1e-5);
+        assert!(difference, "at {angle} rad: {covariance} vs {expected_covariance}");
     }
     // Without a direction of motion (one measurement) the input goes in unrotated.
     let single = PredictionRequest::from_history(&history(&points[..1]), 0.03);

@@ -20,6 +20,14 @@ file (the input with the chosen values substituted, comments kept) and a JSON lo
     python3 tools/tune_physics.py --data out/tune/default/validation out/tune/turning/validation \\
         --out out/tune/primm.toml
 
+``--parameters learned --method pr-imm`` tunes the learned mode's side instead, on the same
+validation-only terms: the factor on the model's own displacement covariance
+(``predictor.learned_process_noise_scale``), the likelihood temperature ``imm.likelihood_temperature``
+and the constant ``Q_PR`` of cars and pedestrians (used where the model gives no covariance):
+
+    python3 tools/tune_physics.py --data out/tune/default/validation --parameters learned \\
+        --method pr-imm --config config/primm.toml --out out/tune/learned.toml
+
 Needs only the Python standard library (3.11+) and a release build of primm.
 """
 
@@ -34,7 +42,7 @@ import sys
 import tempfile
 import tomllib
 
-# (section, key) of every tuned parameter.
+# (section, key) of every tuned parameter of the physics modes.
 PARAMETERS = [
     (f"classes.{cls}{sub}", key)
     for cls in ("car", "pedestrian")
@@ -49,6 +57,15 @@ PARAMETERS = [
 ]
 
 
+# (section, key) of every tuned parameter of the learned mode and the mode update.
+LEARNED_PARAMETERS = [
+    ("predictor", "learned_process_noise_scale"),
+    ("imm", "likelihood_temperature"),
+]
+
+PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS}
+
+
 def parse_args(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--data", nargs="+", required=True, help="validation directories of measurement CSV files")
@@ -59,6 +76,9 @@ def parse_args(argv=None):
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--idf1-weight", type=float, default=20.0, help="metres of RMSE per unit of IDF1 lost")
     parser.add_argument("--tracking-frame", choices=["world", "vehicle"], default="world")
+    parser.add_argument("--parameters", choices=sorted(PARAMETER_SETS), default="physics",
+                        help="which parameters to tune")
+    parser.add_argument("--method", default="imm", help="the method scored (imm, pr-imm, ...)")
     return parser.parse_args(argv)
 
 
@@ -86,7 +106,7 @@ def substitute(text: str, section: str, key: str, value: float) -> str:
 
 
 def score(args, text: str) -> dict:
-    """IMM's RMSE_xy and IDF1 on every data directory for the configuration ``text``."""
+    """The method's RMSE_xy and IDF1 on every data directory for the configuration ``text``."""
     with tempfile.TemporaryDirectory() as tmp:
         config = os.path.join(tmp, "config.toml")
         with open(config, "w") as handle:
@@ -95,14 +115,14 @@ def score(args, text: str) -> dict:
         for data in args.data:
             report = os.path.join(tmp, "report.json")
             subprocess.run(
-                [args.primm, "eval", "--data", data, "--methods", "imm", "--config", config,
+                [args.primm, "eval", "--data", data, "--methods", args.method, "--config", config,
                  "--tracking-frame", args.tracking_frame, "--json", report],
                 check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             )
             with open(report) as handle:
-                imm = json.load(handle)["methods"]["imm"]
-            result["rmse_xy"].append(imm["rmse_xy"])
-            result["idf1"].append(imm["idf1"])
+                scored = json.load(handle)["methods"][args.method.replace("-", "_")]
+            result["rmse_xy"].append(scored["rmse_xy"])
+            result["idf1"].append(scored["idf1"])
     return result
 
 
@@ -127,7 +147,7 @@ def main(argv=None) -> int:
     log = [{"parameter": None, "value": None, "result": start, "objective": best}]
     print(f"start: objective {best:.4f}  {start}", flush=True)
     for round_index in range(args.rounds):
-        for section, key in PARAMETERS:
+        for section, key in PARAMETER_SETS[args.parameters]:
             base = get_value(config, section, key)
             for factor in args.factors:
                 value = float(f"{base * factor:.4g}")

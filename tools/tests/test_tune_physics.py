@@ -37,3 +37,15 @@ def test_tuning_on_an_evaluation_split_is_refused(tmp_path):
     evaluation.mkdir()
     with pytest.raises(SystemExit, match="evaluation split"):
         tune_physics.main(["--data", str(evaluation), "--out", str(tmp_path / "out.toml")])
+
+
+def test_every_parameter_of_both_sets_exists_in_the_shipped_configuration_and_can_be_set():
+    with open(os.path.join(ROOT, "config", "primm.toml")) as handle:
+        text = handle.read()
+    config = tomllib.loads(text)
+    for name, parameters in tune_physics.PARAMETER_SETS.items():
+        assert parameters, name
+        for section, key in parameters:
+            value = tune_physics.get_value(config, section, key)
+            changed = tomllib.loads(tune_physics.substitute(text, section, key, value * 2.0))
+            assert tune_physics.get_value(changed, section, key) == value * 2.0, (name, section, key)
