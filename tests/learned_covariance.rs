@@ -84,8 +84,9 @@ fn the_pr_prior_grows_by_the_predictors_covariance_when_it_gives_one_and_by_the_
 
 #[test]
 fn a_confident_predictor_keeps_more_pr_weight_than_an_unsure_one_and_the_constant_ignores_both() {
-    let learned = Config::default().with_modes(Method::PrImm.modes());
-    assert_eq!(learned.predictor.process_noise, LearnedProcessNoise::Learned);
+    let mut learned = Config::default().with_modes(Method::PrImm.modes());
+    learned.predictor.process_noise = LearnedProcessNoise::Learned;
+    learned.predictor.learned_process_noise_scale = 1.0;
     let (confident, _) = mean_learned_probability(learned.clone(), isotropic(1e-3));
     let (unsure, _) = mean_learned_probability(learned.clone(), isotropic(4.0));
     assert!(confident > unsure + 0.05, "confident {confident} vs unsure {unsure}");
