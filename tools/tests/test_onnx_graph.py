@@ -30,10 +30,14 @@ def test_both_softmax_forms_reproduce_the_trained_model(subtract_max, tmp_path):
     features = np.asarray(parity["features"], np.float32)
     valid = np.asarray(parity["valid"], np.float32)
     session = onnxruntime.InferenceSession(str(path), providers=["CPUExecutionProvider"])
-    output = session.run(None, {"features": features, "valid": valid})[0]
-    reference = onnx_graph.reference_forward(weights, features, valid, heads=4)
+    output, cholesky = session.run(None, {"features": features, "valid": valid})
+    reference, reference_cholesky = onnx_graph.reference_forward(weights, features, valid, heads=4)
     assert np.abs(output - reference).max() < 1e-5
     assert np.abs(output - np.asarray(parity["displacement"])).max() < 1e-5
+    # The uncertainty output: the same factors, with a positive diagonal.
+    assert np.abs(cholesky - reference_cholesky).max() < 1e-5
+    assert np.abs(cholesky - np.asarray(parity["cholesky"])).max() < 1e-5
+    assert (cholesky[:, 0] > 0).all() and (cholesky[:, 2] > 0).all()
     assert any(node.op_type == "ReduceMax" for node in model.graph.node) == subtract_max
 
 
@@ -53,8 +57,9 @@ def test_folding_the_normalisations_keeps_the_function_and_is_idempotent():
     valid = np.asarray(parity["valid"], np.float32)
     before = onnx_graph.reference_forward(weights, features, valid, heads=4)
     after = onnx_graph.reference_forward(folded, features, valid, heads=4)
-    assert np.abs(before - after).max() < 1e-9 * max(1.0, np.abs(before).max())
-    assert np.abs(before).max() > 0.0
+    for output_before, output_after in zip(before, after):
+        assert np.abs(output_before - output_after).max() < 1e-9 * max(1.0, np.abs(output_before).max())
+        assert np.abs(output_before).max() > 0.0
     twice = onnx_graph.fold_normalisations(folded)
     assert all(np.array_equal(twice[k], folded[k]) for k in folded)
     assert not any(node.op_type == "Sub" for node in onnx_graph.build_graph(weights, 4).graph.node)
