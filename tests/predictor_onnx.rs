@@ -294,6 +294,17 @@ fn a_file_of_garbage_is_a_start_up_error_naming_the_file() {
 }
 
 #[test]
+fn a_model_whose_output_names_no_tensor_is_an_error_and_not_a_panic() {
+    // Found by the onnx_model_bytes fuzz target: tract 0.23 panicked ("no entry found for key")
+    // on a graph output that no node produces.
+    let bytes = std::fs::read(repo_path("fuzz/corpus/onnx_model_bytes/output_names_no_tensor.onnx")).unwrap();
+    let source = primm_predictor::onnx::ModelSource::File(PathBuf::from("output_names_no_tensor.onnx"));
+    let error = PrModel::from_bytes(&bytes, source).unwrap_err();
+    assert!(matches!(error, ModelError::NotOnnx { .. }), "{error:?}");
+    assert!(error.to_string().contains("output_names_no_tensor.onnx"), "{error}");
+}
+
+#[test]
 fn a_directory_is_not_a_model() {
     let error = PrModel::load(repo_path("models")).unwrap_err();
     assert!(matches!(error, ModelError::Unreadable { .. }), "{error:?}");

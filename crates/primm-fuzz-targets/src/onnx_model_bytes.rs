@@ -8,8 +8,17 @@ use std::path::PathBuf;
 /// [`ModelError`](primm_predictor::onnx::ModelError), never a panic. A model that loads must
 /// answer a batch of predictions (a history of three measurements and one of one) without
 /// panicking; an inference error is an acceptable answer.
+///
+/// `PrModel::from_bytes` catches the panics tract raises on some malformed files and returns
+/// them as errors. libFuzzer's panic hook would abort on such a caught panic too, so the hook is
+/// silenced while the model loads; a panic that escapes `from_bytes` still reaches libFuzzer's
+/// own `catch_unwind` and is reported as a crash.
 pub fn run(data: &[u8]) {
-    let Ok(model) = PrModel::from_bytes(data, ModelSource::File(PathBuf::from("fuzz-input.onnx"))) else {
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let loaded = PrModel::from_bytes(data, ModelSource::File(PathBuf::from("fuzz-input.onnx")));
+    std::panic::set_hook(hook);
+    let Ok(model) = loaded else {
         return;
     };
     let mut predictor = OnnxPredictor::from_model(model);

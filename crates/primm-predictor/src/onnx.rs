@@ -311,7 +311,26 @@ impl PrModel {
 
     /// Prepares a model from the bytes of an ONNX file, as [`load`](Self::load) does;
     /// `source` names it in errors.
+    ///
+    /// tract itself may panic on some malformed files (fuzzing found a graph output naming a
+    /// tensor no node produces); such a panic is caught and reported as
+    /// [`ModelError::NotOnnx`], so a bad model file is always an error, never a crash.
     pub fn from_bytes(bytes: &[u8], source: ModelSource) -> Result<Self, ModelError> {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Self::prepare(bytes, source.clone())))
+            .unwrap_or_else(|panic| {
+                let message = panic
+                    .downcast_ref::<&str>()
+                    .map(|text| text.to_string())
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "no message".to_string());
+                Err(ModelError::NotOnnx {
+                    model: source,
+                    reason: format!("tract panicked reading it: {message}"),
+                })
+            })
+    }
+
+    fn prepare(bytes: &[u8], source: ModelSource) -> Result<Self, ModelError> {
         let mut model = tract_onnx::onnx()
             .model_for_read(&mut &bytes[..])
             .map_err(|error| ModelError::NotOnnx { model: source.clone(), reason: format!("{error:#}") })?;
