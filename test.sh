@@ -23,5 +23,6 @@ export PATH="$PWD/$venv/bin:$PATH"
 if cargo fmt --version >/dev/null 2>&1; then
     cargo fmt --all -- --check # formatting (rustfmt.toml); skipped where rustfmt is not installed
 fi
-cargo test --workspace --locked
+# `primm/tunnel`: the host-to-host tunnel (zenoh) and its loopback tests, off in a plain build.
+cargo test --workspace --locked --features primm/tunnel
 python3 -m pytest -q tools/tests

@@ -33,6 +33,9 @@ enum Command {
     Score(cli::score::Args),
     /// Run the tracker over a long synthetic scene, checking it after every frame.
     Soak(cli::soak::Args),
+    /// Relay the service's streams to other hosts through the iceoryx2 link tunnel over zenoh.
+    #[cfg(feature = "tunnel")]
+    Tunnel(cli::tunnel::Args),
 }
 
 /// Why a subcommand failed: its own error.
@@ -65,6 +68,10 @@ enum CommandError {
     /// `primm soak` failed.
     #[error(transparent)]
     Soak(#[from] cli::soak::SoakError),
+    /// `primm tunnel` failed.
+    #[cfg(feature = "tunnel")]
+    #[error(transparent)]
+    Tunnel(#[from] cli::tunnel::TunnelError),
 }
 
 fn main() -> ExitCode {
@@ -80,6 +87,8 @@ fn main() -> ExitCode {
         Command::Eval(args) => cli::eval::run(&args).map_err(Into::into),
         Command::Score(args) => cli::score::run(&args).map_err(Into::into),
         Command::Soak(args) => cli::soak::run(&args).map_err(Into::into),
+        #[cfg(feature = "tunnel")]
+        Command::Tunnel(args) => cli::tunnel::run(&args).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

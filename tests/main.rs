@@ -47,4 +47,6 @@ mod shm_hygiene;
 mod track_loops;
 mod tracker;
 mod tracker_allocation;
+#[cfg(feature = "tunnel")]
+mod tunnel_loopback;
 mod world_frame;

@@ -8,7 +8,9 @@ notifies, and opens the service with the same QoS as every primm program.
 
     python3 examples/python/subscriber.py [--service-prefix PREFIX] [--frames N] [--json]
 
-With ``--json`` it prints one JSON object per track frame instead of a table.
+With ``--json`` it prints one JSON object per track frame instead of a table. Like every primm
+program it works in the iceoryx2 domain that ``PRIMM_ICEORYX2_DOMAIN`` names (iceoryx2's default
+domain when unset), so it also reads the tracks a ``primm tunnel`` brings from another host.
 """
 
 import argparse
@@ -21,6 +23,15 @@ import iceoryx2 as iox2
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "crates", "primm-wire", "python"))
 from primm_wire import CLASS_NAMES, QOS, STATUS_NAMES, TRACKS, TrackFrame, service_name  # noqa: E402
+
+
+def iceoryx2_config():
+    """iceoryx2's global configuration in the domain PRIMM_ICEORYX2_DOMAIN names, if set."""
+    config = iox2.config.global_config()
+    domain = os.environ.get("PRIMM_ICEORYX2_DOMAIN")
+    if domain:
+        config.global_cfg.prefix = iox2.FileName.new(domain)
+    return config
 
 
 def open_tracks(node, prefix):
@@ -91,7 +102,7 @@ def main():
     args = parser.parse_args()
 
     iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
-    node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
+    node = iox2.NodeBuilder.new().config(iceoryx2_config()).create(iox2.ServiceType.Ipc)
     data, events = open_tracks(node, args.service_prefix)
     subscriber = data.subscriber_builder().create()
     listener = events.listener_builder().create()

@@ -14,6 +14,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
+#[cfg(feature = "tunnel")]
+mod two_hosts;
+
 /// Arguments of `primm demo`.
 #[derive(Debug, Clone, clap::Args)]
 #[command(about = "Run tracker, publisher and subscriber over shared memory on a built-in scenario")]
@@ -38,6 +41,11 @@ pub struct Args {
     /// Let the tracker and subscriber spin instead of sleeping.
     #[arg(long)]
     pub busy_poll: bool,
+    /// Hosts to spread the processes over: 1 (everything over shared memory) or 2 (publisher
+    /// and tracker on host A, subscriber on host B, each "host" its own iceoryx2 domain, joined
+    /// by two `primm tunnel`s over zenoh on 127.0.0.1; needs the `tunnel` feature).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub hosts: u8,
 }
 
 /// Why the demo failed.
@@ -88,6 +96,13 @@ pub enum DemoError {
     /// The subscriber never saw the end of the replay.
     #[error("the subscriber did not receive the answer to the last frame")]
     Incomplete,
+    /// `--hosts 2` needs the tunnel, which this build leaves out.
+    #[cfg_attr(feature = "tunnel", allow(dead_code))]
+    #[error("--hosts 2 needs the tunnel, which this primm was built without; build it with `cargo build --release --features tunnel`")]
+    TunnelNotBuilt,
+    /// No free TCP port on the loopback interface for the tunnels.
+    #[error("cannot find a free TCP port on 127.0.0.1 for the tunnel: {0}")]
+    Port(std::io::Error),
 }
 
 /// How long a child asked to stop (SIGINT) may take before it is killed.
@@ -211,6 +226,12 @@ fn companion(exe: &Path, binary: &str, subcommand: &str) -> Command {
 
 /// Runs the demo.
 pub fn run(args: Args) -> Result<(), DemoError> {
+    if args.hosts == 2 {
+        #[cfg(feature = "tunnel")]
+        return two_hosts::run(args);
+        #[cfg(not(feature = "tunnel"))]
+        return Err(DemoError::TunnelNotBuilt);
+    }
     let exe = std::env::current_exe().map_err(DemoError::Executable)?;
     let prefix = format!("primm-demo-{}", std::process::id());
     let names = ServiceNames::new(&prefix);
@@ -221,10 +242,11 @@ pub fn run(args: Args) -> Result<(), DemoError> {
         "primm demo: {:.0} s scenario (seed {}) replayed at {}x; tracker method {}; services under '{prefix}/'",
         args.duration_s, args.seed, args.speed, args.method
     );
-    let mut tracker = spawn_tracker(&exe, &prefix, &args, files.join(format!("{prefix}-tracker.log")))?;
+    let mut tracker = spawn_tracker(&exe, &prefix, None, &args, files.join(format!("{prefix}-tracker.log")))?;
     let mut subscriber = spawn_subscriber(
         &exe,
         &prefix,
+        None,
         &summary_path,
         &args,
         files.join(format!("{prefix}-subscriber.log")),
@@ -232,7 +254,8 @@ pub fn run(args: Args) -> Result<(), DemoError> {
     // Start the publisher once the tracker serves and the subscriber listens, so that no frame
     // and no answer is missed.
     wait_until_connected(&names, &mut tracker, &mut subscriber)?;
-    let publisher = spawn_publisher(&exe, &prefix, &args, files.join(format!("{prefix}-publisher.log")))?;
+    let publisher =
+        spawn_publisher(&exe, &prefix, None, &args, files.join(format!("{prefix}-publisher.log")))?;
     let replay_s = args.duration_s / args.speed.max(1e-3);
     let outputs = wait_for_the_end(publisher, subscriber, tracker, replay_s);
     let complete = stream_end_seen(&summary_path);
@@ -251,14 +274,29 @@ pub fn run(args: Args) -> Result<(), DemoError> {
     Ok(())
 }
 
+/// Runs `command` in the iceoryx2 domain `domain` (see [`catalog::ICEORYX2_DOMAIN_ENV`]), or in
+/// the demo's own when `None`.
+fn in_domain(command: &mut Command, domain: Option<&str>) {
+    if let Some(domain) = domain {
+        command.env(catalog::ICEORYX2_DOMAIN_ENV, domain);
+    }
+}
+
 /// Logs of the child processes: warnings only, unless `RUST_LOG` says otherwise.
 fn quiet_logs(command: &mut Command) {
     command.env("RUST_LOG", std::env::var("RUST_LOG").unwrap_or_else(|_| "warn".to_owned()));
 }
 
 /// Starts `primm serve` under `prefix`, its output captured.
-fn spawn_tracker(exe: &Path, prefix: &str, args: &Args, stderr_path: PathBuf) -> Result<Managed, DemoError> {
+fn spawn_tracker(
+    exe: &Path,
+    prefix: &str,
+    domain: Option<&str>,
+    args: &Args,
+    stderr_path: PathBuf,
+) -> Result<Managed, DemoError> {
     let mut command = Command::new(exe);
+    in_domain(&mut command, domain);
     command
         .args(["serve", "--service-prefix", prefix, "--method", args.method.id(), "--latency-every", "50"])
         .stdout(Stdio::piped());
@@ -277,11 +315,13 @@ fn spawn_tracker(exe: &Path, prefix: &str, args: &Args, stderr_path: PathBuf) ->
 fn spawn_subscriber(
     exe: &Path,
     prefix: &str,
+    domain: Option<&str>,
     summary_path: &Path,
     args: &Args,
     stderr_path: PathBuf,
 ) -> Result<Managed, DemoError> {
     let mut command = companion(exe, "primm-subscriber", "subscribe");
+    in_domain(&mut command, domain);
     command
         .args(["--service-prefix", prefix, "--until-end", "--quiet", "--idle-timeout-s", "60", "--json"])
         .arg(summary_path)
@@ -297,10 +337,12 @@ fn spawn_subscriber(
 fn spawn_publisher(
     exe: &Path,
     prefix: &str,
+    domain: Option<&str>,
     args: &Args,
     stderr_path: PathBuf,
 ) -> Result<Managed, DemoError> {
     let mut command = companion(exe, "primm-publisher", "publish");
+    in_domain(&mut command, domain);
     command.args([
         "--service-prefix",
         prefix,
@@ -329,15 +371,26 @@ fn wait_until_connected(
 ) -> Result<(), DemoError> {
     let node = catalog::create_node("primm-demo")?;
     let tracks = catalog::tracks(&node, names)?;
+    wait_for_ports(&tracks, &tracks, tracker, subscriber)
+}
+
+/// Waits up to [`READY_TIMEOUT`] until `tracker` publishes on `tracker_side` and `subscriber`
+/// subscribes on `subscriber_side` (the same stream, seen from the domain each runs in).
+fn wait_for_ports(
+    tracker_side: &catalog::Stream<primm_wire::TrackFrame>,
+    subscriber_side: &catalog::Stream<primm_wire::TrackFrame>,
+    tracker: &mut Managed,
+    subscriber: &mut Managed,
+) -> Result<(), DemoError> {
     let ready_deadline = Instant::now() + READY_TIMEOUT;
-    while tracks.publisher_count() == 0 || tracks.subscriber_count() == 0 {
+    while tracker_side.publisher_count() == 0 || subscriber_side.subscriber_count() == 0 {
         for child in [&mut *tracker, &mut *subscriber] {
             if let Some(status) = child.exited()? {
                 return Err(child.exited_error(status));
             }
         }
         if Instant::now() >= ready_deadline {
-            let what = if tracks.publisher_count() == 0 { tracker.what } else { subscriber.what };
+            let what = if tracker_side.publisher_count() == 0 { tracker.what } else { subscriber.what };
             return Err(DemoError::Timeout { what, event: "come up", seconds: READY_TIMEOUT.as_secs() });
         }
         std::thread::sleep(POLL_INTERVAL);

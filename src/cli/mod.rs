@@ -9,6 +9,8 @@ pub mod score;
 pub mod serve;
 pub mod soak;
 pub mod track;
+#[cfg(feature = "tunnel")]
+pub mod tunnel;
 
 use primm_core::config::{Config, TrackingFrame};
 

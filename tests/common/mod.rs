@@ -206,3 +206,5 @@ impl primm_core::predictor::DisplacementPredictor for LaneOracle {
 }
 pub mod counting_allocator;
 pub mod service;
+#[cfg(feature = "tunnel")]
+pub mod tunnel;

@@ -64,7 +64,16 @@ pub struct TestClient {
 
 impl TestClient {
     pub fn new(names: &ServiceNames) -> Self {
-        let node = catalog::create_node("primm-test").unwrap();
+        Self::with_node(names, catalog::create_node("primm-test").unwrap())
+    }
+
+    /// A client in the iceoryx2 domain `domain`, whatever `PRIMM_ICEORYX2_DOMAIN` says.
+    pub fn in_domain(names: &ServiceNames, domain: &str) -> Self {
+        let config = catalog::iceoryx2_config_in(Some(domain)).unwrap();
+        Self::with_node(names, catalog::create_node_with("primm-test", &config).unwrap())
+    }
+
+    fn with_node(names: &ServiceNames, node: Node<Ipc>) -> Self {
         let measurements = catalog::measurements(&node, names).unwrap();
         let tracks = catalog::tracks(&node, names).unwrap();
         Self {

@@ -200,13 +200,29 @@ pub const ICEORYX2_DOMAIN_ENV: &str = "PRIMM_ICEORYX2_DOMAIN";
 /// [`ICEORYX2_DOMAIN_ENV`] names (if set), with the removal of dead nodes left to
 /// [`create_node`] so that it can count them.
 pub fn iceoryx2_config() -> Result<Config, ConnectError> {
+    iceoryx2_config_in(std::env::var(ICEORYX2_DOMAIN_ENV).ok().as_deref())
+}
+
+/// [`iceoryx2_config`] in the domain `domain` (iceoryx2's default domain when `None`), whatever
+/// [`ICEORYX2_DOMAIN_ENV`] says: for a program that works in two domains at once, such as a
+/// test of the host-to-host tunnel.
+pub fn iceoryx2_config_in(domain: Option<&str>) -> Result<Config, ConnectError> {
+    quiet_iceoryx2();
     let mut config = Config::global_config().clone();
-    if let Ok(domain) = std::env::var(ICEORYX2_DOMAIN_ENV) {
+    if let Some(domain) = domain {
         config.global.prefix = FileName::new(domain.as_bytes())
-            .map_err(|reason| ConnectError::InvalidDomain { domain: domain.clone(), reason })?;
+            .map_err(|reason| ConnectError::InvalidDomain { domain: domain.to_owned(), reason })?;
     }
     config.global.node.cleanup_dead_nodes_on_creation = false;
     Ok(config)
+}
+
+/// iceoryx2 logs to the console on its own; keep it to errors unless IOX2_LOG_LEVEL says
+/// otherwise (primm's own logs go through `tracing`). Done once, before iceoryx2 is first used,
+/// so that a program may raise the level afterwards.
+fn quiet_iceoryx2() {
+    static QUIET_ICEORYX2: std::sync::Once = std::sync::Once::new();
+    QUIET_ICEORYX2.call_once(|| set_log_level_from_env_or(LogLevel::Error));
 }
 
 /// Creates a node named `name` that leaves SIGINT/SIGTERM to the program (see
@@ -224,12 +240,13 @@ pub fn iceoryx2_config() -> Result<Config, ConnectError> {
 /// (`<domain><hash>_node.<version>.global_mgmt`, 16 bytes), which iceoryx2 creates once per domain
 /// and version without an owner, shares with every process of the domain and never removes.
 pub fn create_node(name: &str) -> Result<Node<Ipc>, ConnectError> {
-    // iceoryx2 logs to the console on its own; keep it to errors unless IOX2_LOG_LEVEL says
-    // otherwise (primm's own logs go through `tracing`).
-    static QUIET_ICEORYX2: std::sync::Once = std::sync::Once::new();
-    QUIET_ICEORYX2.call_once(|| set_log_level_from_env_or(LogLevel::Error));
-    let config = iceoryx2_config()?;
-    let mut builder = NodeBuilder::new().config(&config).signal_handling_mode(SignalHandlingMode::Disabled);
+    create_node_with(name, &iceoryx2_config()?)
+}
+
+/// [`create_node`] with the configuration `config` (e.g. from [`iceoryx2_config_in`]).
+pub fn create_node_with(name: &str, config: &Config) -> Result<Node<Ipc>, ConnectError> {
+    quiet_iceoryx2();
+    let mut builder = NodeBuilder::new().config(config).signal_handling_mode(SignalHandlingMode::Disabled);
     if let Ok(node_name) = NodeName::new(name) {
         builder = builder.name(&node_name);
     }
