@@ -67,6 +67,7 @@ fn dependencies_between_primm_crates_point_one_way() {
     assert_eq!(primm("primm-service"), set(&["primm-service", "primm-wire", "primm-core"]));
     assert_eq!(primm("primm-sim"), set(&["primm-sim", "primm-core"]));
     assert_eq!(primm("primm-ffi"), set(&["primm-ffi", "primm-config", "primm-predictor", "primm-core"]));
+    assert_eq!(primm("primm-tunnel"), set(&["primm-tunnel", "primm-service", "primm-wire", "primm-core"]));
     assert_eq!(
         primm("primm-fuzz-targets"),
         set(&[
@@ -91,6 +92,7 @@ fn no_library_crate_depends_on_the_fuzz_targets_or_a_fuzzing_crate() {
         "primm-service",
         "primm-sim",
         "primm-ffi",
+        "primm-tunnel",
     ];
     for package in packages {
         let names = dependency_names(package, &[]);
@@ -98,6 +100,18 @@ fn no_library_crate_depends_on_the_fuzz_targets_or_a_fuzzing_crate() {
             assert!(!names.contains(forbidden), "{package} depends on {forbidden}");
         }
     }
+}
+
+#[test]
+fn zenoh_is_built_into_primm_only_with_the_tunnel_feature() {
+    for package in
+        ["primm-core", "primm-service", "primm-wire", "primm-ffi", "primm-publisher", "primm-subscriber"]
+    {
+        assert!(!dependency_names(package, &[]).contains("zenoh"), "{package} depends on zenoh");
+    }
+    assert!(!dependency_names("primm", &[]).contains("zenoh"), "a plain `primm` build includes zenoh");
+    let with_tunnel = dependency_names("primm", &["--features", "tunnel"]);
+    assert!(with_tunnel.contains("zenoh") && with_tunnel.contains("primm-tunnel"), "{with_tunnel:?}");
 }
 
 #[test]

@@ -7,7 +7,7 @@
 
 use crate::common;
 
-use common::service::{spawn_serve, write_frame, ChildGuard, TestClient};
+use common::service::{write_frame, ChildGuard, TestClient};
 use common::tunnel::{counts, TwoHosts, HANG_GUARD};
 use primm_service::catalog;
 use primm_wire::{MeasurementFrame, WireMeasurement};
@@ -58,7 +58,7 @@ fn every_frame_sent_on_one_host_arrives_intact_and_in_order_on_the_other() {
         sent
     };
     let mut received: Vec<Sent> = Vec::new();
-    let mut receive = |received: &mut Vec<Sent>| {
+    let receive = |received: &mut Vec<Sent>| {
         while let Some(sample) = subscriber.receive().unwrap() {
             received.push(Sent::of(&sample));
         }
@@ -199,7 +199,11 @@ fn the_python_subscriber_on_the_far_host_reads_the_tracks_of_a_tracker_on_the_ne
             break;
         }
     }
+    // Frames 1..=FRAMES one at a time, each once the Python subscriber has printed the one
+    // before, so that its buffer of 16 track frames never overflows (that would be the
+    // subscriber's loss, not the tunnel's).
     let mut expected = Vec::new();
+    let mut seen = Vec::new();
     for (k, frame) in frames.iter().enumerate().skip(1) {
         client.send(frame, k as u64, 0);
         let answer = client
@@ -210,17 +214,16 @@ fn the_python_subscriber_on_the_far_host_reads_the_tracks_of_a_tracker_on_the_ne
             })
             .expect("the tracker answers");
         expected.push(answer);
-    }
-    // What the Python subscriber printed of frames 1..=FRAMES, after the probes.
-    let mut seen = Vec::new();
-    while seen.len() < FRAMES {
-        let line = line_rx.recv_timeout(Duration::from_secs(20)).unwrap_or_else(|_| {
-            panic!("the Python subscriber on host B printed {} of {FRAMES} frames", seen.len())
-        });
-        let record: serde_json::Value = serde_json::from_str(&line).expect("one JSON object per line");
-        let sequence = record["input_sequence"].as_u64().unwrap();
-        if sequence > 0 {
-            seen.push((sequence, printed_tracks(&record)));
+        loop {
+            let line = line_rx.recv_timeout(Duration::from_secs(20)).unwrap_or_else(|_| {
+                panic!("the Python subscriber on host B printed {} of {FRAMES} frames", seen.len())
+            });
+            let record: serde_json::Value = serde_json::from_str(&line).expect("one JSON object per line");
+            let sequence = record["input_sequence"].as_u64().unwrap();
+            if sequence > 0 {
+                seen.push((sequence, printed_tracks(&record)));
+                break;
+            }
         }
     }
     drop(python);
