@@ -17,7 +17,10 @@
 //! Prints HdrHistogram percentiles and writes `benches/results/service_latency.md`; nothing is
 //! asserted.
 //!
-//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--latency-every 100] [--no-write]`
+//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--latency-every 100] [--no-write]`
+//!
+//! `--model FILE` runs the tracker with that PR model instead of the built-in one (to compare
+//! two models side by side on one machine); its results are printed, not written.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -43,6 +46,7 @@ fn measure(
     objects: usize,
     frames: usize,
     latency_every: &str,
+    model: Option<&str>,
 ) -> Vec<Histogram<u64>> {
     let prefix = unique_prefix(&format!("bench-{mode}"));
     let client = TestClient::new(&ServiceNames::new(&prefix));
@@ -50,6 +54,9 @@ fn measure(
     let busy = mode == "busy-poll";
     if busy {
         extra.push("--busy-poll");
+    }
+    if let Some(model) = model {
+        extra.extend(["--model", model]);
     }
     let serve = spawn_serve(&prefix, &extra);
     client.wait_for_tracker(Duration::from_secs(60));
@@ -114,12 +121,13 @@ fn main() {
     // The tracker's latency report (every 100 frames by default) costs ~0.1 ms of percentile
     // computation on the tracking thread; `--latency-every 0` leaves it out.
     let latency_every = argument("--latency-every").unwrap_or_else(|| "100".into());
+    let model = argument("--model");
     let us = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q) as f64 / 1000.0;
     let mut table = String::new();
     writeln!(table, "| wait mode | leg | frames | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |").unwrap();
     writeln!(table, "|---|---|---|---|---|---|---|---|").unwrap();
     for mode in modes.split(',') {
-        let histograms = measure(mode, &method, objects, frames, &latency_every);
+        let histograms = measure(mode, &method, objects, frames, &latency_every, model.as_deref());
         for (leg, h) in LEGS.iter().zip(&histograms) {
             writeln!(
                 table,
@@ -134,11 +142,12 @@ fn main() {
             .unwrap();
         }
     }
+    let model_option = model.as_ref().map_or(String::new(), |file| format!(" --model {file}"));
     let heading = format!(
-        "Service latency through `primm serve --method {method} --latency-every {latency_every}`, {objects} objects per frame, {frames} frames per wait mode after 500 warm-up frames, one frame in flight.\n\n"
+        "Service latency through `primm serve --method {method}{model_option} --latency-every {latency_every}`, {objects} objects per frame, {frames} frames per wait mode after 500 warm-up frames, one frame in flight.\n\n"
     );
     println!("{heading}{table}");
-    if !std::env::args().any(|a| a == "--no-write") {
+    if model.is_none() && !std::env::args().any(|a| a == "--no-write") {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
         std::fs::create_dir_all(&dir).unwrap();
         let suffix = if latency_every == "0" { "_no_reports" } else { "" };

@@ -1,5 +1,6 @@
 //! The tunnel leg against the local shared-memory path: latency and highest sustained frame
-//! rate of `primm/measurements` frames at a given number of objects (the `tunnel` feature).
+//! rate of measurement frames (`primm/measurements`) and track frames (`primm/tracks`) at a
+//! given number of objects (the `tunnel` feature).
 //!
 //! * `local`: publisher and subscriber in one iceoryx2 domain, shared memory only.
 //! * `tunnel`: publisher on host A, subscriber on host B, two iceoryx2 domains on this machine,
@@ -12,7 +13,11 @@
 //! frames, then bisects `--steps` times. Prints one line per trial and a summary table; writes
 //! nothing and asserts nothing.
 //!
-//! `cargo bench --features tunnel --bench tunnel [-- --objects 64] [--seconds 5] [--latency-seconds 20] [--start-hz 100] [--steps 4] [--paths local,tunnel]`
+//! A track frame is written as the tracker would leave it for `--objects` tracks (header and
+//! count; the slots' contents do not change what crosses: every sample crosses whole, 94 272
+//! bytes, as a measurement frame crosses as 16 448 bytes whatever its count).
+//!
+//! `cargo bench --features tunnel --bench tunnel [-- --objects 64] [--seconds 5] [--latency-seconds 20] [--start-hz 100] [--steps 4] [--paths local,tunnel] [--streams measurements,tracks]`
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -24,7 +29,53 @@ use iceoryx2::node::Node;
 use primm_core::measurement::Frame;
 use primm_service::catalog::{self, Ipc, ServiceNames};
 use primm_service::clock::monotonic_ns;
+use primm_wire::{MeasurementFrame, TrackFrame};
+use std::mem::MaybeUninit;
 use std::time::{Duration, Instant};
+
+/// A stream the benchmark sends on.
+trait Payload: std::fmt::Debug + iceoryx2::prelude::ZeroCopySend + Sized + 'static {
+    /// The stream's service name.
+    const STREAM: &'static str;
+    fn open(node: &Node<Ipc>, names: &ServiceNames) -> catalog::Stream<Self>;
+    /// Writes frame `sequence` of the scene, stamped with the current time.
+    fn write(slot: &mut MaybeUninit<Self>, scene: &[Frame], sequence: u64, objects: usize);
+    fn publish_time_ns(&self) -> u64;
+}
+
+impl Payload for MeasurementFrame {
+    const STREAM: &'static str = "measurements";
+    fn open(node: &Node<Ipc>, names: &ServiceNames) -> catalog::Stream<Self> {
+        catalog::measurements(node, names).unwrap()
+    }
+    fn write(slot: &mut MaybeUninit<Self>, scene: &[Frame], sequence: u64, _objects: usize) {
+        write_frame(slot, &scene[sequence as usize % scene.len()], sequence, 0);
+    }
+    fn publish_time_ns(&self) -> u64 {
+        self.publish_time_ns
+    }
+}
+
+impl Payload for TrackFrame {
+    const STREAM: &'static str = "tracks";
+    fn open(node: &Node<Ipc>, names: &ServiceNames) -> catalog::Stream<Self> {
+        catalog::tracks(node, names).unwrap()
+    }
+    fn write(slot: &mut MaybeUninit<Self>, _scene: &[Frame], sequence: u64, objects: usize) {
+        // SAFETY: every field is plain data, valid as zero; the header is then set.
+        let frame = unsafe {
+            slot.as_mut_ptr().write_bytes(0, 1);
+            slot.assume_init_mut()
+        };
+        frame.input_sequence = sequence;
+        frame.count = objects as u32;
+        frame.wire_version = primm_wire::WIRE_VERSION;
+        frame.publish_time_ns = monotonic_ns();
+    }
+    fn publish_time_ns(&self) -> u64 {
+        self.publish_time_ns
+    }
+}
 
 /// Where the frames travel.
 enum Path {
@@ -72,26 +123,27 @@ struct Trial {
     latency_ns: Histogram<u64>,
 }
 
-/// Sends `seconds` of frames at `rate_hz` from `sender` to `receiver` over `names`, after
-/// probing until a frame crosses.
-fn trial(path: &Path, scene: &[Frame], rate_hz: f64, seconds: f64) -> Trial {
+/// Sends `seconds` of frames of type `P` at `rate_hz` from the path's sender to its receiver,
+/// after probing until a frame crosses.
+fn trial<P: Payload>(path: &Path, scene: &[Frame], objects: usize, rate_hz: f64, seconds: f64) -> Trial {
     let (sender, receiver, names) = path.nodes();
-    let stream_a = catalog::measurements(&sender, &names).unwrap();
+    let stream_a = P::open(&sender, &names);
     let (publisher, notifier) = (stream_a.publisher().unwrap(), stream_a.notifier().unwrap());
-    let stream_b = catalog::measurements(&receiver, &names).unwrap();
+    let stream_b = P::open(&receiver, &names);
     let subscriber = stream_b.subscriber().unwrap();
     let send = |sequence: u64| {
         let mut loan = publisher.loan_uninit().unwrap();
-        write_frame(loan.payload_mut(), &scene[sequence as usize % scene.len()], sequence, 0);
-        // SAFETY: write_frame wrote the header and the measurements; the rest is plain data.
+        P::write(loan.payload_mut(), scene, sequence, objects);
+        // SAFETY: `P::write` wrote every field the receiver reads; the rest is plain data.
         unsafe { loan.assume_init() }.send().unwrap();
         notifier.notify().unwrap();
     };
-    // Probe until a frame crosses (the far side's subscription has reached the sender).
+    // Probe with frame 0 until one crosses (the far side's subscription has reached the
+    // sender); the trial's frames are numbered from 1.
     let deadline = Instant::now() + Duration::from_secs(60);
     'probe: loop {
         assert!(Instant::now() < deadline, "no frame crossed within 60 s");
-        send(u64::MAX);
+        send(0);
         let until = Instant::now() + Duration::from_millis(50);
         while Instant::now() < until {
             if subscriber.receive().unwrap().is_some() {
@@ -107,7 +159,7 @@ fn trial(path: &Path, scene: &[Frame], rate_hz: f64, seconds: f64) -> Trial {
     let mut received = 0;
     let mut take = |latency_ns: &mut Histogram<u64>| {
         while let Some(sample) = subscriber.receive().unwrap() {
-            latency_ns.saturating_record(monotonic_ns().saturating_sub(sample.publish_time_ns).max(1));
+            latency_ns.saturating_record(monotonic_ns().saturating_sub(sample.publish_time_ns()).max(1));
             received += 1;
         }
     };
@@ -125,7 +177,7 @@ fn trial(path: &Path, scene: &[Frame], rate_hz: f64, seconds: f64) -> Trial {
             // Short sleeps: the receive time is read when this loop comes round.
             std::thread::sleep((due - now).min(Duration::from_micros(50)));
         }
-        send(k);
+        send(k + 1);
     }
     let drain_until = Instant::now() + Duration::from_secs(2);
     while Instant::now() < drain_until {
@@ -165,50 +217,52 @@ fn main() {
     let start_hz: f64 = argument("--start-hz").and_then(|v| v.parse().ok()).unwrap_or(100.0);
     let steps: usize = argument("--steps").and_then(|v| v.parse().ok()).unwrap_or(4);
     let paths = argument("--paths").unwrap_or_else(|| "local,tunnel".into());
+    let streams = argument("--streams").unwrap_or_else(|| "measurements,tracks".into());
     let scene = common::scene_frames(&common::lanes(objects), 500, 0.05, 0.2, 11);
     println!(
-        "measurement frames of {objects} objects, {} bytes each on the wire",
-        std::mem::size_of::<primm_wire::MeasurementFrame>()
+        "{objects} objects; on the wire a measurement frame is {} bytes, a track frame {} bytes",
+        std::mem::size_of::<MeasurementFrame>(),
+        std::mem::size_of::<TrackFrame>()
     );
     let mut rows = Vec::new();
     for name in paths.split(',') {
         let path = Path::open(name);
-        let at_radar_rate = trial(&path, &scene, 20.0, latency_seconds);
-        report(name, &at_radar_rate);
-        let (mut good, mut bad): (Option<f64>, Option<f64>) = (None, None);
-        let mut rate = start_hz;
-        while bad.is_none() && rate <= 200_000.0 {
-            let outcome = trial(&path, &scene, rate, seconds);
-            report(name, &outcome);
-            if outcome.received == outcome.sent {
-                good = Some(rate);
-                rate *= 2.0;
-            } else {
-                bad = Some(rate);
-            }
-        }
-        for _ in 0..steps {
-            let (Some(low), Some(high)) = (good, bad) else { break };
-            let rate = (low + high) / 2.0;
-            let outcome = trial(&path, &scene, rate, seconds);
-            report(name, &outcome);
-            if outcome.received == outcome.sent {
-                good = Some(rate);
-            } else {
-                bad = Some(rate);
-            }
+        for stream in streams.split(',') {
+            let row = match stream {
+                "measurements" => search::<MeasurementFrame>(
+                    &path,
+                    name,
+                    &scene,
+                    objects,
+                    seconds,
+                    latency_seconds,
+                    start_hz,
+                    steps,
+                ),
+                "tracks" => search::<TrackFrame>(
+                    &path,
+                    name,
+                    &scene,
+                    objects,
+                    seconds,
+                    latency_seconds,
+                    start_hz,
+                    steps,
+                ),
+                other => panic!("unknown stream '{other}' (measurements, tracks)"),
+            };
+            rows.push(row);
         }
         if let Some((report_a, report_b)) = path.close() {
             println!("host A's tunnel:\n{report_a}host B's tunnel:\n{report_b}");
         }
-        rows.push((name.to_owned(), at_radar_rate, good, bad));
     }
-    println!("\n| path | objects | p50 µs at 20 Hz | p90 µs | p99 µs | highest rate without loss, Hz | lowest rate with loss, Hz |");
-    println!("|---|---|---|---|---|---|---|");
+    println!("\n| path | stream | objects | p50 µs at 20 Hz | p90 µs | p99 µs | highest rate without loss, Hz | lowest rate with loss, Hz |");
+    println!("|---|---|---|---|---|---|---|---|");
     let show = |rate: Option<f64>| rate.map_or("-".to_owned(), |r| format!("{r:.0}"));
-    for (name, trial, good, bad) in rows {
+    for (name, stream, trial, good, bad) in rows {
         println!(
-            "| {name} | {objects} | {:.1} | {:.1} | {:.1} | {} | {} |",
+            "| {name} | {stream} | {objects} | {:.1} | {:.1} | {:.1} | {} | {} |",
             micros(&trial, 0.5),
             micros(&trial, 0.9),
             micros(&trial, 0.99),
@@ -216,4 +270,44 @@ fn main() {
             show(bad)
         );
     }
+}
+
+/// The latency trial at 20 Hz, then the rate search, on stream `P`.
+fn search<P: Payload>(
+    path: &Path,
+    name: &str,
+    scene: &[Frame],
+    objects: usize,
+    seconds: f64,
+    latency_seconds: f64,
+    start_hz: f64,
+    steps: usize,
+) -> (String, &'static str, Trial, Option<f64>, Option<f64>) {
+    let label = format!("{name} {}", P::STREAM);
+    let at_radar_rate = trial::<P>(path, scene, objects, 20.0, latency_seconds);
+    report(&label, &at_radar_rate);
+    let (mut good, mut bad): (Option<f64>, Option<f64>) = (None, None);
+    let mut rate = start_hz;
+    while bad.is_none() && rate <= 200_000.0 {
+        let outcome = trial::<P>(path, scene, objects, rate, seconds);
+        report(&label, &outcome);
+        if outcome.received == outcome.sent {
+            good = Some(rate);
+            rate *= 2.0;
+        } else {
+            bad = Some(rate);
+        }
+    }
+    for _ in 0..steps {
+        let (Some(low), Some(high)) = (good, bad) else { break };
+        let rate = (low + high) / 2.0;
+        let outcome = trial::<P>(path, scene, objects, rate, seconds);
+        report(&label, &outcome);
+        if outcome.received == outcome.sent {
+            good = Some(rate);
+        } else {
+            bad = Some(rate);
+        }
+    }
+    (name.to_owned(), P::STREAM, at_radar_rate, good, bad)
 }

@@ -96,12 +96,53 @@ impl<T: Debug + ZeroCopySend + Sequenced + 'static> StreamWatch<T> {
     }
 
     fn count_arrival(&mut self, sequence: u64) {
-        self.counts.arrived += 1;
-        match self.last_arrived {
-            Some(last) if sequence > last => self.counts.arrival_gaps += sequence - last - 1,
-            Some(_) => self.counts.arrived_out_of_order += 1,
-            None => {}
+        count(&mut self.counts, &mut self.last_arrived, sequence);
+    }
+}
+
+/// Counts one arrival with sequence number `sequence` after the arrival `last` (if any).
+fn count(counts: &mut StreamCounts, last: &mut Option<u64>, sequence: u64) {
+    counts.arrived += 1;
+    match *last {
+        Some(previous) if sequence > previous => {
+            counts.arrival_gaps = counts.arrival_gaps.saturating_add(sequence - previous - 1)
         }
-        self.last_arrived = Some(sequence);
+        Some(_) => counts.arrived_out_of_order += 1,
+        None => {}
+    }
+    *last = Some(sequence);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The counting alone, without a subscriber.
+    fn counts_of(sequences: &[u64]) -> StreamCounts {
+        let mut counts = StreamCounts::default();
+        let mut last = None;
+        for &sequence in sequences {
+            count(&mut counts, &mut last, sequence);
+        }
+        counts
+    }
+
+    #[test]
+    fn consecutive_arrivals_count_no_gap() {
+        assert_eq!(counts_of(&[3, 4, 5, 6]), StreamCounts { arrived: 4, ..StreamCounts::default() });
+    }
+
+    #[test]
+    fn skipped_sequence_numbers_are_counted_as_gaps() {
+        let counts = counts_of(&[0, 1, 4, 5, 9]);
+        assert_eq!((counts.arrived, counts.arrival_gaps, counts.arrived_out_of_order), (5, 5, 0));
+    }
+
+    #[test]
+    fn a_repeated_or_restarted_sequence_counts_as_out_of_order_and_never_overflows() {
+        let counts = counts_of(&[0, u64::MAX, 0, 1, 1]);
+        assert_eq!(counts.arrived, 5);
+        assert_eq!(counts.arrived_out_of_order, 2);
+        assert_eq!(counts.arrival_gaps, u64::MAX - 1);
     }
 }
