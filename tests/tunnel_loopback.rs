@@ -37,8 +37,17 @@ impl Sent {
 
 #[test]
 fn every_frame_sent_on_one_host_arrives_intact_and_in_order_on_the_other() {
-    const FRAMES: usize = 400;
-    let hosts = TwoHosts::start("tunnel_frames");
+    every_frame_crosses(TwoHosts::start("tunnel_frames"), 400);
+}
+
+#[test]
+fn frames_cross_between_a_tunnel_in_router_mode_and_one_in_client_mode() {
+    every_frame_crosses(TwoHosts::start_in_modes("tunnel_router", "router", "client"), 100);
+}
+
+/// Sends `count` measurement frames on host A at 200 Hz and checks that host B receives each
+/// of them intact and in order, and that the tunnels' counters agree.
+fn every_frame_crosses(hosts: TwoHosts, count: usize) {
     let names = hosts.names();
     let (node_a, node_b) = (hosts.node_a("sender"), hosts.node_b("receiver"));
     let stream_a = catalog::measurements(&node_a, &names).unwrap();
@@ -46,7 +55,7 @@ fn every_frame_sent_on_one_host_arrives_intact_and_in_order_on_the_other() {
     let stream_b = catalog::measurements(&node_b, &names).unwrap();
     let (subscriber, listener) = (stream_b.subscriber().unwrap(), stream_b.listener().unwrap());
 
-    let frames = common::scene_frames(&common::lanes(12), FRAMES + 1, 0.05, 0.2, 11);
+    let frames = common::scene_frames(&common::lanes(12), count + 1, 0.05, 0.2, 11);
     let send = |sequence: usize| -> Sent {
         let mut loan = publisher.loan_uninit().unwrap();
         write_frame(loan.payload_mut(), &frames[sequence], sequence as u64, 0);
@@ -79,15 +88,15 @@ fn every_frame_sent_on_one_host_arrives_intact_and_in_order_on_the_other() {
     let probes = received.len();
     received.clear();
 
-    // Then frames 1..=FRAMES at 200 Hz, four times the radar's rate.
+    // Then frames 1..=count at 200 Hz, four times the radar's rate.
     let mut sent = Vec::new();
-    for sequence in 1..=FRAMES {
+    for sequence in 1..=count {
         sent.push(send(sequence));
         std::thread::sleep(Duration::from_millis(5));
         receive(&mut received);
     }
     let deadline = Instant::now() + Duration::from_secs(10);
-    while received.last().map(|frame| frame.sequence) != Some(FRAMES as u64) && Instant::now() < deadline {
+    while received.last().map(|frame| frame.sequence) != Some(count as u64) && Instant::now() < deadline {
         let _ = listener.timed_wait(|_| {}, Duration::from_millis(50));
         receive(&mut received);
     }
@@ -98,15 +107,15 @@ fn every_frame_sent_on_one_host_arrives_intact_and_in_order_on_the_other() {
     // published them (arrived), this test's subscriber on host B took them.
     let [sent_by_a, ..] = counts(&report_a, "primm/measurements");
     let [_, arrived_at_b, gaps_at_b, _] = counts(&report_b, "primm/measurements");
-    let lost = FRAMES - received.iter().filter(|frame| frame.sequence > 0).count();
+    let lost = count - received.iter().filter(|frame| frame.sequence > 0).count();
     let where_lost = format!(
-        "{lost} of {FRAMES} frames lost: tunnel A picked up {sent_by_a} ({probes} probe frames arrived before), \
-         ({probes_sent} probes, {FRAMES} frames sent), tunnel B published {arrived_at_b} with {gaps_at_b} sequence gaps\nhost A:\n{report_a}host B:\n{report_b}"
+        "{lost} of {count} frames lost: tunnel A picked up {sent_by_a} ({probes} probe frames arrived before), \
+         ({probes_sent} probes, {count} frames sent), tunnel B published {arrived_at_b} with {gaps_at_b} sequence gaps\nhost A:\n{report_a}host B:\n{report_b}"
     );
-    assert_eq!(sent_by_a as usize, probes_sent + FRAMES, "tunnel A missed local frames\n{where_lost}");
-    assert_eq!(arrived_at_b as usize, probes + FRAMES, "{where_lost}");
+    assert_eq!(sent_by_a as usize, probes_sent + count, "tunnel A missed local frames\n{where_lost}");
+    assert_eq!(arrived_at_b as usize, probes + count, "{where_lost}");
     let received: Vec<Sent> = received.into_iter().filter(|frame| frame.sequence > 0).collect();
-    assert_eq!(received.len(), FRAMES, "{where_lost}");
+    assert_eq!(received.len(), count, "{where_lost}");
     for (got, expected) in received.iter().zip(&sent) {
         assert_eq!(
             got, expected,

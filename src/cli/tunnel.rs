@@ -40,8 +40,9 @@ pub struct Args {
     /// waiting for room.
     #[arg(long)]
     pub drop_when_congested: bool,
-    /// Write this file once the tunnel is connected to a zenoh peer or router (it holds the
-    /// tunnel's zenoh id); removed again when the tunnel stops.
+    /// Write this file once the tunnel is connected to another zenoh session (a peer, a router
+    /// or, in router mode, a client); it holds the tunnel's zenoh id and is removed again when
+    /// the tunnel stops.
     #[arg(long, value_name = "FILE")]
     pub ready_file: Option<PathBuf>,
     /// Print the counters to stderr this often (0: only at the end).

@@ -25,26 +25,24 @@ impl TwoHosts {
     /// Starts the tunnels of both hosts under a fresh service prefix and waits until they are
     /// connected to each other.
     pub fn start(test: &str) -> Self {
+        Self::start_in_modes(test, "peer", "peer")
+    }
+
+    /// [`start`](Self::start) with host A's tunnel in zenoh mode `mode_a` (it listens) and host
+    /// B's in `mode_b` (it connects).
+    pub fn start_in_modes(test: &str, mode_a: &str, mode_b: &str) -> Self {
         let host_a = Iceoryx2Domain::new(&format!("{test}_a"));
         let host_b = Iceoryx2Domain::new(&format!("{test}_b"));
         let prefix = unique_prefix(test);
         let port = std::net::TcpListener::bind(("127.0.0.1", 0)).unwrap().local_addr().unwrap().port();
         let endpoint = format!("tcp/127.0.0.1:{port}");
         let mut tunnels = Vec::new();
-        for (host, option) in [(&host_a, "--listen"), (&host_b, "--connect")] {
+        for (host, option, mode) in [(&host_a, "--listen", mode_a), (&host_b, "--connect", mode_b)] {
             let ready = std::env::temp_dir().join(format!("{}tunnel.ready", host.name()));
             let _ = std::fs::remove_file(&ready);
             let child = host
                 .primm("warn")
-                .args([
-                    "tunnel",
-                    "--service-prefix",
-                    &prefix,
-                    "--mode",
-                    "peer",
-                    "--multicast-scouting",
-                    "off",
-                ])
+                .args(["tunnel", "--service-prefix", &prefix, "--mode", mode, "--multicast-scouting", "off"])
                 .args([option, &endpoint])
                 .arg("--ready-file")
                 .arg(&ready)

@@ -14,7 +14,7 @@ pub struct TunnelReport {
     /// Propagation cycles in which at least one bridge failed to move its samples (logged;
     /// iceoryx2's link says which bridge).
     pub propagation_failures: u64,
-    /// The most zenoh peers and routers connected at once.
+    /// The most zenoh sessions (peers, routers or clients) connected at once.
     pub peers_max: usize,
     /// Per stream, by service name.
     pub streams: Vec<(String, StreamCounts)>,
@@ -31,7 +31,7 @@ impl std::fmt::Display for TunnelReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(
             f,
-            "tunnel: {} cycles, {} discoveries ({} failed), {} propagation failures, at most {} zenoh peer(s)",
+            "tunnel: {} cycles, {} discoveries ({} failed), {} propagation failures, at most {} zenoh session(s) connected",
             self.cycles, self.discoveries, self.discovery_failures, self.propagation_failures, self.peers_max
         )?;
         writeln!(

@@ -72,7 +72,7 @@ pub enum TunnelRunError {
 /// A running tunnel's state, handed to [`StreamTunnel::run`]'s observer after every discovery.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TunnelStatus {
-    /// zenoh peers and routers the session is connected to right now.
+    /// zenoh sessions (peers, routers or clients) the session is connected to right now.
     pub peers: usize,
     /// The run's counters so far.
     pub report: TunnelReport,
@@ -166,10 +166,11 @@ impl StreamTunnel {
         self.session.zid().to_string()
     }
 
-    /// zenoh peers and routers the session is connected to right now.
+    /// zenoh sessions (peers, routers or clients) this one is connected to right now.
     pub fn peers(&self) -> usize {
-        let info = self.session.info();
-        info.peers_zid().wait().count() + info.routers_zid().wait().count()
+        // `transports` lists every connected session whatever its role; the stable
+        // `peers_zid` and `routers_zid` leave out the clients of a tunnel in router mode.
+        self.session.info().transports().wait().count()
     }
 
     /// The counters so far.
