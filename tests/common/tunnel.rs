@@ -51,6 +51,18 @@ impl TwoHosts {
                 .spawn()
                 .expect("primm tunnel starts (built with the `tunnel` feature)");
             tunnels.push((ChildGuard(child), ready));
+            if option == "--listen" {
+                // zenoh in client mode gives up at once when nothing listens yet: start the
+                // connecting side once the listening side accepts connections.
+                let deadline = Instant::now() + HANG_GUARD;
+                while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+                    assert!(
+                        Instant::now() < deadline,
+                        "the listening tunnel did not listen within {HANG_GUARD:?}"
+                    );
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+            }
         }
         let deadline = Instant::now() + HANG_GUARD;
         for (tunnel, ready) in &mut tunnels {
