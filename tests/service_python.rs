@@ -6,7 +6,6 @@ use crate::common;
 
 use common::service::{spawn_serve, unique_prefix, ChildGuard, TestClient};
 use primm_service::ServiceNames;
-use std::io::BufRead;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -48,15 +47,7 @@ fn the_python_subscriber_reads_the_tracks_the_tracker_publishes() {
 
     // Lines from the Python subscriber, read on a thread; one frame at a time so that the
     // Python side never falls behind by a full subscriber buffer.
-    let stdout = python.0.stdout.take().unwrap();
-    let (line_tx, line_rx) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        for line in std::io::BufReader::new(stdout).lines() {
-            if line_tx.send(line.unwrap()).is_err() {
-                break;
-            }
-        }
-    });
+    let line_rx = python.stdout_lines();
 
     let frames = common::scene_frames(&common::lanes(4), FRAMES, 0.05, 0.2, 3);
     let mut expected = Vec::new();

@@ -11,7 +11,6 @@ use common::service::{write_frame, ChildGuard, TestClient};
 use common::tunnel::{counts, TwoHosts, HANG_GUARD};
 use primm_service::catalog;
 use primm_wire::{MeasurementFrame, WireMeasurement};
-use std::io::BufRead;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -186,15 +185,7 @@ fn the_python_subscriber_on_the_far_host_reads_the_tracks_of_a_tracker_on_the_ne
         assert!(Instant::now() < deadline, "the Python subscriber did not subscribe on host B");
         std::thread::sleep(Duration::from_millis(20));
     }
-    let stdout = python.0.stdout.take().unwrap();
-    let (line_tx, line_rx) = std::sync::mpsc::channel();
-    std::thread::spawn(move || {
-        for line in std::io::BufReader::new(stdout).lines() {
-            if line_tx.send(line.unwrap()).is_err() {
-                break;
-            }
-        }
-    });
+    let line_rx = python.stdout_lines();
 
     let frames = common::scene_frames(&common::lanes(4), FRAMES + 1, 0.05, 0.2, 3);
     // Frame 0, as a stream start, until its answer reaches host B.

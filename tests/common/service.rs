@@ -159,6 +159,21 @@ impl TestClient {
 pub struct ChildGuard(pub Child);
 
 impl ChildGuard {
+    /// The lines the child prints on its (piped) stdout, read on a thread of their own.
+    pub fn stdout_lines(&mut self) -> std::sync::mpsc::Receiver<String> {
+        use std::io::BufRead;
+        let stdout = self.0.stdout.take().expect("the child's stdout is piped");
+        let (line_tx, line_rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(stdout).lines() {
+                if line_tx.send(line.unwrap()).is_err() {
+                    break;
+                }
+            }
+        });
+        line_rx
+    }
+
     pub fn pid(&self) -> i32 {
         self.0.id() as i32
     }
