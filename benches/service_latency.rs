@@ -17,10 +17,11 @@
 //! Prints HdrHistogram percentiles and writes `benches/results/service_latency.md`; nothing is
 //! asserted.
 //!
-//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--latency-every 100] [--no-write]`
+//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--inference-threads N] [--latency-every 100] [--no-write]`
 //!
-//! `--model FILE` runs the tracker with that PR model instead of the built-in one (to compare
-//! two models side by side on one machine); its results are printed, not written.
+//! `--model FILE` runs the tracker with that PR model instead of the built-in one, and
+//! `--inference-threads N` with that many inference threads instead of the configuration's (to
+//! compare side by side on one machine); their results are printed, not written.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -47,6 +48,7 @@ fn measure(
     frames: usize,
     latency_every: &str,
     model: Option<&str>,
+    inference_threads: Option<&str>,
 ) -> Vec<Histogram<u64>> {
     let prefix = unique_prefix(&format!("bench-{mode}"));
     let client = TestClient::new(&ServiceNames::new(&prefix));
@@ -57,6 +59,9 @@ fn measure(
     }
     if let Some(model) = model {
         extra.extend(["--model", model]);
+    }
+    if let Some(threads) = inference_threads {
+        extra.extend(["--inference-threads", threads]);
     }
     let serve = spawn_serve(&prefix, &extra);
     client.wait_for_tracker(Duration::from_secs(60));
@@ -122,12 +127,21 @@ fn main() {
     // computation on the tracking thread; `--latency-every 0` leaves it out.
     let latency_every = argument("--latency-every").unwrap_or_else(|| "100".into());
     let model = argument("--model");
+    let inference_threads = argument("--inference-threads");
     let us = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q) as f64 / 1000.0;
     let mut table = String::new();
     writeln!(table, "| wait mode | leg | frames | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |").unwrap();
     writeln!(table, "|---|---|---|---|---|---|---|---|").unwrap();
     for mode in modes.split(',') {
-        let histograms = measure(mode, &method, objects, frames, &latency_every, model.as_deref());
+        let histograms = measure(
+            mode,
+            &method,
+            objects,
+            frames,
+            &latency_every,
+            model.as_deref(),
+            inference_threads.as_deref(),
+        );
         for (leg, h) in LEGS.iter().zip(&histograms) {
             writeln!(
                 table,
@@ -142,12 +156,13 @@ fn main() {
             .unwrap();
         }
     }
-    let model_option = model.as_ref().map_or(String::new(), |file| format!(" --model {file}"));
+    let model_option = model.as_ref().map_or(String::new(), |file| format!(" --model {file}"))
+        + &inference_threads.as_ref().map_or(String::new(), |n| format!(" --inference-threads {n}"));
     let heading = format!(
         "Service latency through `primm serve --method {method}{model_option} --latency-every {latency_every}`, {objects} objects per frame, {frames} frames per wait mode after 500 warm-up frames, one frame in flight.\n\n"
     );
     println!("{heading}{table}");
-    if model.is_none() && !std::env::args().any(|a| a == "--no-write") {
+    if model.is_none() && inference_threads.is_none() && !std::env::args().any(|a| a == "--no-write") {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
         std::fs::create_dir_all(&dir).unwrap();
         let suffix = if latency_every == "0" { "_no_reports" } else { "" };

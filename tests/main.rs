@@ -34,6 +34,7 @@ mod motion_models;
 mod predictor_allocation;
 mod predictor_onnx;
 mod predictor_request;
+mod predictor_split;
 mod predictor_threaded;
 mod predictor_usefulness;
 mod process_noise;

@@ -1,5 +1,6 @@
-//! With the PR model on its inference thread, the tracking thread allocates nothing per frame;
-//! tract's per-run allocations happen, and are counted, on the inference thread.
+//! With the PR model on its inference thread (or two, sharing each batch), the tracking thread
+//! allocates nothing per frame; tract's per-run allocations happen, and are counted, on the
+//! inference threads.
 
 use crate::common;
 use crate::common::counting_allocator;
@@ -10,6 +11,7 @@ use primm_core::measurement::Frame;
 use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::OnnxPredictor;
+use primm_predictor::split::SplitPredictor;
 use primm_predictor::threaded::{ThreadedPredictor, INFERENCE_THREAD_NAME};
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -84,4 +86,49 @@ fn two_thousand_frames_with_the_onnx_model_allocate_nothing_on_the_tracking_thre
         inference_allocations as f64 / batches as f64
     );
     assert!(inference_allocations >= batches, "{inference_allocations} allocations over {batches} batches");
+}
+
+#[test]
+fn two_thousand_frames_with_the_model_on_two_inference_threads_allocate_nothing_on_the_tracking_thread() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr.onnx");
+    let model = OnnxPredictor::load(&path).unwrap();
+    let batches: [Arc<AtomicU64>; 2] = Default::default();
+    let on_inference_thread = Arc::new(AtomicU64::new(0));
+    let parts = [model.fork().unwrap(), model]
+        .into_iter()
+        .zip(&batches)
+        .map(|(inner, batches)| {
+            let counting = CountingPredictor {
+                inner,
+                allocations: Arc::default(),
+                batches: batches.clone(),
+                on_inference_thread: on_inference_thread.clone(),
+            };
+            ThreadedPredictor::new(counting, Duration::from_secs(10)).unwrap()
+        })
+        .collect();
+    let predictor = SplitPredictor::new(parts).unwrap();
+    let mut tracker = Tracker::with_predictor(Config::default(), predictor).unwrap();
+    // 64 objects: every frame's batch is split in two halves of 32.
+    let base = common::scene_frames(&common::lanes(64), 200, 0.04, 0.2, 7);
+    let mut frame: Frame = base[0].clone();
+    let frames = 2_000usize;
+    let warm_up = batches.each_ref().map(|b| b.load(Ordering::Relaxed));
+    let tracking_allocations = count_allocations(|| {
+        for k in 0..frames {
+            let source = &base[k % base.len()];
+            frame.timestamp_s = k as f64 * 0.04;
+            frame.measurements.clone_from(&source.measurements);
+            tracker.step(&frame).expect("valid frame");
+        }
+    });
+    assert_eq!(tracking_allocations, 0, "the tracking thread allocated");
+    for (part, (batches, warm_up)) in batches.iter().zip(warm_up).enumerate() {
+        let ran = batches.load(Ordering::Relaxed) - warm_up;
+        assert_eq!(ran, frames as u64 - 1, "part {part}");
+        assert_eq!(tracker.predictor().parts()[part].stats().deadline_misses, 0, "part {part}");
+    }
+    assert_eq!(tracker.stats().learned_predictions_missing, 0);
+    let total: u64 = batches.iter().map(|b| b.load(Ordering::Relaxed)).sum();
+    assert_eq!(on_inference_thread.load(Ordering::Relaxed), total, "every batch ran on an inference thread");
 }

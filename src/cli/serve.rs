@@ -6,6 +6,7 @@ use primm_core::mode::Method;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::{ModelError, OnnxPredictor};
+use primm_predictor::split::{on_inference_threads, InferenceThreadsError, SplitPredictor};
 use primm_predictor::threaded::ThreadedPredictor;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
 use primm_service::{
@@ -41,6 +42,10 @@ pub struct Args {
     /// Publish a latency report every this many frames (0: only at shutdown).
     #[arg(long, default_value_t = 100, value_name = "FRAMES")]
     pub latency_every: u64,
+    /// Inference threads sharing each frame's batch (1 to 8); overrides the configuration's
+    /// `predictor.inference_threads`.
+    #[arg(long, value_name = "COUNT")]
+    pub inference_threads: Option<usize>,
 }
 
 /// Why `primm serve` failed.
@@ -68,9 +73,9 @@ pub enum ServeError {
         /// What went wrong with the model file.
         source: ModelError,
     },
-    /// The inference thread could not be started.
-    #[error("cannot start the inference thread: {0}")]
-    InferenceThread(std::io::Error),
+    /// The inference threads could not be started.
+    #[error("cannot start the inference threads: {0}")]
+    InferenceThread(InferenceThreadsError),
     /// The SIGINT/SIGTERM handlers could not be installed.
     #[error("cannot install signal handlers: {0}")]
     Signals(std::io::Error),
@@ -91,7 +96,12 @@ pub fn run(args: Args) -> Result<(), ServeError> {
     if let (Some(path), false) = (&args.model, args.method.needs_predictor()) {
         return Err(ServeError::ModelWithoutPredictor { path: path.clone(), method: args.method });
     }
-    let config = config.with_modes(args.method.modes());
+    let mut config = config.with_modes(args.method.modes());
+    if let Some(threads) = args.inference_threads {
+        config.predictor.inference_threads = threads;
+    }
+    // Checked before the model and its threads are set up, so a bad value is named, not spawned.
+    config.validate()?;
     if args.method.needs_predictor() {
         let predictor = learned_predictor(args.model.as_deref(), &config, args.method)?;
         serve(Tracker::with_predictor(config, predictor)?, &args)
@@ -106,15 +116,21 @@ fn learned_predictor(
     path: Option<&Path>,
     config: &Config,
     method: Method,
-) -> Result<ThreadedPredictor, ServeError> {
+) -> Result<SplitPredictor<ThreadedPredictor>, ServeError> {
     let model = match path {
         Some(path) => OnnxPredictor::load(path),
         None => OnnxPredictor::embedded(),
     }
     .map_err(|source| ServeError::Model { method, source })?;
     let deadline = config.predictor.deadline();
-    tracing::info!(model = %model.model().source(), deadline_ms = config.predictor.deadline_ms, "learned predictor loaded");
-    ThreadedPredictor::new(model, deadline).map_err(ServeError::InferenceThread)
+    tracing::info!(
+        model = %model.model().source(),
+        deadline_ms = config.predictor.deadline_ms,
+        inference_threads = config.predictor.inference_threads,
+        "learned predictor loaded"
+    );
+    on_inference_threads(model, config.predictor.inference_threads, deadline)
+        .map_err(ServeError::InferenceThread)
 }
 
 /// Serves with `tracker` until SIGINT or SIGTERM.

@@ -30,7 +30,7 @@ use primm_core::mode::Method;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::{ModelError, OnnxPredictor};
-use primm_predictor::threaded::ThreadedPredictor;
+use primm_predictor::split::{on_inference_threads, InferenceThreadsError};
 use scene::SoakScene;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -62,8 +62,8 @@ pub struct Args {
     /// ONNX model of the learned predictor (default: the built-in model).
     #[arg(long, value_name = "FILE")]
     pub model: Option<PathBuf>,
-    /// Run the learned predictor on the inference thread with the configuration's deadline (as
-    /// `primm serve`) instead of synchronously.
+    /// Run the learned predictor on the inference threads with the configuration's deadline
+    /// and `predictor.inference_threads` (as `primm serve`) instead of synchronously.
     #[arg(long)]
     pub inference_thread: bool,
     /// Print a progress line on stderr every this many frames (0: never).
@@ -83,9 +83,9 @@ pub enum SoakError {
     /// The learned predictor's model could not be loaded.
     #[error(transparent)]
     Model(#[from] ModelError),
-    /// The inference thread could not be started.
-    #[error("cannot start the inference thread: {0}")]
-    InferenceThread(std::io::Error),
+    /// The inference threads could not be started.
+    #[error("cannot start the inference threads: {0}")]
+    InferenceThread(InferenceThreadsError),
     /// The soak ran to the end but found violations (the report was printed).
     #[error("{count} violations of the tracker's invariants or state bounds")]
     Violations {
@@ -123,7 +123,8 @@ pub fn run(args: &Args) -> Result<(), SoakError> {
     };
     if args.inference_thread {
         let deadline = config.predictor.deadline();
-        let predictor = ThreadedPredictor::new(model, deadline).map_err(SoakError::InferenceThread)?;
+        let threads = config.predictor.inference_threads;
+        let predictor = on_inference_threads(model, threads, deadline).map_err(SoakError::InferenceThread)?;
         soak(Tracker::with_predictor(config, predictor)?, args)
     } else {
         soak(Tracker::with_predictor(config, model)?, args)
@@ -278,6 +279,6 @@ fn predictor_mode(args: &Args) -> &'static str {
     match (args.method.needs_predictor(), args.inference_thread) {
         (false, _) => "no learned predictor",
         (true, false) => "learned predictor synchronous",
-        (true, true) => "learned predictor on the inference thread",
+        (true, true) => "learned predictor on the inference threads",
     }
 }

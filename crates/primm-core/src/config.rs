@@ -67,7 +67,13 @@ pub struct PredictorConfig {
     /// Factor on the model's covariance when `process_noise` is
     /// [`Learned`](LearnedProcessNoise::Learned), dimensionless (> 0).
     pub learned_process_noise_scale: f64,
+    /// Service only: inference threads that share each frame's batch (1 to
+    /// [`MAX_INFERENCE_THREADS`]); batches below 16 requests per thread use fewer.
+    pub inference_threads: usize,
 }
+
+/// Most inference threads `predictor.inference_threads` may ask for.
+pub const MAX_INFERENCE_THREADS: usize = 8;
 
 impl Default for PredictorConfig {
     fn default() -> Self {
@@ -76,6 +82,7 @@ impl Default for PredictorConfig {
             max_displacement_speed_mps: 100.0,
             process_noise: LearnedProcessNoise::Constant,
             learned_process_noise_scale: 1.0,
+            inference_threads: 2,
         }
     }
 }
@@ -509,6 +516,9 @@ fn validate_tracker_and_predictor(
     }
     positive("predictor.max_displacement_speed_mps", predictor.max_displacement_speed_mps)?;
     positive("predictor.learned_process_noise_scale", predictor.learned_process_noise_scale)?;
+    if !(1..=MAX_INFERENCE_THREADS).contains(&predictor.inference_threads) {
+        return Err(invalid("predictor.inference_threads", "must be from 1 to 8"));
+    }
     positive("tracker.max_coast_s", tracker.max_coast_s)?;
     positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
     if tracker.confirmation_hits == 0 {
@@ -619,6 +629,18 @@ mod tests {
     fn an_empty_mode_set_is_rejected() {
         let config = Config::default().with_modes(ModeSet::EMPTY);
         assert_eq!(invalid_key(&config), "imm.modes");
+    }
+
+    #[test]
+    fn no_or_too_many_inference_threads_are_rejected() {
+        for bad in [0, MAX_INFERENCE_THREADS + 1, usize::MAX] {
+            let mut config = Config::default();
+            config.predictor.inference_threads = bad;
+            assert_eq!(invalid_key(&config), "predictor.inference_threads", "threads {bad}");
+        }
+        let mut config = Config::default();
+        config.predictor.inference_threads = MAX_INFERENCE_THREADS;
+        assert!(config.validate().is_ok());
     }
 
     #[test]

@@ -105,7 +105,7 @@ pub(crate) enum Failure {
     /// The model could not be loaded.
     Model(ModelError),
     /// The inference thread could not be started.
-    InferenceThread(std::io::Error),
+    InferenceThread(primm_predictor::split::InferenceThreadsError),
     /// The tracker rejected the frame.
     Step(StepError),
     /// The caller's buffer holds `capacity` entries, `needed` are required.

@@ -15,7 +15,7 @@ use primm_core::pose::EgoPose;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::{ModelSource, OnnxPredictor, PrModel};
-use primm_predictor::threaded::ThreadedPredictor;
+use primm_predictor::split::on_inference_threads;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
@@ -85,8 +85,12 @@ impl PrimmTracker {
             };
             if options.inference_thread {
                 Box::new(
-                    ThreadedPredictor::new(onnx, config.predictor.deadline())
-                        .map_err(Failure::InferenceThread)?,
+                    on_inference_threads(
+                        onnx,
+                        config.predictor.inference_threads,
+                        config.predictor.deadline(),
+                    )
+                    .map_err(Failure::InferenceThread)?,
                 )
             } else {
                 Box::new(onnx)

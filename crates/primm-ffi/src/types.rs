@@ -105,7 +105,8 @@ pub struct PrimmTrackerOptions {
     /// When the modes include PR and `model_onnx` is NULL: use the model built into the library
     /// (`models/pr.onnx`) if true, fail with `PRIMM_STATUS_INVALID_MODEL` if false.
     pub use_builtin_model: bool,
-    /// Run the PR model on a dedicated inference thread with the configuration's
+    /// Run the PR model on dedicated inference threads (`predictor.inference_threads` of them,
+    /// sharing each frame's batch) with the configuration's
     /// `predictor.deadline_ms`: `primm_tracker_step` then allocates nothing with any method, but
     /// whether a frame gets its learned predictions depends on timing. If false, the model runs
     /// inside `primm_tracker_step` (deterministic; tract allocates during the run).

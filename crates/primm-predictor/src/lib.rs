@@ -10,6 +10,8 @@
 //!   evaluation use it).
 //! * [`threaded::ThreadedPredictor`] runs any predictor on a dedicated inference thread with a
 //!   per-frame deadline; the tracking thread allocates nothing (the real-time service uses it).
+//! * [`split::SplitPredictor`] shares each frame's batch among several predictors;
+//!   [`split::on_inference_threads`] runs the model on several inference threads at once.
 //! * [`DEFAULT_MODEL_ONNX`] is the shipped model, `models/pr.onnx`, built into the binary, so
 //!   nothing needs to be found on disk: [`predictor_for`] uses it unless a file is given.
 //!
@@ -40,6 +42,7 @@
 //! ```
 
 pub mod onnx;
+pub mod split;
 pub mod threaded;
 
 use onnx::{ModelError, OnnxPredictor};

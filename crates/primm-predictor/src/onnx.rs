@@ -382,6 +382,21 @@ impl PrModel {
         Ok(loaded)
     }
 
+    /// Another instance of this model that shares its optimised plans and has its own
+    /// execution states, for running batches on another thread at the same time. Nothing is
+    /// parsed or optimised again: only tract's per-plan state is built.
+    pub fn fork(&self) -> Result<Self, ModelError> {
+        let mut plans = Vec::with_capacity(self.plans.len());
+        for plan in &self.plans {
+            let state = plan.plan.spawn().map_err(|error| ModelError::Preparation {
+                model: self.source.clone(),
+                reason: format!("{error:#}"),
+            })?;
+            plans.push(BatchPlan { batch: plan.batch, plan: Arc::clone(&plan.plan), state });
+        }
+        Ok(PrModel { source: self.source.clone(), has_uncertainty: self.has_uncertainty, plans })
+    }
+
     /// Where the model came from.
     pub fn source(&self) -> &ModelSource {
         &self.source
@@ -668,6 +683,12 @@ impl OnnxPredictor {
             stats: OnnxPredictorStats::default(),
             last_error: None,
         }
+    }
+
+    /// A second predictor on the same model (see [`PrModel::fork`]), with its own buffers and
+    /// zeroed counters.
+    pub fn fork(&self) -> Result<Self, ModelError> {
+        Ok(Self::from_model(self.model.fork()?))
     }
 
     /// The model.
