@@ -8,13 +8,14 @@
 //! HdrHistogram, and the stages (as the tracker reports them) are timed too.
 //!
 //! * `imm`: CV + CA + CT, no learned predictor.
-//! * `pr-imm`: CV + CA + CT + PR, the PR model (`models/pr.onnx`, tract) on its own inference
-//!   thread (`ThreadedPredictor`, deadline 50 ms so that no frame misses it and the wait is
-//!   measured in full).
+//! * `pr-imm`: CV + CA + CT + PR, the PR model (`models/pr.onnx`, tract) on its inference
+//!   threads (`on_inference_threads`: `predictor.inference_threads` of the default
+//!   configuration, or `--inference-threads N`; deadline 50 ms so that no frame misses it and
+//!   the wait is measured in full).
 //!
 //! Prints a table and writes `benches/results/step_growth.{md,json,svg}`. Nothing is asserted.
 //!
-//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64]`
+//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64] [-- --inference-threads N]`
 
 use hdrhistogram::Histogram;
 use plotters::prelude::*;
@@ -25,7 +26,7 @@ use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use primm_core::stage_timing::{Stage, StageObserver};
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::OnnxPredictor;
-use primm_predictor::threaded::ThreadedPredictor;
+use primm_predictor::split::on_inference_threads;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -242,12 +243,16 @@ fn main() {
         .map(|c| c.parse().expect("an object count"))
         .collect();
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr.onnx");
+    let inference_threads: usize = argument("--inference-threads")
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(Config::default().predictor.inference_threads);
     let mut rows = Vec::new();
     for &method in &methods {
         for &count in &counts {
             let row = if method.needs_predictor() {
                 let onnx = OnnxPredictor::load(&model).expect("models/pr.onnx loads");
-                let threaded = ThreadedPredictor::new(onnx, Duration::from_millis(50)).unwrap();
+                let threaded =
+                    on_inference_threads(onnx, inference_threads, Duration::from_millis(50)).unwrap();
                 run(method, threaded, count, frames)
             } else {
                 run(method, NoPredictor, count, frames)
@@ -265,7 +270,7 @@ fn main() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
         std::fs::create_dir_all(&dir).unwrap();
         let header = format!(
-            "Tracker step time vs objects (`cargo bench --bench step_growth`), {frames} timed frames per row after {WARM_UP_FRAMES} warm-up frames.\n\n"
+            "Tracker step time vs objects (`cargo bench --bench step_growth`), {frames} timed frames per row after {WARM_UP_FRAMES} warm-up frames; PR on {inference_threads} inference thread(s).\n\n"
         );
         std::fs::write(dir.join("step_growth.md"), header + &text).unwrap();
         std::fs::write(dir.join("step_growth.json"), serde_json::to_string_pretty(&rows).unwrap()).unwrap();
