@@ -28,6 +28,32 @@ and the constant ``Q_PR`` of cars and pedestrians (used where the model gives no
     python3 tools/tune_physics.py --data out/tune/default/validation --parameters learned \\
         --method pr-imm --config config/primm.toml --out out/tune/learned.toml
 
+``--parameters imm`` tunes the IMM side of PR-IMM (scored with ``--method pr-imm``): the Markov
+transition matrix ``imm.transition`` and the initial mode probabilities
+``imm.initial_mode_probabilities`` are generated from a few scalar knobs (mode order pr, cv, ca,
+ct; see ``imm_arrays``), tuned together with the likelihood temperature
+``imm.likelihood_temperature``:
+
+    pr_leave        1 - pi[pr][pr], spread evenly over the active physics modes
+    into_pr         pi[i][pr] for every physics mode i
+    physics_switch  total probability of a physics mode moving to the other active physics modes
+                    (spread evenly); pi[i][i] = 1 - into_pr - physics_switch
+    initial_pr      initial probability of PR; the rest split evenly over the active physics modes
+    temperature     the likelihood temperature tau
+
+The probability knobs and tau are multiplied by the factors (``initial_pr`` through its odds), so
+``--factors 0.25 0.5 2 4`` (the default of this set) spans a wide range in few runs. ``--modes``
+lists candidate mode sets (each must contain pr); the mode set is one more coordinate of the
+descent. ``primm eval --methods pr-imm`` runs all four modes whatever ``imm.modes`` says, so a
+smaller set is realised in the matrices themselves: no probability flows into an inactive mode
+(its column is zero) and it starts at 0, so its prior probability stays 0 and it never enters the
+fused prior; ``imm.modes`` is written as well, for users of the configuration's mode set. The
+matrix is shared: ``--method imm`` uses its cv, ca, ct rows and columns (renormalised), so a set
+without ca or ct, or a changed physics_switch, changes the IMM too; score it alongside.
+
+    python3 tools/tune_physics.py --data out/tune/default/validation out/tune/robust/validation \\
+        --parameters imm --modes pr,cv,ca,ct pr,cv,ct pr,cv pr,ct --out out/tune/imm.toml
+
 Needs only the Python standard library (3.11+) and a release build of primm.
 """
 
@@ -63,7 +89,132 @@ LEARNED_PARAMETERS = [
     ("imm", "likelihood_temperature"),
 ]
 
-PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS}
+# Knobs that generate the [imm] section (see imm_arrays); section "imm" marks them as knobs.
+IMM_PARAMETERS = [
+    ("imm", "pr_leave"),
+    ("imm", "into_pr"),
+    ("imm", "physics_switch"),
+    ("imm", "initial_pr"),
+    ("imm", "likelihood_temperature"),
+]
+
+PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS, "imm": IMM_PARAMETERS}
+
+# Mode order of the vectors and matrices of [imm].
+MODES = ("pr", "cv", "ca", "ct")
+PHYSICS_MODES = MODES[1:]
+# Upper bounds that keep the generated matrices sensible: no mode is left more often than it stays.
+MAX_LEAVE = 0.5
+
+
+def parse_modes(value: str) -> tuple:
+    """A mode set from ``pr,cv,ct``, in the canonical order; must contain pr and a physics mode."""
+    names = [name.strip() for name in value.split(",") if name.strip()]
+    unknown = [name for name in names if name not in MODES]
+    if unknown or "pr" not in names or len(set(names)) < 2:
+        raise argparse.ArgumentTypeError(
+            f"mode set {value!r}: list pr and at least one of cv, ca, ct, comma separated")
+    return tuple(mode for mode in MODES if mode in names)
+
+
+def imm_arrays(knobs: dict, modes: tuple) -> tuple:
+    """The transition matrix (4x4, rows sum to 1) and initial mode probabilities for ``knobs``
+    over the active ``modes`` (order pr, cv, ca, ct).
+
+    PR stays with 1 - pr_leave and moves to each active physics mode with pr_leave / n (n active
+    physics modes). A physics mode moves to PR with into_pr, to each other active physics mode
+    with physics_switch / (n - 1), and stays with the rest (with n = 1 it keeps physics_switch
+    too). No probability moves into an inactive mode; an inactive physics mode's row is that of
+    an active one with no probability on itself, so it is left at once. New tracks start in PR
+    with initial_pr and in each active physics mode with (1 - initial_pr) / n.
+    Entries are rounded to 1e-8, the diagonal absorbing the rounding, so rows sum to 1."""
+    physics = [mode for mode in PHYSICS_MODES if mode in modes]
+    n = len(physics)
+    if "pr" not in modes or n == 0:
+        raise ValueError(f"mode set {modes}: needs pr and a physics mode")
+    pr_leave, into_pr, switch = knobs["pr_leave"], knobs["into_pr"], knobs["physics_switch"]
+    if not (0.0 <= pr_leave <= 1.0 and 0.0 <= into_pr and 0.0 <= switch and into_pr + switch <= 1.0):
+        raise ValueError(f"knobs out of range: {knobs}")
+    matrix = []
+    for source in MODES:
+        row = {mode: 0.0 for mode in MODES}
+        if source == "pr":
+            for mode in physics:
+                row[mode] = pr_leave / n
+        else:
+            row["pr"] = into_pr
+            others = [mode for mode in physics if mode != source]
+            if source in physics and not others:
+                pass  # the only physics mode: everything but into_pr stays
+            else:
+                for mode in others:
+                    row[mode] = switch / len(others)
+        row = {mode: round(value, 8) for mode, value in row.items()}
+        if source in modes:
+            row[source] = round(1.0 - sum(v for m, v in row.items() if m != source), 8)
+        else:
+            # Inactive physics mode: all of its row goes to the active modes, proportionally.
+            total = sum(row.values())
+            row = {mode: round(value / total, 8) for mode, value in row.items()}
+            largest = max(physics + ["pr"], key=lambda mode: row[mode])
+            row[largest] = round(1.0 - sum(v for m, v in row.items() if m != largest), 8)
+        matrix.append([row[mode] for mode in MODES])
+    initial_pr = knobs["initial_pr"]
+    if not 0.0 < initial_pr < 1.0:
+        raise ValueError(f"initial_pr {initial_pr} not in (0, 1)")
+    initial = {mode: 0.0 for mode in MODES}
+    for mode in physics:
+        initial[mode] = round((1.0 - initial_pr) / n, 8)
+    initial["pr"] = round(1.0 - sum(initial[mode] for mode in physics), 8)
+    return matrix, [initial[mode] for mode in MODES]
+
+
+def imm_knobs(config: dict) -> tuple:
+    """The knobs and active modes that describe ``config``'s [imm] section (exactly, for matrices
+    of the form imm_arrays writes; else the averages over the active modes)."""
+    imm = config["imm"]
+    modes = tuple(mode for mode in MODES if mode in imm["modes"])
+    matrix = imm["transition"]
+    physics = [MODES.index(mode) for mode in modes if mode != "pr"]
+    pr_index = MODES.index("pr")
+    active = [pr_index] + physics
+    row_sum = lambda i: sum(matrix[i][j] for j in active)  # noqa: E731 (renormalised as primm does)
+    pr_leave = sum(matrix[pr_index][j] for j in physics) / row_sum(pr_index)
+    into_pr = sum(matrix[i][pr_index] / row_sum(i) for i in physics) / len(physics)
+    switch = sum(matrix[i][j] / row_sum(i) for i in physics for j in physics if j != i) / len(physics)
+    initial = imm["initial_mode_probabilities"]
+    initial_pr = initial[pr_index] / sum(initial[j] for j in active)
+    knobs = {"pr_leave": pr_leave, "into_pr": into_pr, "physics_switch": switch,
+             "initial_pr": initial_pr, "likelihood_temperature": float(imm["likelihood_temperature"])}
+    return {key: float(f"{value:.6g}") for key, value in knobs.items()}, modes
+
+
+def format_matrix(matrix: list) -> str:
+    rows = "".join(f"    [{', '.join(repr(value) for value in row)}],\n" for row in matrix)
+    return f"[\n{rows}]"
+
+
+def imm_text(text: str, knobs: dict, modes: tuple) -> str:
+    """``text`` (TOML) with the [imm] keys generated from ``knobs`` over ``modes``."""
+    matrix, initial = imm_arrays(knobs, modes)
+    text = substitute_raw(text, "imm", "modes", "[" + ", ".join(f'"{mode}"' for mode in modes) + "]")
+    text = substitute_raw(text, "imm", "transition", format_matrix(matrix))
+    text = substitute_raw(text, "imm", "initial_mode_probabilities",
+                          "[" + ", ".join(repr(value) for value in initial) + "]")
+    return substitute(text, "imm", "likelihood_temperature", knobs["likelihood_temperature"])
+
+
+def scaled_knob(key: str, base: float, factor: float):
+    """``base`` scaled by ``factor`` as the knob ``key`` is tuned, or None where out of range:
+    initial_pr through its odds, the others directly."""
+    if key == "initial_pr":
+        odds = base / (1.0 - base) * factor
+        value = odds / (1.0 + odds)
+        return float(f"{value:.4g}") if 0.001 <= value <= 0.999 else None
+    value = float(f"{base * factor:.4g}")
+    if key in ("pr_leave", "into_pr", "physics_switch") and not 0.0 < value <= MAX_LEAVE:
+        return None
+    return value
 
 
 def parse_args(argv=None):
@@ -72,14 +223,26 @@ def parse_args(argv=None):
     parser.add_argument("--config", default="config/primm.toml", help="starting configuration")
     parser.add_argument("--primm", default="target/release/primm", help="the primm binary")
     parser.add_argument("--out", required=True, help="where to write the tuned configuration (TOML)")
-    parser.add_argument("--factors", type=float, nargs="+", default=[0.5, 0.7, 1.4, 2.0])
+    parser.add_argument("--factors", type=float, nargs="+", default=None,
+                        help="factors tried on each parameter (default: 0.5 0.7 1.4 2; 0.25 0.5 2 4 for imm)")
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--idf1-weight", type=float, default=20.0, help="metres of RMSE per unit of IDF1 lost")
     parser.add_argument("--tracking-frame", choices=["world", "vehicle"], default="world")
     parser.add_argument("--parameters", choices=sorted(PARAMETER_SETS), default="physics",
                         help="which parameters to tune")
-    parser.add_argument("--method", default="imm", help="the method scored (imm, pr-imm, ...)")
-    return parser.parse_args(argv)
+    parser.add_argument("--method", default=None,
+                        help="the method scored (imm, pr-imm, ...); default: pr-imm for --parameters imm, else imm")
+    parser.add_argument("--modes", type=parse_modes, nargs="+", default=None,
+                        help="--parameters imm: candidate mode sets, e.g. pr,cv,ca,ct pr,cv,ct (default: the "
+                             "configuration's)")
+    args = parser.parse_args(argv)
+    if args.method is None:
+        args.method = "pr-imm" if args.parameters == "imm" else "imm"
+    if args.factors is None:
+        args.factors = [0.25, 0.5, 2.0, 4.0] if args.parameters == "imm" else [0.5, 0.7, 1.4, 2.0]
+    if args.modes is not None and args.parameters != "imm":
+        parser.error("--modes goes with --parameters imm")
+    return args
 
 
 def get_value(config: dict, section: str, key: str) -> float:
@@ -91,6 +254,13 @@ def get_value(config: dict, section: str, key: str) -> float:
 
 def substitute(text: str, section: str, key: str, value: float) -> str:
     """``text`` (TOML) with ``key`` of ``[section]`` set to ``value``; comments are kept."""
+    return substitute_raw(text, section, key, repr(value))
+
+
+def substitute_raw(text: str, section: str, key: str, value: str) -> str:
+    """``text`` (TOML) with ``key`` of ``[section]`` set to the TOML text ``value`` (which may span
+    lines); an array value may span lines too (up to its closing bracket). The comment lines
+    around it are kept, and so is a comment at the end of a one-line value."""
     lines = text.splitlines(keepends=True)
     current = None
     for index, line in enumerate(lines):
@@ -99,8 +269,17 @@ def substitute(text: str, section: str, key: str, value: float) -> str:
             current = header.group(1).strip()
             continue
         if current == section and re.match(rf"\s*{re.escape(key)}\s*=", line):
-            comment = line[line.index("#"):].rstrip("\n") if "#" in line else ""
-            lines[index] = f"{key} = {value!r}" + (f" {comment}" if comment else "") + "\n"
+            end, depth = index, 0
+            while True:
+                code = lines[end].split("#", 1)[0]
+                if end == index:
+                    code = code.split("=", 1)[1]
+                depth += code.count("[") - code.count("]")
+                if depth <= 0 or end + 1 == len(lines):
+                    break
+                end += 1
+            comment = line[line.index("#"):].rstrip("\n") if end == index and "#" in line else ""
+            lines[index:end + 1] = [f"{key} = {value}" + (f" {comment}" if comment else "") + "\n"]
             return "".join(lines)
     raise KeyError(f"[{section}] {key} not found")
 
@@ -123,7 +302,19 @@ def score(args, text: str) -> dict:
                 scored = json.load(handle)["methods"][args.method.replace("-", "_")]
             result["rmse_xy"].append(scored["rmse_xy"])
             result["idf1"].append(scored["idf1"])
+            pr_probability = scored_pr_probability(report, args.method)
+            if pr_probability is not None:
+                result.setdefault("pr_probability", []).append(pr_probability)
     return result
+
+
+def scored_pr_probability(report: str, method: str):
+    """PR's mean mode probability in a ``primm eval`` report, where the method has one."""
+    with open(report) as handle:
+        probabilities = json.load(handle).get("mode_probabilities") or {}
+    if probabilities.get("method") == method.replace("-", "_") and "pr" in probabilities:
+        return probabilities["pr"]
+    return None
 
 
 def objective(args, result: dict, start: dict) -> float:
@@ -141,6 +332,8 @@ def main(argv=None) -> int:
             sys.exit(f"tune_physics: {data} is an evaluation split; tune on validation data only")
     with open(args.config) as handle:
         text = handle.read()
+    if args.parameters == "imm":
+        return tune_imm(args, text)
     config = tomllib.loads(text)
     start = score(args, text)
     best = objective(args, start, start)
@@ -161,12 +354,60 @@ def main(argv=None) -> int:
                     config = tomllib.loads(text)
                     print(f"round {round_index + 1}: {section}.{key} = {value}  objective {best:.4f}  {result}",
                           flush=True)
+    return write_result(args, text, log, best)
+
+
+def write_result(args, text: str, log: list, best: float) -> int:
     with open(args.out, "w") as handle:
         handle.write(text)
     with open(os.path.splitext(args.out)[0] + ".log.json", "w") as handle:
         json.dump(log, handle, indent=1)
     print(f"wrote {args.out} (objective {log[0]['objective']:.4f} -> {best:.4f}, {len(log)} runs)")
     return 0
+
+
+def tune_imm(args, text: str) -> int:
+    """Coordinate descent over the knobs of IMM_PARAMETERS and, once per round, the mode set."""
+    original = text
+    knobs, modes = imm_knobs(tomllib.loads(text))
+    start = score(args, text)  # the configuration as given, unchanged
+    best = objective(args, start, start)
+    log = [{"parameter": None, "value": None, "knobs": dict(knobs), "modes": list(modes), "result": start,
+            "objective": best}]
+    print(f"start: {list(modes)} {knobs}  objective {best:.4f}  {start}", flush=True)
+
+    def trial(name, value, candidate_knobs, candidate_modes):
+        nonlocal best, knobs, modes, text
+        candidate = imm_text(original, candidate_knobs, candidate_modes)
+        result = score(args, candidate)
+        value_objective = objective(args, result, start)
+        log.append({"parameter": name, "value": value, "knobs": dict(candidate_knobs),
+                    "modes": list(candidate_modes), "result": result, "objective": value_objective})
+        print(f"  {name} = {value}: objective {value_objective:.4f}  {result}", flush=True)
+        if value_objective < best - 1e-6:
+            best, knobs, modes, text = value_objective, dict(candidate_knobs), candidate_modes, candidate
+            print(f"  -> kept {name} = {value}  objective {best:.4f}", flush=True)
+
+    for round_index in range(args.rounds):
+        print(f"round {round_index + 1}", flush=True)
+        for candidate_modes in args.modes or []:
+            if candidate_modes != modes:
+                trial("modes", ",".join(candidate_modes), knobs, candidate_modes)
+        for _, key in IMM_PARAMETERS:
+            if key == "physics_switch" and len(modes) < 3:
+                continue  # a single physics mode has nothing to switch to
+            base = knobs[key]
+            for factor in args.factors:
+                value = scaled_knob(key, base, factor)
+                if value is None or value == base:
+                    continue
+                candidate_knobs = dict(knobs, **{key: value})
+                if candidate_knobs["into_pr"] + candidate_knobs["physics_switch"] > MAX_LEAVE:
+                    continue
+                trial(key, value, candidate_knobs, modes)
+        print(f"after round {round_index + 1}: {list(modes)} {knobs}  objective {best:.4f}", flush=True)
+    log.append({"parameter": "chosen", "value": None, "knobs": knobs, "modes": list(modes), "objective": best})
+    return write_result(args, text, log, best)
 
 
 if __name__ == "__main__":
