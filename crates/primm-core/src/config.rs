@@ -288,7 +288,9 @@ impl Default for Config {
                     [off, off, stay, off],
                     [off, off, off, stay],
                 ],
-                initial_mode_probabilities: [0.25; MODE_COUNT],
+                // PR starts at 1/13 (odds 1:12), chosen on validation data
+                // (`config/primm.toml` says how).
+                initial_mode_probabilities: [0.07692001, 0.30769333, 0.30769333, 0.30769333],
                 likelihood_temperature: 0.1,
                 mode_probability_floor: 0.001,
             },
