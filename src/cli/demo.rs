@@ -101,6 +101,7 @@ pub enum DemoError {
     #[error("--hosts 2 needs the tunnel, which this primm was built without; build it with `cargo build --release --features tunnel`")]
     TunnelNotBuilt,
     /// No free TCP port on the loopback interface for the tunnels.
+    #[cfg_attr(not(feature = "tunnel"), allow(dead_code))]
     #[error("cannot find a free TCP port on 127.0.0.1 for the tunnel: {0}")]
     Port(std::io::Error),
 }
