@@ -4,11 +4,13 @@
 //! No outcome depends on the machine's speed: the test either sends a frame and waits for its
 //! answer, or lets a publisher with flow control (`--max-in-flight 1`: a frame goes out only
 //! once the tracker answered the one before) pace itself against the tracker. The timeouts are
-//! there only to fail instead of hanging when the tracker is gone.
+//! there only to fail instead of hanging when the tracker is gone. Each test runs in an
+//! iceoryx2 domain of its own ([`PrivateService`]): what a killed process leaves behind stays
+//! there.
 
 use crate::common;
 
-use common::service::{spawn_serve, unique_prefix, ChildGuard, TestClient};
+use common::service::{unique_prefix, ChildGuard, PrivateService, TestClient};
 use primm_core::measurement::Frame;
 use primm_service::ServiceNames;
 use primm_wire::{FrameStatus, TRACK_FLAG_TRACKER_RESET};
@@ -32,14 +34,15 @@ fn answer(client: &TestClient) -> (u64, Option<FrameStatus>, Vec<u64>, u16, u8) 
 #[test]
 fn malformed_frames_are_rejected_and_counted_and_the_next_good_frame_is_tracked() {
     let prefix = unique_prefix("malformed");
-    let client = TestClient::new(&ServiceNames::new(&prefix));
-    let serve = spawn_serve(&prefix, &[]);
+    let service = PrivateService::new("faults_malformed", &ServiceNames::new(&prefix));
+    let client = service.client();
+    let serve = service.serve(&prefix, &[]);
     client.wait_for_tracker(Duration::from_secs(20));
     let frames = lane_frames(40);
     let mut confirmed_before = Vec::new();
     for (k, frame) in frames.iter().take(20).enumerate() {
         client.send(frame, k as u64, 0);
-        let (sequence, status, confirmed, _, _) = answer(&client);
+        let (sequence, status, confirmed, _, _) = answer(client);
         assert_eq!((sequence, status), (k as u64, Some(FrameStatus::Tracked)));
         confirmed_before = confirmed;
     }
@@ -49,7 +52,7 @@ fn malformed_frames_are_rejected_and_counted_and_the_next_good_frame_is_tracked(
     let mut with_nan = frames[20].clone();
     with_nan.measurements[0].x_m = f64::NAN;
     client.send(&with_nan, 20, 0);
-    let (_, status, _, rejected, _) = answer(&client);
+    let (_, status, _, rejected, _) = answer(client);
     assert_eq!((status, rejected), (Some(FrameStatus::Tracked), 1));
 
     // More measurements claimed than a frame holds.
@@ -58,20 +61,20 @@ fn malformed_frames_are_rejected_and_counted_and_the_next_good_frame_is_tracked(
         frame.sensor_timestamp_s = frames[21].timestamp_s;
         frame.count = 100_000;
     });
-    assert_eq!(answer(&client).1, Some(FrameStatus::RejectedTooManyMeasurements));
+    assert_eq!(answer(client).1, Some(FrameStatus::RejectedTooManyMeasurements));
     // Time going backwards.
     client.send(&frames[5], 22, 0);
-    assert_eq!(answer(&client).1, Some(FrameStatus::RejectedTimestampNotIncreasing));
+    assert_eq!(answer(client).1, Some(FrameStatus::RejectedTimestampNotIncreasing));
     // A NaN timestamp.
     client.send_raw(|frame| {
         frame.sequence = 23;
         frame.sensor_timestamp_s = f64::NAN;
     });
-    assert_eq!(answer(&client).1, Some(FrameStatus::RejectedNonFiniteTimestamp));
+    assert_eq!(answer(client).1, Some(FrameStatus::RejectedNonFiniteTimestamp));
 
     // The next good frame continues the same tracks.
     client.send(&frames[24], 24, 0);
-    let (sequence, status, confirmed, rejected, flags) = answer(&client);
+    let (sequence, status, confirmed, rejected, flags) = answer(client);
     assert_eq!((sequence, status, rejected), (24, Some(FrameStatus::Tracked), 0));
     assert_eq!(confirmed, confirmed_before, "the rejected frames did not disturb the tracks");
     assert_eq!(flags & TRACK_FLAG_TRACKER_RESET, 0);
@@ -86,13 +89,15 @@ fn malformed_frames_are_rejected_and_counted_and_the_next_good_frame_is_tracked(
 #[test]
 fn a_subscriber_that_dies_or_stops_reading_never_blocks_the_tracker() {
     let prefix = unique_prefix("slow-subscriber");
-    let client = TestClient::new(&ServiceNames::new(&prefix));
-    let _serve = spawn_serve(&prefix, &[]);
+    let service = PrivateService::new("faults_subscriber", &ServiceNames::new(&prefix));
+    let client = service.client();
+    let _serve = service.serve(&prefix, &[]);
     client.wait_for_tracker(Duration::from_secs(20));
     let spawn_subscriber = || {
         ChildGuard(
             Command::new(env!("CARGO_BIN_EXE_primm"))
                 .args(["subscribe", "--quiet", "--service-prefix", &prefix])
+                .env("PRIMM_ICEORYX2_DOMAIN", service.domain.name())
                 .stdout(Stdio::null())
                 .stderr(Stdio::null())
                 .spawn()
@@ -113,7 +118,7 @@ fn a_subscriber_that_dies_or_stops_reading_never_blocks_the_tracker() {
     let frames = lane_frames(300);
     for (k, frame) in frames.iter().enumerate() {
         client.send(frame, k as u64, 0);
-        let (sequence, status, _, _, _) = answer(&client);
+        let (sequence, status, _, _, _) = answer(client);
         assert_eq!((sequence, status), (k as u64, Some(FrameStatus::Tracked)));
     }
     stopped.signal(libc::SIGCONT);
@@ -147,8 +152,9 @@ fn summary_counts(stdout: &str) -> (u64, u64, u64, u64, u64) {
 #[test]
 fn a_publisher_killed_mid_stream_and_restarted_resumes_tracking() {
     let prefix = unique_prefix("publisher-restart");
-    let client = TestClient::new(&ServiceNames::new(&prefix));
-    let serve = spawn_serve(&prefix, &[]);
+    let service = PrivateService::new("faults_publisher", &ServiceNames::new(&prefix));
+    let client = service.client();
+    let serve = service.serve(&prefix, &[]);
     client.wait_for_tracker(Duration::from_secs(20));
     // With flow control the tracker's input can never overflow, whatever the load. The test's
     // own answer buffer (16 frames) may drop answers when the test falls behind, so nothing
@@ -160,6 +166,7 @@ fn a_publisher_killed_mid_stream_and_restarted_resumes_tracking() {
                 .args(["--service-prefix", &prefix])
                 .args(extra)
                 .env("RUST_LOG", "warn")
+                .env("PRIMM_ICEORYX2_DOMAIN", service.domain.name())
                 .stdout(Stdio::null())
                 .spawn()
                 .unwrap(),
@@ -169,7 +176,7 @@ fn a_publisher_killed_mid_stream_and_restarted_resumes_tracking() {
     let first = spawn_publisher(&[]);
     let mut previous = None;
     loop {
-        let (sequence, status, ..) = answer(&client);
+        let (sequence, status, ..) = answer(client);
         assert_eq!(status, Some(FrameStatus::Tracked), "frame {sequence}");
         assert!(previous.is_none_or(|previous| sequence > previous), "{sequence} after {previous:?}");
         previous = Some(sequence);
@@ -214,18 +221,19 @@ fn a_publisher_killed_mid_stream_and_restarted_resumes_tracking() {
 #[test]
 fn the_tracker_restarts_after_sigkill() {
     let prefix = unique_prefix("tracker-restart");
-    let client = TestClient::new(&ServiceNames::new(&prefix));
+    let service = PrivateService::new("faults_tracker", &ServiceNames::new(&prefix));
+    let client = service.client();
     let frames = lane_frames(40);
-    let first = spawn_serve(&prefix, &[]);
+    let first = service.serve(&prefix, &[]);
     client.wait_for_tracker(Duration::from_secs(20));
     for (k, frame) in frames.iter().take(10).enumerate() {
         client.send(frame, k as u64, 0);
-        assert_eq!(answer(&client).0, k as u64);
+        assert_eq!(answer(client).0, k as u64);
     }
     first.signal(libc::SIGKILL);
     drop(first);
 
-    let second = spawn_serve(&prefix, &[]);
+    let second = service.serve(&prefix, &[]);
     // The dead tracker's publisher may still be listed until the new node cleans it up.
     let deadline = Instant::now() + Duration::from_secs(20);
     loop {
@@ -241,7 +249,7 @@ fn the_tracker_restarts_after_sigkill() {
     for (k, frame) in frames.iter().enumerate().skip(11) {
         client.send(frame, k as u64, 0);
         let (sequence, status, _, _, _) = loop {
-            let answer = answer(&client);
+            let answer = answer(client);
             if answer.0 != 10 {
                 break answer;
             }

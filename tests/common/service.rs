@@ -217,7 +217,13 @@ impl Drop for ChildGuard {
 
 /// `primm serve` under `prefix`, stdout captured.
 pub fn spawn_serve(prefix: &str, extra: &[&str]) -> ChildGuard {
-    let child = Command::new(env!("CARGO_BIN_EXE_primm"))
+    spawn_serve_with(Command::new(env!("CARGO_BIN_EXE_primm")), prefix, extra)
+}
+
+/// `primm serve` as [`spawn_serve`] starts it, from `command` (e.g. with a domain in its
+/// environment).
+fn spawn_serve_with(mut command: Command, prefix: &str, extra: &[&str]) -> ChildGuard {
+    let child = command
         .args(["serve", "--service-prefix", prefix])
         .args(if extra.contains(&"--latency-every") { &[][..] } else { &["--latency-every", "20"][..] })
         .args(extra)
@@ -306,6 +312,13 @@ impl Iceoryx2Domain {
 
 impl Drop for Iceoryx2Domain {
     fn drop(&mut self) {
+        self.remove_files();
+    }
+}
+
+impl Iceoryx2Domain {
+    /// Removes every file of the domain.
+    pub fn remove_files(&self) {
         for path in self.all_files() {
             let _ = std::fs::remove_file(&path);
             // Node directories are named by the node's id and hold only its tag files.
@@ -315,6 +328,45 @@ impl Drop for Iceoryx2Domain {
                 }
             }
         }
+    }
+}
+
+/// A test's client and its processes in a private iceoryx2 domain, for tests that kill
+/// processes. A process killed while it creates a shared-memory resource leaves it half made,
+/// and iceoryx2 0.10's clean-up of dead nodes (every node's drop runs it) waits on such a
+/// resource without limit: in a domain of its own, that can stall no other test. Declare it
+/// before the test's [`ChildGuard`]s: when it is dropped, the processes are gone, and it removes
+/// the domain's files before its client's node, so that the node's clean-up finds nothing to
+/// wait on.
+pub struct PrivateService {
+    pub domain: Iceoryx2Domain,
+    client: std::mem::ManuallyDrop<TestClient>,
+}
+
+impl PrivateService {
+    pub fn new(test: &str, names: &ServiceNames) -> Self {
+        let domain = Iceoryx2Domain::new(test);
+        let client = std::mem::ManuallyDrop::new(TestClient::in_domain(names, domain.name()));
+        Self { domain, client }
+    }
+
+    pub fn client(&self) -> &TestClient {
+        &self.client
+    }
+
+    /// `primm serve` in the domain, as [`spawn_serve`] starts it.
+    pub fn serve(&self, prefix: &str, extra: &[&str]) -> ChildGuard {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_primm"));
+        command.env("PRIMM_ICEORYX2_DOMAIN", self.domain.name());
+        spawn_serve_with(command, prefix, extra)
+    }
+}
+
+impl Drop for PrivateService {
+    fn drop(&mut self) {
+        self.domain.remove_files();
+        // SAFETY: the client is dropped here only, once.
+        unsafe { std::mem::ManuallyDrop::drop(&mut self.client) };
     }
 }
 
