@@ -2,7 +2,7 @@
 //! several inference threads), every result in its place, small batches kept whole, a fault
 //! confined to its own part, and the same displacements as one predictor gives.
 
-use glam::DVec2;
+use crate::common::{anchored_requests as requests, echoed_anchor as expected};
 use primm_core::predictor::{Displacement, DisplacementPredictor, HistoryEntry, PredictionRequest};
 use primm_predictor::onnx::OnnxPredictor;
 use primm_predictor::split::{
@@ -50,25 +50,6 @@ impl DisplacementPredictor for Recorder {
             *out = *result;
         }
     }
-}
-
-fn requests(frame: usize, count: usize) -> Vec<PredictionRequest> {
-    (0..count)
-        .map(|i| {
-            let entry = HistoryEntry {
-                x_m: (frame * 1000 + i) as f64,
-                y_m: 1.0,
-                radial_velocity_mps: 0.0,
-                rcs_dbsm: 0.0,
-                timestamp_s: frame as f64 * 0.02,
-            };
-            PredictionRequest::from_history(&[entry], frame as f64 * 0.02 + 0.02)
-        })
-        .collect()
-}
-
-fn expected(frame: usize, i: usize) -> Option<Displacement> {
-    Some((DVec2::new((frame * 1000 + i) as f64, 1.0) / 1000.0).into())
 }
 
 /// The recorded batch sizes without the threaded predictor's empty warm-up batch.

@@ -7,6 +7,7 @@
 //! long that is, and the test knows the order of events from the gate instead of from sleeps.
 //! Frames that must get their results wait [`PATIENT`], a deadline no loaded machine reaches.
 
+use crate::common::{anchored_requests as requests, echoed_anchor as expected};
 use glam::DVec2;
 use primm_core::predictor::{Displacement, DisplacementPredictor, HistoryEntry, PredictionRequest};
 use primm_predictor::onnx::OnnxPredictor;
@@ -99,25 +100,6 @@ impl DisplacementPredictor for Echo {
             *out = Some((request.anchor_m / 1000.0).into());
         }
     }
-}
-
-fn requests(frame: usize, count: usize) -> Vec<PredictionRequest> {
-    (0..count)
-        .map(|i| {
-            let entry = HistoryEntry {
-                x_m: (frame * 100 + i) as f64,
-                y_m: 1.0,
-                radial_velocity_mps: 0.0,
-                rcs_dbsm: 0.0,
-                timestamp_s: frame as f64 * 0.02,
-            };
-            PredictionRequest::from_history(&[entry], frame as f64 * 0.02 + 0.02)
-        })
-        .collect()
-}
-
-fn expected(frame: usize, i: usize) -> Option<Displacement> {
-    Some((DVec2::new((frame * 100 + i) as f64, 1.0) / 1000.0).into())
 }
 
 #[test]

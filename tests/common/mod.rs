@@ -204,6 +204,29 @@ impl primm_core::predictor::DisplacementPredictor for LaneOracle {
         }
     }
 }
+/// One request per track of `frame`, each a single measurement at `x = 100·frame + i`, so that
+/// [`echoed_anchor`] names the request an answer belongs to (for predictors that answer with the
+/// anchor scaled by 1/1000).
+pub fn anchored_requests(frame: usize, count: usize) -> Vec<primm_core::predictor::PredictionRequest> {
+    (0..count)
+        .map(|i| {
+            let entry = primm_core::predictor::HistoryEntry {
+                x_m: (frame * 100 + i) as f64,
+                y_m: 1.0,
+                radial_velocity_mps: 0.0,
+                rcs_dbsm: 0.0,
+                timestamp_s: frame as f64 * 0.02,
+            };
+            primm_core::predictor::PredictionRequest::from_history(&[entry], frame as f64 * 0.02 + 0.02)
+        })
+        .collect()
+}
+
+/// The anchor of request `i` of [`anchored_requests`]`(frame, _)`, scaled by 1/1000.
+pub fn echoed_anchor(frame: usize, i: usize) -> Option<primm_core::predictor::Displacement> {
+    Some((glam::DVec2::new((frame * 100 + i) as f64, 1.0) / 1000.0).into())
+}
+
 pub mod counting_allocator;
 pub mod service;
 #[cfg(feature = "tunnel")]

@@ -173,13 +173,9 @@ pub fn on_inference_threads(
     if threads == 0 {
         return Err(InferenceThreadsError::NoThreads);
     }
-    let mut models = Vec::with_capacity(threads);
-    for _ in 1..threads {
-        models.push(model.fork()?);
-    }
-    models.insert(0, model);
+    let forks = (1..threads).map(|_| model.fork()).collect::<Result<Vec<_>, _>>()?;
     let mut parts = Vec::with_capacity(threads);
-    for model in models {
+    for model in std::iter::once(model).chain(forks) {
         parts.push(ThreadedPredictor::new(model, deadline).map_err(InferenceThreadsError::Spawn)?);
     }
     SplitPredictor::new(parts).map_err(|_| InferenceThreadsError::NoThreads)
