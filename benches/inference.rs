@@ -1,6 +1,10 @@
-//! PR model inference latency with tract, per batch size.
+//! PR model inference latency with tract and with the native forward pass, per batch size.
 //!
 //! `cargo bench --bench inference`
+//!
+//! The groups `pr_model` and `onnx_predictor` run on tract, `pr_model_native` and
+//! `onnx_predictor_native` the same inputs on the native forward pass
+//! (`primm_predictor::native`).
 //!
 //! `pr_model/B` is one `PrModel::run` of B samples (the parity fixture's inputs, repeated):
 //! what the inference thread spends per frame when B model rows are needed. `onnx_predictor/N`
@@ -12,6 +16,7 @@
 //! 23.8 and 21.6 µs per sample; `onnx_predictor` 649 µs (16 tracks), 2.19 ms (64 tracks).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use primm_core::config::InferenceEngine;
 use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
 use primm_predictor::onnx::{OnnxPredictor, PrModel};
 use std::hint::black_box;
@@ -37,9 +42,24 @@ fn parity_inputs(batch: usize) -> (Vec<f32>, Vec<f32>) {
     (features, valid)
 }
 
+/// The group name of `base` on `engine`.
+fn group_name(base: &str, engine: InferenceEngine) -> String {
+    match engine {
+        InferenceEngine::Tract => base.to_string(),
+        InferenceEngine::Native => format!("{base}_native"),
+    }
+}
+
 fn model_run(c: &mut Criterion) {
+    for engine in [InferenceEngine::Tract, InferenceEngine::Native] {
+        model_run_on(c, engine);
+    }
+}
+
+fn model_run_on(c: &mut Criterion, engine: InferenceEngine) {
     let mut model = PrModel::load(model_path()).unwrap();
-    let mut group = c.benchmark_group("pr_model");
+    assert_eq!(model.set_engine(engine), engine);
+    let mut group = c.benchmark_group(group_name("pr_model", engine));
     for batch in [1usize, 16, 64, 256] {
         let (features, valid) = parity_inputs(batch);
         let mut out = vec![0.0f32; 2 * batch];
@@ -52,8 +72,15 @@ fn model_run(c: &mut Criterion) {
 }
 
 fn predictor_frame(c: &mut Criterion) {
+    for engine in [InferenceEngine::Tract, InferenceEngine::Native] {
+        predictor_frame_on(c, engine);
+    }
+}
+
+fn predictor_frame_on(c: &mut Criterion, engine: InferenceEngine) {
     let mut predictor = OnnxPredictor::load(model_path()).unwrap();
-    let mut group = c.benchmark_group("onnx_predictor");
+    assert_eq!(predictor.set_engine(engine), engine);
+    let mut group = c.benchmark_group(group_name("onnx_predictor", engine));
     for tracks in [16usize, 64] {
         let t = 1.0;
         let requests: Vec<PredictionRequest> = (0..tracks)

@@ -17,7 +17,7 @@
 //! Prints HdrHistogram percentiles and writes `benches/results/service_latency.md`; nothing is
 //! asserted.
 //!
-//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--inference-threads N] [--latency-every 100] [--no-write]`
+//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--inference-threads N] [--engine native|tract] [--latency-every 100] [--no-write]`
 //!
 //! `--model FILE` runs the tracker with that PR model instead of the built-in one, and
 //! `--inference-threads N` with that many inference threads instead of the configuration's (to
@@ -49,6 +49,7 @@ fn measure(
     latency_every: &str,
     model: Option<&str>,
     inference_threads: Option<&str>,
+    engine: Option<&str>,
 ) -> Vec<Histogram<u64>> {
     let prefix = unique_prefix(&format!("bench-{mode}"));
     let client = TestClient::new(&ServiceNames::new(&prefix));
@@ -62,6 +63,9 @@ fn measure(
     }
     if let Some(threads) = inference_threads {
         extra.extend(["--inference-threads", threads]);
+    }
+    if let Some(engine) = engine {
+        extra.extend(["--engine", engine]);
     }
     let serve = spawn_serve(&prefix, &extra);
     client.wait_for_tracker(Duration::from_secs(60));
@@ -128,6 +132,7 @@ fn main() {
     let latency_every = argument("--latency-every").unwrap_or_else(|| "100".into());
     let model = argument("--model");
     let inference_threads = argument("--inference-threads");
+    let engine = argument("--engine");
     let us = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q) as f64 / 1000.0;
     let mut table = String::new();
     writeln!(table, "| wait mode | leg | frames | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |").unwrap();
@@ -141,6 +146,7 @@ fn main() {
             &latency_every,
             model.as_deref(),
             inference_threads.as_deref(),
+            engine.as_deref(),
         );
         for (leg, h) in LEGS.iter().zip(&histograms) {
             writeln!(
@@ -157,12 +163,17 @@ fn main() {
         }
     }
     let model_option = model.as_ref().map_or(String::new(), |file| format!(" --model {file}"))
-        + &inference_threads.as_ref().map_or(String::new(), |n| format!(" --inference-threads {n}"));
+        + &inference_threads.as_ref().map_or(String::new(), |n| format!(" --inference-threads {n}"))
+        + &engine.as_ref().map_or(String::new(), |e| format!(" --engine {e}"));
     let heading = format!(
         "Service latency through `primm serve --method {method}{model_option} --latency-every {latency_every}`, {objects} objects per frame, {frames} frames per wait mode after 500 warm-up frames, one frame in flight.\n\n"
     );
     println!("{heading}{table}");
-    if model.is_none() && inference_threads.is_none() && !std::env::args().any(|a| a == "--no-write") {
+    if model.is_none()
+        && inference_threads.is_none()
+        && engine.is_none()
+        && !std::env::args().any(|a| a == "--no-write")
+    {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
         std::fs::create_dir_all(&dir).unwrap();
         let suffix = if latency_every == "0" { "_no_reports" } else { "" };

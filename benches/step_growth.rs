@@ -8,18 +8,18 @@
 //! HdrHistogram, and the stages (as the tracker reports them) are timed too.
 //!
 //! * `imm`: CV + CA + CT, no learned predictor.
-//! * `pr-imm`: CV + CA + CT + PR, the PR model (`models/pr.onnx`, tract) on its inference
-//!   threads (`on_inference_threads`: `predictor.inference_threads` of the default
+//! * `pr-imm`: CV + CA + CT + PR, the PR model (`models/pr.onnx`, on the configuration's
+//!   `predictor.engine` or `--engine native|tract`) on its inference threads (`on_inference_threads`: `predictor.inference_threads` of the default
 //!   configuration, or `--inference-threads N`; deadline 50 ms so that no frame misses it and
 //!   the wait is measured in full).
 //!
 //! Prints a table and writes `benches/results/step_growth.{md,json,svg}`. Nothing is asserted.
 //!
-//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64] [-- --inference-threads N]`
+//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64] [-- --inference-threads N] [-- --engine native|tract]`
 
 use hdrhistogram::Histogram;
 use plotters::prelude::*;
-use primm_core::config::Config;
+use primm_core::config::{Config, InferenceEngine};
 use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
@@ -246,11 +246,18 @@ fn main() {
     let inference_threads: usize = argument("--inference-threads")
         .and_then(|v| v.parse().ok())
         .unwrap_or(Config::default().predictor.inference_threads);
+    let engine = match argument("--engine").as_deref() {
+        None => Config::default().predictor.engine,
+        Some("native") => InferenceEngine::Native,
+        Some("tract") => InferenceEngine::Tract,
+        Some(other) => panic!("--engine {other}: use native or tract"),
+    };
     let mut rows = Vec::new();
     for &method in &methods {
         for &count in &counts {
             let row = if method.needs_predictor() {
-                let onnx = OnnxPredictor::load(&model).expect("models/pr.onnx loads");
+                let mut onnx = OnnxPredictor::load(&model).expect("models/pr.onnx loads");
+                assert_eq!(onnx.set_engine(engine), engine);
                 let threaded =
                     on_inference_threads(onnx, inference_threads, Duration::from_millis(50)).unwrap();
                 run(method, threaded, count, frames)
@@ -270,7 +277,7 @@ fn main() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
         std::fs::create_dir_all(&dir).unwrap();
         let header = format!(
-            "Tracker step time vs objects (`cargo bench --bench step_growth`), {frames} timed frames per row after {WARM_UP_FRAMES} warm-up frames; PR on {inference_threads} inference thread(s).\n\n"
+            "Tracker step time vs objects (`cargo bench --bench step_growth`), {frames} timed frames per row after {WARM_UP_FRAMES} warm-up frames; PR on {inference_threads} inference thread(s), engine {engine:?}.\n\n"
         );
         std::fs::write(dir.join("step_growth.md"), header + &text).unwrap();
         std::fs::write(dir.join("step_growth.json"), serde_json::to_string_pretty(&rows).unwrap()).unwrap();

@@ -32,6 +32,7 @@ mod learned_covariance;
 mod logging;
 mod motion_models;
 mod predictor_allocation;
+mod predictor_native;
 mod predictor_onnx;
 mod predictor_request;
 mod predictor_split;

@@ -1,7 +1,8 @@
-//! The shipped PR model through tract: parity with PyTorch, masking, the step displacement of
-//! coasting tracks, and clear start-up errors for unusable model files.
+//! The shipped PR model on tract and on the native forward pass: parity with PyTorch, masking,
+//! the step displacement of coasting tracks, and clear start-up errors for unusable model files.
 
 use glam::DVec2;
+use primm_core::config::InferenceEngine;
 use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
 use primm_predictor::onnx::{ModelError, MotionFrame, OnnxPredictor, PrModel};
 use std::path::{Path, PathBuf};
@@ -12,6 +13,15 @@ fn repo_path(relative: &str) -> PathBuf {
 
 fn model() -> PrModel {
     PrModel::load(repo_path("models/pr.onnx")).expect("the shipped model loads")
+}
+
+/// Both engines; the shipped model has a native forward pass.
+const ENGINES: [InferenceEngine; 2] = [InferenceEngine::Tract, InferenceEngine::Native];
+
+fn model_on(engine: InferenceEngine) -> PrModel {
+    let mut model = model();
+    assert_eq!(model.set_engine(engine), engine, "{:?}", model.native_unsupported());
+    model
 }
 
 #[derive(serde::Deserialize)]
@@ -38,7 +48,7 @@ fn flatten(
 }
 
 #[test]
-fn tract_matches_pytorch_on_the_parity_fixture_within_a_tenth_of_a_millimetre() {
+fn both_engines_match_pytorch_on_the_parity_fixture_within_a_tenth_of_a_millimetre() {
     let parity = parity();
     assert_eq!(parity.features.len(), 64);
     // Every history length is represented.
@@ -46,14 +56,16 @@ fn tract_matches_pytorch_on_the_parity_fixture_within_a_tenth_of_a_millimetre() 
         assert!(parity.length.contains(&length), "no sample of length {length}");
     }
     let (features, valid) = flatten(&parity.features, &parity.valid);
-    let mut out = vec![0.0f32; 2 * parity.features.len()];
-    model().run(&features, &valid, &mut out).unwrap();
-    let mut max_difference = 0.0f32;
-    for (got, want) in out.chunks(2).zip(&parity.displacement) {
-        max_difference = max_difference.max((got[0] - want[0]).abs()).max((got[1] - want[1]).abs());
+    for engine in ENGINES {
+        let mut out = vec![0.0f32; 2 * parity.features.len()];
+        model_on(engine).run(&features, &valid, &mut out).unwrap();
+        let mut max_difference = 0.0f32;
+        for (got, want) in out.chunks(2).zip(&parity.displacement) {
+            max_difference = max_difference.max((got[0] - want[0]).abs()).max((got[1] - want[1]).abs());
+        }
+        println!("max abs difference {engine:?} vs PyTorch: {max_difference:e} m");
+        assert!(max_difference <= 1e-4, "{engine:?}: max abs difference {max_difference} m");
     }
-    println!("max abs difference tract vs PyTorch: {max_difference:e} m");
-    assert!(max_difference <= 1e-4, "max abs difference {max_difference} m");
     // The outputs are not trivial: displacements of different samples differ.
     let spread = parity.displacement.iter().map(|d| d[0]).fold(f32::NEG_INFINITY, f32::max)
         - parity.displacement.iter().map(|d| d[0]).fold(f32::INFINITY, f32::min);
@@ -61,26 +73,28 @@ fn tract_matches_pytorch_on_the_parity_fixture_within_a_tenth_of_a_millimetre() 
 }
 
 #[test]
-fn tract_matches_pytorch_on_the_covariance_output_within_a_tenth_of_a_millimetre() {
+fn both_engines_match_pytorch_on_the_covariance_output_within_a_tenth_of_a_millimetre() {
     let parity = parity();
-    let mut model = model();
-    // The shipped model estimates its uncertainty, and the fixture has PyTorch's answers.
-    assert!(model.has_uncertainty(), "the shipped model has the displacement_cholesky output");
     let expected = parity.cholesky.expect("the parity fixture has the covariance output");
     let (features, valid) = flatten(&parity.features, &parity.valid);
-    let mut out = vec![0.0f32; 2 * parity.features.len()];
-    let mut factors = vec![0.0f32; 3 * parity.features.len()];
-    model.run_with_uncertainty(&features, &valid, &mut out, &mut factors).unwrap();
-    let mut max_difference = 0.0f32;
-    for (got, want) in factors.chunks(3).zip(&expected) {
-        for axis in 0..3 {
-            max_difference = max_difference.max((got[axis] - want[axis]).abs());
+    for engine in ENGINES {
+        let mut model = model_on(engine);
+        // The shipped model estimates its uncertainty, and the fixture has PyTorch's answers.
+        assert!(model.has_uncertainty(), "the shipped model has the displacement_cholesky output");
+        let mut out = vec![0.0f32; 2 * parity.features.len()];
+        let mut factors = vec![0.0f32; 3 * parity.features.len()];
+        model.run_with_uncertainty(&features, &valid, &mut out, &mut factors).unwrap();
+        let mut max_difference = 0.0f32;
+        for (got, want) in factors.chunks(3).zip(&expected) {
+            for axis in 0..3 {
+                max_difference = max_difference.max((got[axis] - want[axis]).abs());
+            }
+            // Positive diagonal: a valid Cholesky factor.
+            assert!(got[0] > 0.0 && got[2] > 0.0, "{got:?}");
         }
-        // Positive diagonal: a valid Cholesky factor.
-        assert!(got[0] > 0.0 && got[2] > 0.0, "{got:?}");
+        println!("max abs difference of the Cholesky factors {engine:?} vs PyTorch: {max_difference:e} m");
+        assert!(max_difference <= 1e-4, "{engine:?}: max abs difference {max_difference} m");
     }
-    println!("max abs difference of the Cholesky factors tract vs PyTorch: {max_difference:e} m");
-    assert!(max_difference <= 1e-4, "max abs difference {max_difference} m");
     // The model's confidence varies between inputs.
     let smallest = expected.iter().map(|f| f[0]).fold(f32::INFINITY, f32::min);
     let largest = expected.iter().map(|f| f[0]).fold(f32::NEG_INFINITY, f32::max);
@@ -89,8 +103,13 @@ fn tract_matches_pytorch_on_the_covariance_output_within_a_tenth_of_a_millimetre
 
 #[test]
 fn each_sample_gets_the_same_output_alone_as_in_a_batch_and_padded_rows_are_ignored() {
+    for engine in ENGINES {
+        each_sample_alone_as_in_a_batch(model_on(engine));
+    }
+}
+
+fn each_sample_alone_as_in_a_batch(mut model: PrModel) {
     let parity = parity();
-    let mut model = model();
     let (features, valid) = flatten(&parity.features, &parity.valid);
     let mut batched = vec![0.0f32; 2 * parity.features.len()];
     model.run(&features, &valid, &mut batched).unwrap();
@@ -118,7 +137,8 @@ fn each_sample_gets_the_same_output_alone_as_in_a_batch_and_padded_rows_are_igno
 #[test]
 fn batches_of_any_size_run_in_planned_chunks_and_every_row_gets_its_own_output() {
     let parity = parity();
-    let mut model = model();
+    // The chunks and padding are tract's.
+    let mut model = model_on(InferenceEngine::Tract);
     let (features, valid) = flatten(&parity.features, &parity.valid);
     let mut reference = vec![0.0f32; 2 * parity.features.len()];
     model.run(&features, &valid, &mut reference).unwrap();
@@ -350,11 +370,16 @@ fn a_model_without_the_valid_input_is_rejected() {
 fn the_model_is_loaded_for_learned_methods_only_and_is_built_in_when_no_file_is_given() {
     use primm_core::mode::Method;
     use primm_predictor::predictor_for;
-    assert!(predictor_for(Method::Imm, Some(Path::new("/nonexistent.onnx"))).is_ok());
-    let error = predictor_for(Method::PrImm, Some(Path::new("/nonexistent/pr.onnx"))).err().unwrap();
+    assert!(predictor_for(Method::Imm, Some(Path::new("/nonexistent.onnx")), InferenceEngine::Native).is_ok());
+    let error =
+        predictor_for(Method::PrImm, Some(Path::new("/nonexistent/pr.onnx")), InferenceEngine::Native)
+            .err()
+            .unwrap();
     assert!(error.to_string().contains("/nonexistent/pr.onnx"), "{error}");
-    assert!(predictor_for(Method::Learned, Some(&repo_path("models/pr.onnx"))).is_ok());
-    assert!(predictor_for(Method::Learned, None).is_ok());
+    assert!(
+        predictor_for(Method::Learned, Some(&repo_path("models/pr.onnx")), InferenceEngine::Native).is_ok()
+    );
+    assert!(predictor_for(Method::Learned, None, InferenceEngine::Native).is_ok());
 }
 
 #[test]

@@ -150,7 +150,7 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
     let mut panels = Vec::new();
     let mut ground_truth = Vec::new();
     for &method in &args.methods {
-        let predictor = match predictor_for(method, args.model.as_deref()) {
+        let predictor = match predictor_for(method, args.model.as_deref(), base_config.predictor.engine) {
             Ok(predictor) => predictor,
             Err(reason) => {
                 eprintln!("{method}: unavailable: {reason}");

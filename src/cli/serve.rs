@@ -1,11 +1,12 @@
 //! `primm serve`: the tracker as a shared-memory service.
 
 use primm_config::ConfigError;
-use primm_core::config::Config;
+use primm_core::config::{Config, InferenceEngine};
 use primm_core::mode::Method;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use primm_core::tracker::Tracker;
-use primm_predictor::onnx::{ModelError, OnnxPredictor};
+use primm_predictor::load_predictor;
+use primm_predictor::onnx::ModelError;
 use primm_predictor::split::{on_inference_threads, InferenceThreadsError, SplitPredictor};
 use primm_predictor::threaded::ThreadedPredictor;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
@@ -46,6 +47,19 @@ pub struct Args {
     /// `predictor.inference_threads`.
     #[arg(long, value_name = "COUNT")]
     pub inference_threads: Option<usize>,
+    /// What runs the PR model: `native` (primm's forward pass where the model allows it) or
+    /// `tract`; overrides the configuration's `predictor.engine`.
+    #[arg(long, value_name = "ENGINE", value_parser = parse_engine)]
+    pub engine: Option<InferenceEngine>,
+}
+
+/// `native` or `tract`.
+fn parse_engine(text: &str) -> Result<InferenceEngine, String> {
+    match text {
+        "native" => Ok(InferenceEngine::Native),
+        "tract" => Ok(InferenceEngine::Tract),
+        _ => Err(format!("'{text}' is not an engine: use native or tract")),
+    }
 }
 
 /// Why `primm serve` failed.
@@ -100,6 +114,9 @@ pub fn run(args: Args) -> Result<(), ServeError> {
     if let Some(threads) = args.inference_threads {
         config.predictor.inference_threads = threads;
     }
+    if let Some(engine) = args.engine {
+        config.predictor.engine = engine;
+    }
     // Checked before the model and its threads are set up, so a bad value is named, not spawned.
     config.validate()?;
     if args.method.needs_predictor() {
@@ -117,14 +134,12 @@ fn learned_predictor(
     config: &Config,
     method: Method,
 ) -> Result<SplitPredictor<ThreadedPredictor>, ServeError> {
-    let model = match path {
-        Some(path) => OnnxPredictor::load(path),
-        None => OnnxPredictor::embedded(),
-    }
-    .map_err(|source| ServeError::Model { method, source })?;
+    let model = load_predictor(path, config.predictor.engine)
+        .map_err(|source| ServeError::Model { method, source })?;
     let deadline = config.predictor.deadline();
     tracing::info!(
         model = %model.model().source(),
+        engine = ?model.model().engine(),
         deadline_ms = config.predictor.deadline_ms,
         inference_threads = config.predictor.inference_threads,
         "learned predictor loaded"

@@ -29,7 +29,8 @@ use primm_core::limits::MAX_TRACKS;
 use primm_core::mode::Method;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::tracker::Tracker;
-use primm_predictor::onnx::{ModelError, OnnxPredictor};
+use primm_predictor::load_predictor;
+use primm_predictor::onnx::ModelError;
 use primm_predictor::split::{on_inference_threads, InferenceThreadsError};
 use scene::SoakScene;
 use std::path::PathBuf;
@@ -117,10 +118,7 @@ pub fn run(args: &Args) -> Result<(), SoakError> {
     if !args.method.needs_predictor() {
         return soak(Tracker::new(config)?, args);
     }
-    let model = match &args.model {
-        Some(path) => OnnxPredictor::load(path)?,
-        None => OnnxPredictor::embedded()?,
-    };
+    let model = load_predictor(args.model.as_deref(), config.predictor.engine)?;
     if args.inference_thread {
         let deadline = config.predictor.deadline();
         let threads = config.predictor.inference_threads;

@@ -108,7 +108,7 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         args.tracking_frame,
     )
     .with_modes(args.method.modes());
-    let predictor = predictor_for(args.method, args.model.as_deref())?;
+    let predictor = predictor_for(args.method, args.model.as_deref(), config.predictor.engine)?;
     let mut tracker = Tracker::with_predictor(config, predictor)?;
     let sequence = read_sequence_file(&args.input)?;
     let file = create(&args.output)?;

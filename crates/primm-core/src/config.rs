@@ -70,6 +70,8 @@ pub struct PredictorConfig {
     /// Service only: inference threads that share each frame's batch (1 to
     /// [`MAX_INFERENCE_THREADS`]); batches below 16 requests per thread use fewer.
     pub inference_threads: usize,
+    /// What runs the PR model's forward pass.
+    pub engine: InferenceEngine,
 }
 
 /// Most inference threads `predictor.inference_threads` may ask for.
@@ -83,8 +85,23 @@ impl Default for PredictorConfig {
             process_noise: LearnedProcessNoise::Constant,
             learned_process_noise_scale: 1.0,
             inference_threads: 2,
+            engine: InferenceEngine::Native,
         }
     }
+}
+
+/// What runs the PR model's forward pass (`predictor.engine`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum InferenceEngine {
+    /// primm's own fixed-size forward pass of the shipped architecture
+    /// (`primm_predictor::native`), for models of that architecture that agree with tract on
+    /// probe inputs at load; any other model runs on tract.
+    #[default]
+    Native,
+    /// tract runs the ONNX graph.
+    Tract,
 }
 
 /// The source of the PR mode's process noise `Q_PR` (`eq:pr_cov`). The default configuration

@@ -78,11 +78,12 @@ impl PrimmTracker {
             None => None,
         };
         let predictor: Box<dyn DisplacementPredictor + Send> = if config.imm.modes.contains(Mode::Learned) {
-            let onnx = match model {
+            let mut onnx = match model {
                 Some(model) => OnnxPredictor::from_model(model),
                 None if options.use_builtin_model => OnnxPredictor::embedded().map_err(Failure::Model)?,
                 None => return Err(Failure::ModelRequired),
             };
+            onnx.set_engine(config.predictor.engine);
             if options.inference_thread {
                 Box::new(
                     on_inference_threads(

@@ -55,7 +55,11 @@ fn compile_example(dir: &Path, library: &Path) -> PathBuf {
 fn primm_track_imm(input: &Path) -> String {
     let method = Method::Imm;
     let config = Config::default().with_modes(method.modes());
-    let mut tracker = Tracker::with_predictor(config, predictor_for(method, None).unwrap()).unwrap();
+    let mut tracker = Tracker::with_predictor(
+        config,
+        predictor_for(method, None, Config::default().predictor.engine).unwrap(),
+    )
+    .unwrap();
     let sequence = read_sequence_file(input).unwrap();
     let frames = sequence.to_frames().unwrap();
     let mut writer =

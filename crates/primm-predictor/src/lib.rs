@@ -6,6 +6,8 @@
 //! [`DisplacementPredictor`] trait:
 //!
 //! * [`onnx::PrModel`] loads and checks a model and plans it for fixed batch sizes;
+//!   [`native::NativeModel`] is primm's own fixed-size forward pass of the shipped
+//!   architecture, which `PrModel` uses where the model has it and it agrees with tract;
 //!   [`onnx::OnnxPredictor`] is the synchronous predictor (deterministic: offline tracking and
 //!   evaluation use it).
 //! * [`threaded::ThreadedPredictor`] runs any predictor on a dedicated inference thread with a
@@ -41,11 +43,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod native;
 pub mod onnx;
 pub mod split;
 pub mod threaded;
 
 use onnx::{ModelError, OnnxPredictor};
+use primm_core::config::InferenceEngine;
 use primm_core::mode::Method;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use std::path::Path;
@@ -54,20 +58,35 @@ use std::path::Path;
 /// `models/pr.json`), embedded at build time.
 pub const DEFAULT_MODEL_ONNX: &[u8] = include_bytes!("../../../models/pr.onnx");
 
+/// The PR model from `model`, or the built-in [`DEFAULT_MODEL_ONNX`] when `model` is `None`,
+/// running on `engine` where it can ([`onnx::PrModel::set_engine`]). Asking for the native
+/// engine with a model that has no native forward pass logs a warning naming the reason and
+/// runs the model on tract.
+pub fn load_predictor(model: Option<&Path>, engine: InferenceEngine) -> Result<OnnxPredictor, ModelError> {
+    let mut predictor = match model {
+        Some(path) => OnnxPredictor::load(path)?,
+        None => OnnxPredictor::embedded()?,
+    };
+    let used = predictor.set_engine(engine);
+    if used != engine {
+        let reason = predictor.model().native_unsupported().map(ToString::to_string).unwrap_or_default();
+        tracing::warn!(model = %predictor.model().source(), %reason, "the PR model runs on tract: no native forward pass");
+    }
+    Ok(predictor)
+}
+
 /// The predictor a method needs: none for the physics-only methods; for PR and PR-IMM the PR
-/// model from `model`, or the built-in [`DEFAULT_MODEL_ONNX`] when `model` is `None`, run
-/// synchronously so that offline results do not depend on timing. A missing, unreadable or
-/// incompatible model file is an error naming the file.
+/// model from `model`, or the built-in [`DEFAULT_MODEL_ONNX`] when `model` is `None`, on
+/// `engine` where it can ([`load_predictor`]), run synchronously so that offline results do not
+/// depend on timing. A missing, unreadable or incompatible model file is an error naming the
+/// file.
 pub fn predictor_for(
     method: Method,
     model: Option<&Path>,
+    engine: InferenceEngine,
 ) -> Result<Box<dyn DisplacementPredictor + Send>, ModelError> {
     if !method.needs_predictor() {
         return Ok(Box::new(NoPredictor));
     }
-    let predictor = match model {
-        Some(path) => OnnxPredictor::load(path)?,
-        None => OnnxPredictor::embedded()?,
-    };
-    Ok(Box::new(predictor))
+    Ok(Box::new(load_predictor(model, engine)?))
 }

@@ -42,7 +42,9 @@
 //! `f(t_k) − f(t_{k−1})` otherwise. [`OnnxPredictor`] evaluates both rows in the same batch, so a
 //! frame in which `n` of `N` tracks coasted runs a batch of `N + n` rows.
 
+use crate::native::{NativeModel, Unsupported};
 use glam::{DMat2, DVec2};
+use primm_core::config::InferenceEngine;
 use primm_core::limits::MAX_TRACKS;
 use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest, FEATURES, MAX_HISTORY};
 use std::fmt;
@@ -261,13 +263,24 @@ struct BatchPlan {
     state: TypedSimpleState,
 }
 
-/// The loaded, optimised PR model: one plan per size of [`PLAN_BATCH_SIZES`].
+/// Largest difference, in any output value, between [`NativeModel`] and tract on the probe
+/// inputs that a model may show and still run natively, m. float32 rounding in the two
+/// summation orders gives ~1e-6 m on the shipped model.
+pub const MAX_PROBE_DIFFERENCE_M: f32 = 1e-4;
+
+/// The loaded, optimised PR model: one plan per size of [`PLAN_BATCH_SIZES`] and, where the
+/// model has the shipped architecture and agrees with tract on probe inputs, its
+/// [`NativeModel`].
 pub struct PrModel {
     source: ModelSource,
     /// Whether the model has the [`CHOLESKY_OUTPUT`].
     has_uncertainty: bool,
     /// Ascending batch sizes, as [`PLAN_BATCH_SIZES`].
     plans: Vec<BatchPlan>,
+    /// The native forward pass, or why the model cannot have one.
+    native: Result<Arc<NativeModel>, Unsupported>,
+    /// The engine batches run on.
+    engine: InferenceEngine,
 }
 
 impl fmt::Debug for PrModel {
@@ -276,6 +289,8 @@ impl fmt::Debug for PrModel {
             .field("source", &self.source)
             .field("batch_sizes", &self.plans.iter().map(|p| p.batch).collect::<Vec<_>>())
             .field("nodes", &self.plans.last().map(|p| p.plan.model().nodes().len()))
+            .field("engine", &self.engine)
+            .field("native", &self.native.as_ref().map(|_| ()))
             .finish()
     }
 }
@@ -331,9 +346,11 @@ impl PrModel {
     }
 
     fn prepare(bytes: &[u8], source: ModelSource) -> Result<Self, ModelError> {
-        let mut model = tract_onnx::onnx()
-            .model_for_read(&mut &bytes[..])
-            .map_err(|error| ModelError::NotOnnx { model: source.clone(), reason: format!("{error:#}") })?;
+        let onnx = tract_onnx::onnx();
+        let not_onnx =
+            |error: TractError| ModelError::NotOnnx { model: source.clone(), reason: format!("{error:#}") };
+        let proto = onnx.proto_model_for_read(&mut &bytes[..]).map_err(not_onnx)?;
+        let mut model = onnx.model_for_proto_model(&proto).map_err(not_onnx)?;
         let has_uncertainty = check_signature(&source, &model)?;
         let batch = model.symbols.sym(BATCH_SYMBOL).to_dim();
         let prepare = |error: TractError| ModelError::Preparation {
@@ -362,7 +379,8 @@ impl PrModel {
             let state = plan.spawn().map_err(prepare)?;
             plans.push(BatchPlan { batch, plan, state });
         }
-        let mut loaded = PrModel { source, has_uncertainty, plans };
+        let native = NativeModel::from_proto(&proto, has_uncertainty).map(Arc::new);
+        let mut loaded = PrModel { source, has_uncertainty, plans, native, engine: InferenceEngine::Tract };
         // A trial run: a model that loads but cannot run fails here, at start-up.
         let mut out = [0.0f32; 2];
         let mut factor = [0.0f32; CHOLESKY_VALUES];
@@ -379,7 +397,70 @@ impl PrModel {
             model: loaded.source.clone(),
             reason: error.to_string(),
         })?;
+        if loaded.native.is_ok() {
+            let agreement = loaded.probe_agreement();
+            loaded.native = agreement.map_err(|error| ModelError::Preparation {
+                model: loaded.source.clone(),
+                reason: error.to_string(),
+            })?;
+        }
+        loaded.set_engine(InferenceEngine::Native);
         Ok(loaded)
+    }
+
+    /// Runs the probe batch ([`probe_batch`]) on tract and on the native forward pass and keeps
+    /// the native model only if no output differs by more than [`MAX_PROBE_DIFFERENCE_M`].
+    fn probe_agreement(&mut self) -> Result<Result<Arc<NativeModel>, Unsupported>, InferenceError> {
+        let Ok(native) = self.native.clone() else { return Ok(self.native.clone()) };
+        let (features, valid) = probe_batch();
+        let rows = valid.len() / MAX_HISTORY;
+        let (mut tract_out, mut native_out) = (vec![0.0f32; rows * 2], vec![0.0f32; rows * 2]);
+        let (mut tract_factor, mut native_factor) =
+            (vec![0.0f32; rows * CHOLESKY_VALUES], vec![0.0f32; rows * CHOLESKY_VALUES]);
+        self.engine = InferenceEngine::Tract;
+        let cholesky = self.has_uncertainty.then_some(&mut tract_factor[..]);
+        self.run_outputs(&features, &valid, &mut tract_out, cholesky)?;
+        native.run(
+            &features,
+            &valid,
+            &mut native_out,
+            self.has_uncertainty.then_some(&mut native_factor[..]),
+        );
+        let difference = tract_out
+            .iter()
+            .zip(&native_out)
+            .chain(tract_factor.iter().zip(&native_factor))
+            .map(|(a, b)| if a.is_finite() && b.is_finite() { (a - b).abs() } else { f32::INFINITY })
+            .fold(0.0f32, f32::max);
+        if difference <= MAX_PROBE_DIFFERENCE_M {
+            Ok(Ok(native))
+        } else {
+            Ok(Err(Unsupported::Disagrees { difference_m: difference, tolerance_m: MAX_PROBE_DIFFERENCE_M }))
+        }
+    }
+
+    /// Chooses the engine batches run on and returns the one in use: [`Native`] where the
+    /// model has a native forward pass ([`native_unsupported`](Self::native_unsupported) says
+    /// why not otherwise), else [`Tract`]. A loaded model starts on [`Native`] where it can.
+    ///
+    /// [`Native`]: InferenceEngine::Native
+    /// [`Tract`]: InferenceEngine::Tract
+    pub fn set_engine(&mut self, engine: InferenceEngine) -> InferenceEngine {
+        self.engine = match engine {
+            InferenceEngine::Native if self.native.is_ok() => InferenceEngine::Native,
+            _ => InferenceEngine::Tract,
+        };
+        self.engine
+    }
+
+    /// The engine batches run on.
+    pub fn engine(&self) -> InferenceEngine {
+        self.engine
+    }
+
+    /// Why this model has no native forward pass; `None` where it has one.
+    pub fn native_unsupported(&self) -> Option<&Unsupported> {
+        self.native.as_ref().err()
     }
 
     /// Another instance of this model that shares its optimised plans and has its own
@@ -394,7 +475,13 @@ impl PrModel {
             })?;
             plans.push(BatchPlan { batch: plan.batch, plan: Arc::clone(&plan.plan), state });
         }
-        Ok(PrModel { source: self.source.clone(), has_uncertainty: self.has_uncertainty, plans })
+        Ok(PrModel {
+            source: self.source.clone(),
+            has_uncertainty: self.has_uncertainty,
+            plans,
+            native: self.native.clone(),
+            engine: self.engine,
+        })
     }
 
     /// Where the model came from.
@@ -456,6 +543,13 @@ impl PrModel {
         if batch == 0 {
             return Ok(());
         }
+        if let (InferenceEngine::Native, Ok(native)) = (self.engine, &self.native) {
+            if cholesky.is_some() && !native.has_uncertainty() {
+                return Err(InferenceError::CholeskyShape { found: Vec::new(), batch });
+            }
+            native.run(features, valid, displacements, cholesky);
+            return Ok(());
+        }
         let mut done = 0;
         while done < batch {
             let rows = self.run_chunk(
@@ -505,6 +599,45 @@ impl PrModel {
         }
         Ok(rows)
     }
+}
+
+/// Rows of the probe batch: every history length, at several speeds, headings, ranges of
+/// radial velocity and RCS, and measurement intervals.
+const PROBE_ROWS: usize = 60;
+
+/// The inputs [`PrModel`] compares tract and the native forward pass on: deterministic,
+/// spanning what the tracker sends (history lengths 1 to 5, speeds to ~40 m/s, intervals of
+/// 15 to 80 ms) and beyond it.
+fn probe_batch() -> (Vec<f32>, Vec<f32>) {
+    let mut features = vec![0.0f32; PROBE_ROWS * MAX_HISTORY * FEATURES];
+    let mut valid = vec![0.0f32; PROBE_ROWS * MAX_HISTORY];
+    // A small linear congruential generator: the probe must not depend on a crate's stream.
+    let mut state = 0x2545_f491_u32;
+    let mut uniform = move || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 8) as f32 / (1u32 << 24) as f32
+    };
+    for row in 0..PROBE_ROWS {
+        let len = 1 + row % MAX_HISTORY;
+        let speed = 40.0 * uniform();
+        let heading = std::f32::consts::TAU * uniform();
+        let interval = 0.015 + 0.065 * uniform();
+        let radial = 60.0 * uniform() - 30.0;
+        let rcs = 40.0 * uniform() - 10.0;
+        let prediction_gap = interval * (0.5 + uniform());
+        for index in 0..len {
+            let steps_back = (len - 1 - index) as f32;
+            let base = (row * MAX_HISTORY + index) * FEATURES;
+            let back = speed * interval * steps_back;
+            features[base] = -back * heading.cos() + (uniform() - 0.5) * 0.6;
+            features[base + 1] = -back * heading.sin() + (uniform() - 0.5) * 0.6;
+            features[base + 2] = radial + (uniform() - 0.5);
+            features[base + 3] = rcs + 4.0 * (uniform() - 0.5);
+            features[base + 4] = -(prediction_gap + interval * steps_back);
+            valid[row * MAX_HISTORY + index] = 1.0;
+        }
+    }
+    (features, valid)
 }
 
 /// A zero tensor of `shape` whose leading values are copied from `values` (as many as fit):
@@ -689,6 +822,11 @@ impl OnnxPredictor {
     /// zeroed counters.
     pub fn fork(&self) -> Result<Self, ModelError> {
         Ok(Self::from_model(self.model.fork()?))
+    }
+
+    /// Chooses the model's engine ([`PrModel::set_engine`]); returns the one in use.
+    pub fn set_engine(&mut self, engine: InferenceEngine) -> InferenceEngine {
+        self.model.set_engine(engine)
     }
 
     /// The model.

@@ -1,0 +1,552 @@
+//! primm's own forward pass of the shipped PR architecture, in fixed-size arrays.
+//!
+//! tract runs any ONNX graph, but for a model this small (two encoder layers of width 32, seven
+//! tokens) most of its time goes to the work around the matrix products: ~40 small products
+//! packed one at a time, element-wise operators run one element or row at a time
+//! (`BENCHMARKS.md`, section 1). [`NativeModel`] computes the same function directly: one
+//! sample at a time, every tensor a stack array whose size is a constant, the linear layers as
+//! fixed-size loops the compiler vectorises (dispatched at run time to AVX2 or AVX-512 where
+//! the CPU has them, with the portable build as the fallback), and no allocation at all.
+//!
+//! It reads its weights from the ONNX file's initializers, by the names
+//! `training/onnx_graph.py` gives them, and accepts only that architecture: the widths below,
+//! four heads whose query and output weights are the block-masked stacks that file writes,
+//! ReLU feed-forward blocks, LayerNorms, and the optional uncertainty head. A model of any other
+//! shape is [`Unsupported`] and runs on tract. [`PrModel`](crate::onnx::PrModel) also runs
+//! both on probe inputs at load and uses this forward pass only when it agrees with tract
+//! (`MAX_PROBE_DIFFERENCE_M`), so a graph with the right names but different arithmetic
+//! cannot slip through.
+//!
+//! Differences from the graph, none of which changes the function:
+//! * padded history rows are not computed: the graph computes them and then gives them zero
+//!   attention weight;
+//! * each head's softmax subtracts its largest score first (the graph may skip that while the
+//!   weights bound the scores, `models/pr.json`);
+//! * the heads' queries and outputs use only each head's own channels, which are the only
+//!   non-zero entries of the graph's stacked weights (checked at load);
+//! * the last layer updates only the two query tokens, as the graph does.
+
+use multiversion::multiversion;
+use primm_core::predictor::{FEATURES, MAX_HISTORY};
+use std::collections::HashMap;
+use tract_onnx::pb::ModelProto;
+use tract_onnx::prelude::*;
+
+/// Width of a token, the model's `d_model`.
+pub const MODEL_WIDTH: usize = 32;
+/// Attention heads.
+pub const HEADS: usize = 4;
+/// Channels per head.
+pub const HEAD_WIDTH: usize = MODEL_WIDTH / HEADS;
+/// Width of the feed-forward blocks' hidden layer.
+pub const FEED_FORWARD_WIDTH: usize = 64;
+/// Encoder layers.
+pub const LAYERS: usize = 2;
+/// Query tokens appended to the history; the model reads its answer from them.
+pub const QUERIES: usize = 2;
+/// Tokens of a sample: the history rows, then the query tokens.
+pub const TOKENS: usize = MAX_HISTORY + QUERIES;
+/// Values of the uncertainty output per sample, `[l_xx, l_yx, l_yy]`.
+pub const CHOLESKY_VALUES: usize = 3;
+/// LayerNorm's epsilon (`LayerNormalization`'s default, which `training/onnx_graph.py` writes).
+pub const LAYER_NORM_EPSILON: f32 = 1e-5;
+
+/// The ONNX operators a graph of this architecture is made of; a graph with any other is
+/// [`Unsupported`].
+pub const GRAPH_OPERATORS: [&str; 17] = [
+    "Abs",
+    "Add",
+    "Div",
+    "Exp",
+    "LayerNormalization",
+    "Log",
+    "MatMul",
+    "Mul",
+    "Neg",
+    "Pad",
+    "Relu",
+    "Reshape",
+    "ReduceMax",
+    "Slice",
+    "Sub",
+    "Transpose",
+    "Unsqueeze",
+];
+
+/// Why a model cannot run on [`NativeModel`] (it then runs on tract).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Unsupported {
+    /// A weight the architecture needs is not among the file's initializers.
+    #[error("no initializer `{name}`")]
+    MissingWeight {
+        /// The initializer's name.
+        name: String,
+    },
+    /// A weight has another element type or shape than the architecture's.
+    #[error("initializer `{name}` has shape {found:?} ({datum}), expected {expected:?} of F32")]
+    WeightShape {
+        /// The initializer's name.
+        name: String,
+        /// The shape the file has.
+        found: Vec<usize>,
+        /// The element type the file has.
+        datum: String,
+        /// The shape the architecture needs.
+        expected: Vec<usize>,
+    },
+    /// A stacked query or output weight has a non-zero entry outside its head's channels.
+    #[error("`{name}` mixes channels across heads")]
+    HeadsNotSeparated {
+        /// The initializer's name.
+        name: String,
+    },
+    /// The graph uses an operator this architecture does not.
+    #[error("the graph uses `{operator}`")]
+    Operator {
+        /// The ONNX operator type.
+        operator: String,
+    },
+    /// A weight could not be decoded.
+    #[error("initializer `{name}` cannot be read: {reason}")]
+    Unreadable {
+        /// The initializer's name.
+        name: String,
+        /// tract's description of the problem.
+        reason: String,
+    },
+    /// On the probe inputs, the forward pass and tract differ by more than the tolerance.
+    #[error("differs from tract by {difference_m:.3e} m on probe inputs (tolerance {tolerance_m:.0e} m)")]
+    Disagrees {
+        /// The largest difference of any output value, m.
+        difference_m: f32,
+        /// The tolerance.
+        tolerance_m: f32,
+    },
+}
+
+/// A linear layer `y = x W + b`, `W` stored input-major so that the inner loop runs along the
+/// contiguous outputs.
+#[derive(Debug, Clone)]
+struct Linear<const IN: usize, const OUT: usize> {
+    weight: [[f32; OUT]; IN],
+    bias: [f32; OUT],
+}
+
+impl<const IN: usize, const OUT: usize> Linear<IN, OUT> {
+    #[inline(always)]
+    fn apply(&self, input: &[f32; IN]) -> [f32; OUT] {
+        let mut output = self.bias;
+        for (value, row) in input.iter().zip(&self.weight) {
+            for (out, weight) in output.iter_mut().zip(row) {
+                *out += value * weight;
+            }
+        }
+        output
+    }
+}
+
+/// A LayerNorm's affine part (identity once `training/onnx_graph.py` has folded it into the
+/// following layers, but applied as the file says).
+#[derive(Debug, Clone)]
+struct Norm {
+    scale: [f32; MODEL_WIDTH],
+    shift: [f32; MODEL_WIDTH],
+}
+
+impl Norm {
+    #[inline(always)]
+    fn apply(&self, token: &[f32; MODEL_WIDTH]) -> [f32; MODEL_WIDTH] {
+        let mean = token.iter().sum::<f32>() / MODEL_WIDTH as f32;
+        let variance = token.iter().map(|v| (v - mean) * (v - mean)).sum::<f32>() / MODEL_WIDTH as f32;
+        let inverse = 1.0 / (variance + LAYER_NORM_EPSILON).sqrt();
+        let mut out = [0.0; MODEL_WIDTH];
+        for index in 0..MODEL_WIDTH {
+            out[index] = (token[index] - mean) * inverse * self.scale[index] + self.shift[index];
+        }
+        out
+    }
+}
+
+/// One encoder layer (pre-norm attention, then a pre-norm ReLU feed-forward block).
+#[derive(Debug, Clone)]
+struct Layer {
+    norm_attention: Norm,
+    /// Every head's queries side by side (head `h` in channels `h·8..h·8+8`), scaled by
+    /// `1/√8` as in the file.
+    query: Linear<MODEL_WIDTH, MODEL_WIDTH>,
+    key: Linear<MODEL_WIDTH, MODEL_WIDTH>,
+    value: Linear<MODEL_WIDTH, MODEL_WIDTH>,
+    output: Linear<MODEL_WIDTH, MODEL_WIDTH>,
+    norm_feed_forward: Norm,
+    feed_forward_in: Linear<MODEL_WIDTH, FEED_FORWARD_WIDTH>,
+    feed_forward_out: Linear<FEED_FORWARD_WIDTH, MODEL_WIDTH>,
+}
+
+/// The uncertainty head: `[l_xx, l_yx, l_yy]` from the raw values `r` as
+/// `softplus(r)·diagonal_scale + r·off_diagonal_scale + floor`.
+#[derive(Debug, Clone)]
+struct CholeskyHead {
+    linear: Linear<{ QUERIES * MODEL_WIDTH }, CHOLESKY_VALUES>,
+    diagonal_scale: [f32; CHOLESKY_VALUES],
+    off_diagonal_scale: [f32; CHOLESKY_VALUES],
+    floor: [f32; CHOLESKY_VALUES],
+}
+
+/// The PR model's weights in the fixed shapes of the shipped architecture, and its forward pass
+/// (see the [module documentation](self)). Read-only once built; share it between threads.
+#[derive(Debug, Clone)]
+pub struct NativeModel {
+    embedding: [[f32; MODEL_WIDTH]; FEATURES],
+    token_table: [[f32; MODEL_WIDTH]; TOKENS],
+    layers: [Layer; LAYERS],
+    final_norm: Norm,
+    head: Linear<{ QUERIES * MODEL_WIDTH }, 2>,
+    output_scale: [f32; 2],
+    cholesky: Option<CholeskyHead>,
+}
+
+/// The initializers of an ONNX file by name.
+struct Weights<'a> {
+    onnx: &'a tract_onnx::Onnx,
+    by_name: HashMap<&'a str, &'a tract_onnx::pb::TensorProto>,
+}
+
+impl Weights<'_> {
+    /// The values of initializer `name`, which must be F32 of `shape` (a scalar where the
+    /// shape is empty).
+    fn values(&self, name: &str, shape: &[usize]) -> Result<Vec<f32>, Unsupported> {
+        let proto = self.by_name.get(name).ok_or_else(|| Unsupported::MissingWeight { name: name.into() })?;
+        let tensor = tract_onnx::tensor::load_tensor(&*self.onnx.provider, proto, None)
+            .map_err(|error| Unsupported::Unreadable { name: name.into(), reason: format!("{error:#}") })?;
+        if tensor.datum_type() != DatumType::F32 || tensor.shape() != shape {
+            return Err(Unsupported::WeightShape {
+                name: name.into(),
+                found: tensor.shape().to_vec(),
+                datum: format!("{:?}", tensor.datum_type()),
+                expected: shape.to_vec(),
+            });
+        }
+        let plain = tensor
+            .try_as_plain_ram()
+            .and_then(|view| view.as_slice::<f32>().map(<[f32]>::to_vec))
+            .map_err(|error| Unsupported::Unreadable { name: name.into(), reason: format!("{error:#}") })?;
+        Ok(plain)
+    }
+
+    fn vector<const N: usize>(&self, name: &str) -> Result<[f32; N], Unsupported> {
+        let values = self.values(name, &[N])?;
+        Ok(std::array::from_fn(|index| values[index]))
+    }
+
+    fn matrix<const ROWS: usize, const COLUMNS: usize>(
+        &self,
+        name: &str,
+    ) -> Result<[[f32; COLUMNS]; ROWS], Unsupported> {
+        let values = self.values(name, &[ROWS, COLUMNS])?;
+        Ok(std::array::from_fn(|row| std::array::from_fn(|column| values[row * COLUMNS + column])))
+    }
+
+    /// `{prefix}.weight_t` and `{prefix}.bias_row`, the names of
+    /// `training/onnx_graph.py`'s linear layers.
+    fn linear<const IN: usize, const OUT: usize>(
+        &self,
+        prefix: &str,
+    ) -> Result<Linear<IN, OUT>, Unsupported> {
+        Ok(Linear {
+            weight: self.matrix(&format!("{prefix}.weight_t"))?,
+            bias: self.vector(&format!("{prefix}.bias_row"))?,
+        })
+    }
+
+    fn norm(&self, prefix: &str) -> Result<Norm, Unsupported> {
+        Ok(Norm {
+            scale: self.vector(&format!("{prefix}.weight"))?,
+            shift: self.vector(&format!("{prefix}.bias"))?,
+        })
+    }
+
+    /// The stacked query projection `[d, H·d]` (head `h`'s block: the queries masked to that
+    /// head's channels) as one `[d, d]` projection; an entry outside the heads' own channels
+    /// must be zero.
+    fn stacked_query(&self, prefix: &str) -> Result<Linear<MODEL_WIDTH, MODEL_WIDTH>, Unsupported> {
+        let name = format!("{prefix}.weight_t");
+        let weight = self.values(&name, &[MODEL_WIDTH, HEADS * MODEL_WIDTH])?;
+        let bias_name = format!("{prefix}.bias_row");
+        let bias = self.values(&bias_name, &[HEADS * MODEL_WIDTH])?;
+        let own = |column: usize| column / MODEL_WIDTH == (column % MODEL_WIDTH) / HEAD_WIDTH;
+        let separated = |values: &[f32], columns: usize| {
+            values.iter().enumerate().all(|(index, value)| own(index % columns) || *value == 0.0)
+        };
+        if !separated(&weight, HEADS * MODEL_WIDTH) {
+            return Err(Unsupported::HeadsNotSeparated { name });
+        }
+        if !separated(&bias, HEADS * MODEL_WIDTH) {
+            return Err(Unsupported::HeadsNotSeparated { name: bias_name });
+        }
+        // Channel c belongs to head c / 8, whose block starts at column (c / 8)·d.
+        let column = |channel: usize| (channel / HEAD_WIDTH) * MODEL_WIDTH + channel;
+        Ok(Linear {
+            weight: std::array::from_fn(|row| {
+                std::array::from_fn(|channel| weight[row * HEADS * MODEL_WIDTH + column(channel)])
+            }),
+            bias: std::array::from_fn(|channel| bias[column(channel)]),
+        })
+    }
+
+    /// The stacked output projection `[H·d, d]` (head `h`'s block of rows: the projection
+    /// restricted to that head's channels) as one `[d, d]` projection; a row outside the heads'
+    /// own channels must be zero.
+    fn stacked_output(&self, prefix: &str) -> Result<Linear<MODEL_WIDTH, MODEL_WIDTH>, Unsupported> {
+        let name = format!("{prefix}.weight_t");
+        let weight = self.values(&name, &[HEADS * MODEL_WIDTH, MODEL_WIDTH])?;
+        let own = |row: usize| row / MODEL_WIDTH == (row % MODEL_WIDTH) / HEAD_WIDTH;
+        let separated =
+            weight.iter().enumerate().all(|(index, value)| own(index / MODEL_WIDTH) || *value == 0.0);
+        if !separated {
+            return Err(Unsupported::HeadsNotSeparated { name });
+        }
+        let row = |channel: usize| (channel / HEAD_WIDTH) * MODEL_WIDTH + channel;
+        Ok(Linear {
+            weight: std::array::from_fn(|channel| {
+                std::array::from_fn(|out| weight[row(channel) * MODEL_WIDTH + out])
+            }),
+            bias: self.vector(&format!("{prefix}.bias_row"))?,
+        })
+    }
+}
+
+impl NativeModel {
+    /// The weights of `proto`, a model written by `training/onnx_graph.py`; [`Unsupported`] for
+    /// a model of any other architecture. `has_uncertainty`: whether the model has the
+    /// covariance output (whose weights are then required).
+    pub fn from_proto(proto: &ModelProto, has_uncertainty: bool) -> Result<Self, Unsupported> {
+        let graph =
+            proto.graph.as_ref().ok_or_else(|| Unsupported::MissingWeight { name: "graph".into() })?;
+        if let Some(node) = graph.node.iter().find(|node| !GRAPH_OPERATORS.contains(&node.op_type.as_str())) {
+            return Err(Unsupported::Operator { operator: node.op_type.clone() });
+        }
+        let onnx = tract_onnx::onnx();
+        let weights = Weights {
+            onnx: &onnx,
+            by_name: graph.initializer.iter().map(|tensor| (tensor.name.as_str(), tensor)).collect(),
+        };
+        let layer = |index: usize| -> Result<Layer, Unsupported> {
+            let p = format!("layers.{index}");
+            Ok(Layer {
+                norm_attention: weights.norm(&format!("{p}.norm_attention"))?,
+                query: weights.stacked_query(&format!("{p}.attention.query_heads"))?,
+                key: weights.linear(&format!("{p}.attention.key"))?,
+                value: weights.linear(&format!("{p}.attention.value"))?,
+                output: weights.stacked_output(&format!("{p}.attention.output"))?,
+                norm_feed_forward: weights.norm(&format!("{p}.norm_ff"))?,
+                feed_forward_in: weights.linear(&format!("{p}.ff_in"))?,
+                feed_forward_out: weights.linear(&format!("{p}.ff_out"))?,
+            })
+        };
+        // A third layer would be silently ignored: refuse it.
+        let extra_layer = format!("layers.{LAYERS}.ff_in.weight_t");
+        if weights.by_name.contains_key(extra_layer.as_str()) {
+            return Err(Unsupported::WeightShape {
+                name: extra_layer,
+                found: vec![],
+                datum: "F32".into(),
+                expected: vec![],
+            });
+        }
+        let cholesky = if has_uncertainty {
+            let floor = match weights.values("cholesky_floor", &[CHOLESKY_VALUES]) {
+                Ok(values) => std::array::from_fn(|index| values[index]),
+                Err(_) => [weights.values("cholesky_floor", &[])?[0]; CHOLESKY_VALUES],
+            };
+            Some(CholeskyHead {
+                linear: weights.linear("head_cholesky")?,
+                diagonal_scale: weights.vector("cholesky_diagonal_scale")?,
+                off_diagonal_scale: weights.vector("cholesky_off_diagonal_scale")?,
+                floor,
+            })
+        } else {
+            None
+        };
+        Ok(NativeModel {
+            embedding: weights.matrix("embedding.weight_t")?,
+            token_table: weights.matrix("token_table")?,
+            layers: [layer(0)?, layer(1)?],
+            final_norm: weights.norm("final_norm")?,
+            head: weights.linear("head")?,
+            output_scale: weights.vector("output_scale")?,
+            cholesky,
+        })
+    }
+
+    /// Whether the model has the uncertainty head.
+    pub fn has_uncertainty(&self) -> bool {
+        self.cholesky.is_some()
+    }
+
+    /// Runs a batch laid out as [`PrModel::run`](crate::onnx::PrModel::run) takes it:
+    /// `features` `batch × 5 × 5`, `valid` `batch × 5`, `displacements` `batch × 2` and, for a
+    /// model with the uncertainty head, `cholesky` `batch × 3`. The caller checks that the
+    /// buffers agree; extra values are ignored.
+    pub fn run(
+        &self,
+        features: &[f32],
+        valid: &[f32],
+        displacements: &mut [f32],
+        cholesky: Option<&mut [f32]>,
+    ) {
+        run_batch(self, features, valid, displacements, cholesky);
+    }
+
+    /// One sample: the history `features` (rows oldest first) and their `valid` flags; returns
+    /// the displacement and the Cholesky factor (zero without the uncertainty head).
+    #[inline(always)]
+    fn forward(&self, features: &[f32], valid: &[f32]) -> ([f32; 2], [f32; CHOLESKY_VALUES]) {
+        // Attention weight of each token as a key: the history rows' flags, 1 for the queries.
+        let mut key_weight = [1.0f32; TOKENS];
+        key_weight[..MAX_HISTORY].copy_from_slice(&valid[..MAX_HISTORY]);
+        let mut tokens = self.token_table;
+        for (row, token) in tokens.iter_mut().enumerate().take(MAX_HISTORY) {
+            if key_weight[row] == 0.0 {
+                continue;
+            }
+            for (feature, embedding) in
+                features[row * FEATURES..(row + 1) * FEATURES].iter().zip(&self.embedding)
+            {
+                for (out, weight) in token.iter_mut().zip(embedding) {
+                    *out += feature * weight;
+                }
+            }
+        }
+        for (index, layer) in self.layers.iter().enumerate() {
+            // The last layer updates only the query tokens.
+            let first_query = if index + 1 == LAYERS { MAX_HISTORY } else { 0 };
+            layer.apply(&mut tokens, &key_weight, first_query);
+        }
+        let mut flat = [0.0f32; QUERIES * MODEL_WIDTH];
+        for query in 0..QUERIES {
+            let normed = self.final_norm.apply(&tokens[MAX_HISTORY + query]);
+            flat[query * MODEL_WIDTH..(query + 1) * MODEL_WIDTH].copy_from_slice(&normed);
+        }
+        let head = self.head.apply(&flat);
+        let displacement = [head[0] * self.output_scale[0], head[1] * self.output_scale[1]];
+        let mut factor = [0.0f32; CHOLESKY_VALUES];
+        if let Some(cholesky) = &self.cholesky {
+            let raw = cholesky.linear.apply(&flat);
+            for index in 0..CHOLESKY_VALUES {
+                let r = raw[index];
+                let softplus = r.max(0.0) + (1.0 + (-r.abs()).exp()).ln();
+                factor[index] = softplus * cholesky.diagonal_scale[index]
+                    + r * cholesky.off_diagonal_scale[index]
+                    + cholesky.floor[index];
+            }
+        }
+        (displacement, factor)
+    }
+}
+
+impl Layer {
+    /// Updates `tokens[first_query..]` (those with a non-zero key weight) by attention over
+    /// every token of non-zero key weight, then the feed-forward block.
+    #[inline(always)]
+    fn apply(
+        &self,
+        tokens: &mut [[f32; MODEL_WIDTH]; TOKENS],
+        key_weight: &[f32; TOKENS],
+        first_query: usize,
+    ) {
+        let mut keys = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        let mut values = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        let mut queries = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        for token in 0..TOKENS {
+            if key_weight[token] == 0.0 {
+                continue;
+            }
+            let normed = self.norm_attention.apply(&tokens[token]);
+            keys[token] = self.key.apply(&normed);
+            values[token] = self.value.apply(&normed);
+            if token >= first_query {
+                queries[token] = self.query.apply(&normed);
+            }
+        }
+        for query in first_query..TOKENS {
+            if key_weight[query] == 0.0 {
+                continue;
+            }
+            let mut mixed = [0.0f32; MODEL_WIDTH];
+            for head in 0..HEADS {
+                let channels = head * HEAD_WIDTH..(head + 1) * HEAD_WIDTH;
+                let mut scores = [f32::NEG_INFINITY; TOKENS];
+                let mut peak = f32::NEG_INFINITY;
+                for key in 0..TOKENS {
+                    if key_weight[key] == 0.0 {
+                        continue;
+                    }
+                    let mut score = 0.0f32;
+                    for channel in channels.clone() {
+                        score += queries[query][channel] * keys[key][channel];
+                    }
+                    scores[key] = score;
+                    peak = peak.max(score);
+                }
+                let mut total = 0.0f32;
+                let mut weights = [0.0f32; TOKENS];
+                for key in 0..TOKENS {
+                    if key_weight[key] != 0.0 {
+                        weights[key] = (scores[key] - peak).exp() * key_weight[key];
+                        total += weights[key];
+                    }
+                }
+                for key in 0..TOKENS {
+                    if key_weight[key] != 0.0 {
+                        let share = weights[key] / total;
+                        for channel in channels.clone() {
+                            mixed[channel] += share * values[key][channel];
+                        }
+                    }
+                }
+            }
+            let attended = self.output.apply(&mixed);
+            let token = &mut tokens[query];
+            for (value, add) in token.iter_mut().zip(&attended) {
+                *value += add;
+            }
+            let normed = self.norm_feed_forward.apply(token);
+            let mut hidden = self.feed_forward_in.apply(&normed);
+            for value in &mut hidden {
+                *value = value.max(0.0);
+            }
+            let out = self.feed_forward_out.apply(&hidden);
+            for (value, add) in token.iter_mut().zip(&out) {
+                *value += add;
+            }
+        }
+    }
+}
+
+/// The batch loop, compiled for AVX-512 and AVX2 besides the portable baseline and dispatched
+/// at run time; every step below is inlined into it. Rust does not fuse multiplications and
+/// additions on its own, so every version computes the same values in the same order.
+#[multiversion(targets("x86_64+avx512f+avx512bw+avx512vl+avx512dq+avx+avx2+fma", "x86_64+avx+avx2+fma"))]
+fn run_batch(
+    model: &NativeModel,
+    features: &[f32],
+    valid: &[f32],
+    displacements: &mut [f32],
+    mut cholesky: Option<&mut [f32]>,
+) {
+    let samples = features
+        .chunks_exact(MAX_HISTORY * FEATURES)
+        .zip(valid.chunks_exact(MAX_HISTORY))
+        .zip(displacements.chunks_exact_mut(2))
+        .enumerate();
+    for (index, ((features, valid), displacement)) in samples {
+        let (answer, factor) = model.forward(features, valid);
+        displacement.copy_from_slice(&answer);
+        if let Some(out) = cholesky
+            .as_deref_mut()
+            .and_then(|values| values.get_mut(index * CHOLESKY_VALUES..(index + 1) * CHOLESKY_VALUES))
+        {
+            out.copy_from_slice(&factor);
+        }
+    }
+}
