@@ -22,11 +22,23 @@ file (the input with the chosen values substituted, comments kept) and a JSON lo
 
 ``--parameters learned --method pr-imm`` tunes the learned mode's side instead, on the same
 validation-only terms: the factor on the model's own displacement covariance
-(``predictor.learned_process_noise_scale``), the likelihood temperature ``imm.likelihood_temperature``
-and the constant ``Q_PR`` of cars and pedestrians (used where the model gives no covariance):
+(``predictor.learned_process_noise_scale``) and the likelihood temperature
+``imm.likelihood_temperature`` (the constant ``Q_PR`` is the ``pr-noise`` set's):
 
     python3 tools/tune_physics.py --data out/tune/default/validation --parameters learned \\
         --method pr-imm --config config/primm.toml --out out/tune/learned.toml
+
+``--parameters pr-noise`` (scored with ``--method pr-imm``, its default; ``pr`` is allowed too)
+tunes the PR mode's noise per class: the constant process noise ``Q_PR``
+(``classes.<class>.learned.process_noise_covariance_m2``, used with
+``predictor.process_noise = "constant"`` or a model without the covariance output) and the
+measurement noise ``R_PR`` (``classes.<class>.learned.measurement_noise_covariance_m2``) of cars
+and of pedestrians, four knobs. Each knob is a scale on its whole 2x2 matrix relative to the
+starting configuration (so a diagonal or isotropic matrix stays so; entries rounded to 4
+significant digits); the factors (default ``0.25 0.5 2 4``) multiply the knob's current scale:
+
+    python3 tools/tune_physics.py --data out/tune/default/validation out/tune/robust/validation \\
+        --parameters pr-noise --method pr-imm --rounds 1 --out out/tune/pr_noise.toml
 
 ``--parameters imm`` tunes the IMM side of PR-IMM (scored with ``--method pr-imm``): the Markov
 transition matrix ``imm.transition`` and the initial mode probabilities
@@ -98,7 +110,17 @@ IMM_PARAMETERS = [
     ("imm", "likelihood_temperature"),
 ]
 
-PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS, "imm": IMM_PARAMETERS}
+# (section, key) of the PR mode's per-class noise matrices (Q_PR, R_PR); each is scaled as a whole.
+PR_NOISE_PARAMETERS = [
+    (f"classes.{cls}.learned", key)
+    for cls in ("car", "pedestrian")
+    for key in ("process_noise_covariance_m2", "measurement_noise_covariance_m2")
+]
+
+PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS, "imm": IMM_PARAMETERS,
+                  "pr-noise": PR_NOISE_PARAMETERS}
+# Sets tuned with the wide factors and scored with pr-imm by default.
+WIDE_SETS = ("imm", "pr-noise")
 
 # Mode order of the vectors and matrices of [imm].
 MODES = ("pr", "cv", "ca", "ct")
@@ -224,24 +246,30 @@ def parse_args(argv=None):
     parser.add_argument("--primm", default="target/release/primm", help="the primm binary")
     parser.add_argument("--out", required=True, help="where to write the tuned configuration (TOML)")
     parser.add_argument("--factors", type=float, nargs="+", default=None,
-                        help="factors tried on each parameter (default: 0.5 0.7 1.4 2; 0.25 0.5 2 4 for imm)")
+                        help="factors tried on each parameter (default: 0.5 0.7 1.4 2; 0.25 0.5 2 4 for imm and "
+                             "pr-noise)")
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--idf1-weight", type=float, default=20.0, help="metres of RMSE per unit of IDF1 lost")
     parser.add_argument("--tracking-frame", choices=["world", "vehicle"], default="world")
     parser.add_argument("--parameters", choices=sorted(PARAMETER_SETS), default="physics",
                         help="which parameters to tune")
     parser.add_argument("--method", default=None,
-                        help="the method scored (imm, pr-imm, ...); default: pr-imm for --parameters imm, else imm")
+                        help="the method scored (imm, pr-imm, ...); default: pr-imm for --parameters imm and "
+                             "pr-noise, else imm")
     parser.add_argument("--modes", type=parse_modes, nargs="+", default=None,
                         help="--parameters imm: candidate mode sets, e.g. pr,cv,ca,ct pr,cv,ct (default: the "
                              "configuration's)")
     args = parser.parse_args(argv)
     if args.method is None:
-        args.method = "pr-imm" if args.parameters == "imm" else "imm"
+        args.method = "pr-imm" if args.parameters in WIDE_SETS else "imm"
     if args.factors is None:
-        args.factors = [0.25, 0.5, 2.0, 4.0] if args.parameters == "imm" else [0.5, 0.7, 1.4, 2.0]
+        args.factors = [0.25, 0.5, 2.0, 4.0] if args.parameters in WIDE_SETS else [0.5, 0.7, 1.4, 2.0]
+    if any(factor <= 0.0 for factor in args.factors):
+        parser.error("--factors must be positive")
     if args.modes is not None and args.parameters != "imm":
         parser.error("--modes goes with --parameters imm")
+    if args.parameters == "pr-noise" and args.method not in ("pr-imm", "pr"):
+        parser.error("--parameters pr-noise scores a method with the PR mode: --method pr-imm (or pr)")
     return args
 
 
@@ -282,6 +310,38 @@ def substitute_raw(text: str, section: str, key: str, value: str) -> str:
             lines[index:end + 1] = [f"{key} = {value}" + (f" {comment}" if comment else "") + "\n"]
             return "".join(lines)
     raise KeyError(f"[{section}] {key} not found")
+
+
+def get_matrix(config: dict, section: str, key: str) -> list:
+    """The 2x2 matrix ``key`` of ``[section]`` as floats."""
+    node = config
+    for part in section.split("."):
+        node = node[part]
+    matrix = [[float(value) for value in row] for row in node[key]]
+    if len(matrix) != 2 or any(len(row) != 2 for row in matrix):
+        raise ValueError(f"[{section}] {key} is not a 2x2 matrix: {node[key]}")
+    return matrix
+
+
+def scaled_matrix(matrix: list, scale: float) -> list:
+    """``matrix`` times ``scale``, entries rounded to 4 significant digits (zeros stay 0.0)."""
+    if not scale > 0.0:
+        raise ValueError(f"scale {scale} must be positive")
+    return [[float(f"{value * scale:.4g}") for value in row] for row in matrix]
+
+
+def format_covariance(matrix: list) -> str:
+    """A 2x2 matrix as one-line TOML, as config/primm.toml writes it."""
+    return "[" + ", ".join("[" + ", ".join(repr(value) for value in row) + "]" for row in matrix) + "]"
+
+
+def pr_noise_text(text: str, matrices: dict, scales: dict) -> str:
+    """``text`` (TOML) with every matrix of ``matrices`` ({(section, key): starting 2x2 matrix})
+    set to itself times ``scales[(section, key)]`` (1.0 where missing)."""
+    for (section, key), matrix in matrices.items():
+        scale = scales.get((section, key), 1.0)
+        text = substitute_raw(text, section, key, format_covariance(scaled_matrix(matrix, scale)))
+    return text
 
 
 def score(args, text: str) -> dict:
@@ -334,6 +394,8 @@ def main(argv=None) -> int:
         text = handle.read()
     if args.parameters == "imm":
         return tune_imm(args, text)
+    if args.parameters == "pr-noise":
+        return tune_pr_noise(args, text)
     config = tomllib.loads(text)
     start = score(args, text)
     best = objective(args, start, start)
@@ -407,6 +469,51 @@ def tune_imm(args, text: str) -> int:
                 trial(key, value, candidate_knobs, modes)
         print(f"after round {round_index + 1}: {list(modes)} {knobs}  objective {best:.4f}", flush=True)
     log.append({"parameter": "chosen", "value": None, "knobs": knobs, "modes": list(modes), "objective": best})
+    return write_result(args, text, log, best)
+
+
+def tune_pr_noise(args, text: str) -> int:
+    """Coordinate descent over the scales of PR_NOISE_PARAMETERS (Q_PR and R_PR of cars and
+    pedestrians), each a factor on its starting matrix."""
+    original = text
+    config = tomllib.loads(text)
+    if config.get("predictor", {}).get("process_noise", "constant") != "constant":
+        print('note: predictor.process_noise is not "constant": the constant Q_PR is used only where the '
+              "model gives no covariance", flush=True)
+    matrices = {parameter: get_matrix(config, *parameter) for parameter in PR_NOISE_PARAMETERS}
+    scales = {parameter: 1.0 for parameter in PR_NOISE_PARAMETERS}
+    name = lambda parameter: f"{parameter[0]}.{parameter[1]}"  # noqa: E731
+
+    def described(candidate_scales):
+        return {name(p): {"scale": scale, "matrix": scaled_matrix(matrices[p], scale)}
+                for p, scale in candidate_scales.items()}
+
+    start = score(args, text)  # the configuration as given, unchanged
+    best = objective(args, start, start)
+    log = [{"parameter": None, "value": None, "scales": described(scales), "result": start, "objective": best}]
+    print(f"start: objective {best:.4f}  {start}", flush=True)
+    for round_index in range(args.rounds):
+        print(f"round {round_index + 1}", flush=True)
+        for parameter in PR_NOISE_PARAMETERS:
+            base = scales[parameter]
+            for factor in args.factors:
+                value = float(f"{base * factor:.4g}")
+                if value == base:
+                    continue
+                candidate_scales = {**scales, parameter: value}
+                candidate = pr_noise_text(original, matrices, candidate_scales)
+                result = score(args, candidate)
+                value_objective = objective(args, result, start)
+                log.append({"parameter": name(parameter), "value": value, "scales": described(candidate_scales),
+                            "result": result, "objective": value_objective})
+                print(f"  {name(parameter)} x{value} = {format_covariance(scaled_matrix(matrices[parameter], value))}"
+                      f": objective {value_objective:.4f}  {result}", flush=True)
+                if value_objective < best - 1e-6:
+                    best, scales, text = value_objective, candidate_scales, candidate
+                    print(f"  -> kept {name(parameter)} x{value}  objective {best:.4f}", flush=True)
+        print(f"after round {round_index + 1}: {[(name(p), s) for p, s in scales.items()]}  objective {best:.4f}",
+              flush=True)
+    log.append({"parameter": "chosen", "value": None, "scales": described(scales), "objective": best})
     return write_result(args, text, log, best)
 
 

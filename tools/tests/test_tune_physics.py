@@ -1,4 +1,5 @@
-"""tools/tune_physics.py: TOML substitution, the [imm] knobs and the refusal to tune on evaluation data."""
+"""tools/tune_physics.py: TOML substitution, the [imm] knobs, the PR noise scales and the refusal to tune on
+evaluation data."""
 
 import os
 import sys
@@ -45,8 +46,8 @@ def test_every_parameter_of_both_sets_exists_in_the_shipped_configuration_and_ca
     config = tomllib.loads(text)
     for name, parameters in tune_physics.PARAMETER_SETS.items():
         assert parameters, name
-        if name == "imm":
-            continue  # knobs that generate [imm] arrays, not keys (tested below)
+        if name in ("imm", "pr-noise"):
+            continue  # knobs that generate [imm] arrays, and matrix scales (tested below)
         for section, key in parameters:
             value = tune_physics.get_value(config, section, key)
             changed = tomllib.loads(tune_physics.substitute(text, section, key, value * 2.0))
@@ -128,3 +129,144 @@ def test_a_mode_set_needs_pr():
     assert tune_physics.parse_modes("ct,pr") == ("pr", "ct")
     with pytest.raises(Exception):
         tune_physics.parse_modes("cv,ca")
+
+
+PR_NOISE = tune_physics.PR_NOISE_PARAMETERS
+CAR_Q = ("classes.car.learned", "process_noise_covariance_m2")
+CAR_R = ("classes.car.learned", "measurement_noise_covariance_m2")
+PEDESTRIAN_Q = ("classes.pedestrian.learned", "process_noise_covariance_m2")
+PEDESTRIAN_R = ("classes.pedestrian.learned", "measurement_noise_covariance_m2")
+
+
+def shipped_matrices(text):
+    config = tomllib.loads(text)
+    return {parameter: tune_physics.get_matrix(config, *parameter) for parameter in PR_NOISE}
+
+
+def learned_section(config, cls):
+    return config["classes"][cls]["learned"]
+
+
+def test_the_pr_noise_set_is_q_and_r_of_cars_and_pedestrians():
+    assert sorted(PR_NOISE) == sorted([CAR_Q, CAR_R, PEDESTRIAN_Q, PEDESTRIAN_R])
+    assert tune_physics.PARAMETER_SETS["pr-noise"] is PR_NOISE
+    for matrix in shipped_matrices(shipped_text()).values():
+        # Isotropic and diagonal in the shipped configuration, which scaling keeps.
+        assert matrix[0][1] == matrix[1][0] == 0.0 and matrix[0][0] == matrix[1][1] > 0.0
+
+
+def test_a_scaled_matrix_is_scaled_whole_and_rounded():
+    assert tune_physics.scaled_matrix([[0.011, 0.0], [0.0, 0.011]], 4.0) == [[0.044, 0.0], [0.0, 0.044]]
+    assert tune_physics.scaled_matrix([[0.0006, 0.0], [0.0, 0.0006]], 0.25) == [[0.00015, 0.0], [0.0, 0.00015]]
+    assert tune_physics.scaled_matrix([[0.36, 0.01], [0.01, 0.25]], 1 / 3) == [[0.12, 0.003333], [0.003333, 0.08333]]
+    assert tune_physics.format_covariance([[0.044, 0.0], [0.0, 0.044]]) == "[[0.044, 0.0], [0.0, 0.044]]"
+    for scale in (0.0, -1.0):
+        with pytest.raises(ValueError):
+            tune_physics.scaled_matrix([[1.0, 0.0], [0.0, 1.0]], scale)
+    with pytest.raises(ValueError):
+        tune_physics.get_matrix({"a": {"b": [[1.0, 0.0, 0.0]]}}, "a", "b")
+
+
+def test_pr_noise_text_scales_only_the_chosen_matrices_of_their_own_class():
+    text = shipped_text()
+    matrices = shipped_matrices(text)
+    # Unit scales rewrite nothing that matters.
+    assert tomllib.loads(tune_physics.pr_noise_text(text, matrices, {})) == tomllib.loads(text)
+    changed_text = tune_physics.pr_noise_text(text, matrices, {CAR_Q: 4.0, PEDESTRIAN_R: 0.5})
+    changed, before = tomllib.loads(changed_text), tomllib.loads(text)
+    car_q = before["classes"]["car"]["learned"]["process_noise_covariance_m2"][0][0]
+    pedestrian_r = before["classes"]["pedestrian"]["learned"]["measurement_noise_covariance_m2"][0][0]
+    assert learned_section(changed, "car")["process_noise_covariance_m2"] == [
+        [float(f"{car_q * 4:.4g}"), 0.0], [0.0, float(f"{car_q * 4:.4g}")]]
+    assert learned_section(changed, "pedestrian")["measurement_noise_covariance_m2"] == [
+        [pedestrian_r / 2, 0.0], [0.0, pedestrian_r / 2]]
+    # The other class's matrices, the physics modes' R of the same classes (same key name, other
+    # section), the two-wheelers' PR matrices and everything else are untouched.
+    learned_section(changed, "car")["process_noise_covariance_m2"] = learned_section(
+        before, "car")["process_noise_covariance_m2"]
+    learned_section(changed, "pedestrian")["measurement_noise_covariance_m2"] = learned_section(
+        before, "pedestrian")["measurement_noise_covariance_m2"]
+    assert changed == before
+    assert changed_text.count("#") == text.count("#")
+
+
+def test_pr_noise_defaults_to_pr_imm_and_wide_factors_and_needs_the_pr_mode():
+    args = tune_physics.parse_args(["--data", "d", "--out", "o", "--parameters", "pr-noise"])
+    assert args.method == "pr-imm" and args.factors == [0.25, 0.5, 2.0, 4.0]
+    args = tune_physics.parse_args(["--data", "d", "--out", "o", "--parameters", "pr-noise", "--factors", "0.5", "3"])
+    assert args.factors == [0.5, 3.0]
+    assert tune_physics.parse_args(["--data", "d", "--out", "o"]).method == "imm"
+    for bad in (["--method", "imm"], ["--method", "cv"], ["--factors", "0", "2"]):
+        with pytest.raises(SystemExit):
+            tune_physics.parse_args(["--data", "d", "--out", "o", "--parameters", "pr-noise", *bad])
+
+
+def test_pr_noise_tuning_on_an_evaluation_split_is_refused(tmp_path, monkeypatch):
+    validation, evaluation = tmp_path / "validation", tmp_path / "evaluation"
+    validation.mkdir(), evaluation.mkdir()
+    monkeypatch.setattr(tune_physics, "score", lambda args, text: pytest.fail("scored evaluation data"))
+    with pytest.raises(SystemExit, match="evaluation split"):
+        tune_physics.main(["--data", str(validation), str(evaluation) + "/", "--parameters", "pr-noise",
+                           "--config", os.path.join(ROOT, "config", "primm.toml"), "--out", str(tmp_path / "o.toml")])
+    assert not (tmp_path / "o.toml").exists()
+
+
+def test_pr_noise_descent_finds_the_best_scales_and_writes_them(tmp_path, monkeypatch):
+    """A synthetic objective, lowest at car Q_PR x4 and pedestrian R_PR x0.5 with the other two
+    at x1, read back from the candidate configuration primm would get."""
+    text = shipped_text()
+    start = {p: m[0][0] for p, m in shipped_matrices(text).items()}
+    target = {CAR_Q: 4.0, CAR_R: 1.0, PEDESTRIAN_Q: 1.0, PEDESTRIAN_R: 0.5}
+    calls = []
+
+    def fake_score(args, candidate):
+        config = tomllib.loads(candidate)
+        error = 0.0
+        for parameter in PR_NOISE:
+            matrix = tune_physics.get_matrix(config, *parameter)
+            assert matrix[0][1] == matrix[1][0] == 0.0 and matrix[0][0] == matrix[1][1]
+            ratio = matrix[0][0] / start[parameter] / target[parameter]
+            error += abs(ratio - 1.0)
+        calls.append(error)
+        # Two data directories; IDF1 unaffected.
+        return {"rmse_xy": [1.0 + error, 1.2 + error], "idf1": [0.9, 0.8]}
+
+    monkeypatch.setattr(tune_physics, "score", fake_score)
+    out = tmp_path / "pr_noise.toml"
+    assert tune_physics.main(["--data", "a/validation", "b/validation", "--parameters", "pr-noise", "--rounds", "1",
+                              "--config", os.path.join(ROOT, "config", "primm.toml"), "--out", str(out)]) == 0
+    assert len(calls) == 1 + 4 * 4  # the start, then four factors on each of the four knobs
+    chosen = tomllib.loads(out.read_text())
+    for parameter in PR_NOISE:
+        value = tune_physics.get_matrix(chosen, *parameter)[0][0]
+        assert value == pytest.approx(start[parameter] * target[parameter], rel=1e-3), parameter
+    # Nothing outside the four matrices changed.
+    assert tune_physics.pr_noise_text(out.read_text(), shipped_matrices(out.read_text()), {}) == out.read_text()
+    before = tomllib.loads(text)
+    for parameter in PR_NOISE:
+        section, key = parameter
+        cls = section.split(".")[1]
+        learned_section(chosen, cls)[key] = learned_section(before, cls)[key]
+    assert chosen == before
+    import json
+    log = json.loads((tmp_path / "pr_noise.log.json").read_text())
+    assert log[0]["objective"] == pytest.approx(1.1 + calls[0])
+    assert log[-1]["parameter"] == "chosen" and log[-1]["objective"] == pytest.approx(1.1)
+    assert log[-1]["scales"]["classes.car.learned.process_noise_covariance_m2"]["scale"] == 4.0
+    assert log[-1]["scales"]["classes.pedestrian.learned.measurement_noise_covariance_m2"]["scale"] == 0.5
+
+
+def test_an_idf1_loss_outweighs_a_small_rmse_gain(tmp_path, monkeypatch):
+    """pr-noise uses the same objective: a candidate that lowers RMSE_xy by 0.01 m but loses 0.001
+    of IDF1 (x20 = 0.02 m) is not kept."""
+    def fake_score(args, candidate):
+        scale = tune_physics.get_matrix(tomllib.loads(candidate), *CAR_R)[0][0] / 0.36
+        if scale == 1.0:
+            return {"rmse_xy": [1.0], "idf1": [0.9]}
+        return {"rmse_xy": [0.99], "idf1": [0.899]}
+
+    monkeypatch.setattr(tune_physics, "score", fake_score)
+    out = tmp_path / "o.toml"
+    tune_physics.main(["--data", "a/validation", "--parameters", "pr-noise", "--rounds", "1", "--factors", "2",
+                       "--config", os.path.join(ROOT, "config", "primm.toml"), "--out", str(out)])
+    assert tomllib.loads(out.read_text()) == tomllib.loads(shipped_text())
