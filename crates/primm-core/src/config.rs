@@ -339,7 +339,7 @@ impl Default for Config {
                     },
                     learned: LearnedConfig {
                         process_noise_covariance_m2: diagonal(0.011, 0.011),
-                        measurement_noise_covariance_m2: diagonal(0.36, 0.36),
+                        measurement_noise_covariance_m2: diagonal(0.18, 0.18),
                     },
                 },
                 pedestrian: ClassConfig {
@@ -359,7 +359,7 @@ impl Default for Config {
                         max_turn_rate_radps: DEFAULT_MAX_TURN_RATE_RADPS,
                     },
                     learned: LearnedConfig {
-                        process_noise_covariance_m2: diagonal(0.0006, 0.0006),
+                        process_noise_covariance_m2: diagonal(0.00015, 0.00015),
                         measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     },
                 },
