@@ -1,12 +1,13 @@
 //! With the PR model on its inference thread (or two, sharing each batch), the tracking thread
-//! allocates nothing per frame; tract's per-run allocations happen, and are counted, on the
-//! inference threads.
+//! allocates nothing per frame. On the native forward pass (the default engine) the inference
+//! thread allocates nothing either; on tract its per-run allocations happen, and are counted,
+//! there.
 
 use crate::common;
 use crate::common::counting_allocator;
 
 use counting_allocator::{allocations, count_allocations};
-use primm_core::config::Config;
+use primm_core::config::{Config, InferenceEngine};
 use primm_core::measurement::Frame;
 use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
 use primm_core::tracker::Tracker;
@@ -40,14 +41,17 @@ impl DisplacementPredictor for CountingPredictor {
     }
 }
 
-#[test]
-fn two_thousand_frames_with_the_onnx_model_allocate_nothing_on_the_tracking_thread() {
+/// Tracks `frames` frames of 32 objects with the model on `engine`, on its inference thread;
+/// returns the tracking thread's allocations, the inference thread's, and the batches run.
+fn frames_on_the_inference_thread(engine: InferenceEngine, frames: usize) -> (u64, u64, u64) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr.onnx");
     let inference_allocations = Arc::new(AtomicU64::new(0));
     let batches = Arc::new(AtomicU64::new(0));
     let on_inference_thread = Arc::new(AtomicU64::new(0));
+    let mut inner = OnnxPredictor::load(&path).unwrap();
+    assert_eq!(inner.set_engine(engine), engine);
     let counting = CountingPredictor {
-        inner: OnnxPredictor::load(&path).unwrap(),
+        inner,
         allocations: inference_allocations.clone(),
         batches: batches.clone(),
         on_inference_thread: on_inference_thread.clone(),
@@ -57,9 +61,9 @@ fn two_thousand_frames_with_the_onnx_model_allocate_nothing_on_the_tracking_thre
     let mut tracker = Tracker::with_predictor(Config::default(), predictor).unwrap();
     let base = common::scene_frames(&common::lanes(32), 200, 0.04, 0.2, 7);
     let mut frame: Frame = base[0].clone();
-    let frames = 2_000usize;
     let mut updates = 0u64;
     let warm_up_batches = batches.load(Ordering::Relaxed);
+    let warm_up_allocations = inference_allocations.load(Ordering::Relaxed);
     let tracking_allocations = count_allocations(|| {
         for k in 0..frames {
             let source = &base[k % base.len()];
@@ -69,23 +73,38 @@ fn two_thousand_frames_with_the_onnx_model_allocate_nothing_on_the_tracking_thre
             updates += outputs.iter().filter(|o| o.measurement_index.is_some()).count() as u64;
         }
     });
-    assert_eq!(tracking_allocations, 0, "the tracking thread allocated");
     assert_eq!(updates, 32 * frames as u64);
     let stats = *tracker.predictor().stats();
     assert_eq!(stats.deadline_misses, 0);
     // The first frame has no tracks yet, so nothing to predict.
     assert_eq!(stats.batches_on_time, frames as u64 - 1);
     assert_eq!(tracker.stats().learned_predictions_missing, 0);
-    let batches = batches.load(Ordering::Relaxed) - warm_up_batches;
-    assert_eq!(batches, frames as u64 - 1);
-    assert_eq!(on_inference_thread.load(Ordering::Relaxed), batches + warm_up_batches);
-    // tract does allocate per run, there: the counter sees it (so it is known to work).
-    let inference_allocations = inference_allocations.load(Ordering::Relaxed);
+    let batches_run = batches.load(Ordering::Relaxed) - warm_up_batches;
+    assert_eq!(batches_run, frames as u64 - 1);
+    assert_eq!(on_inference_thread.load(Ordering::Relaxed), batches_run + warm_up_batches);
+    let inference = inference_allocations.load(Ordering::Relaxed) - warm_up_allocations;
     println!(
-        "inference thread: {inference_allocations} allocations over {batches} batches ({:.0} per batch)",
-        inference_allocations as f64 / batches as f64
+        "{engine:?}: inference thread {inference} allocations over {batches_run} batches ({:.0} per batch)",
+        inference as f64 / batches_run as f64
     );
-    assert!(inference_allocations >= batches, "{inference_allocations} allocations over {batches} batches");
+    (tracking_allocations, inference, batches_run)
+}
+
+#[test]
+fn two_thousand_frames_with_the_onnx_model_allocate_nothing_on_the_tracking_thread_nor_natively_on_the_inference_thread(
+) {
+    let (tracking, inference, _) = frames_on_the_inference_thread(InferenceEngine::Native, 2_000);
+    assert_eq!(tracking, 0, "the tracking thread allocated");
+    // The predictor's buffers are sized at load; the native forward pass works on the stack.
+    assert_eq!(inference, 0, "the inference thread allocated on the native engine");
+}
+
+#[test]
+fn on_tract_the_inference_thread_allocates_and_the_counter_sees_it_while_the_tracking_thread_does_not() {
+    let (tracking, inference, batches) = frames_on_the_inference_thread(InferenceEngine::Tract, 50);
+    assert_eq!(tracking, 0, "the tracking thread allocated");
+    // tract allocates per run, there: the counter sees it, so the zero above is measured.
+    assert!(inference >= batches, "{inference} allocations over {batches} batches");
 }
 
 #[test]
