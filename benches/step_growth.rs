@@ -246,12 +246,8 @@ fn main() {
     let inference_threads: usize = argument("--inference-threads")
         .and_then(|v| v.parse().ok())
         .unwrap_or(Config::default().predictor.inference_threads);
-    let engine = match argument("--engine").as_deref() {
-        None => Config::default().predictor.engine,
-        Some("native") => InferenceEngine::Native,
-        Some("tract") => InferenceEngine::Tract,
-        Some(other) => panic!("--engine {other}: use native or tract"),
-    };
+    let engine: InferenceEngine = argument("--engine")
+        .map_or(Config::default().predictor.engine, |name| name.parse().expect("--engine native|tract"));
     let mut rows = Vec::new();
     for &method in &methods {
         for &count in &counts {

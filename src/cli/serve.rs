@@ -49,17 +49,8 @@ pub struct Args {
     pub inference_threads: Option<usize>,
     /// What runs the PR model: `native` (primm's forward pass where the model allows it) or
     /// `tract`; overrides the configuration's `predictor.engine`.
-    #[arg(long, value_name = "ENGINE", value_parser = parse_engine)]
+    #[arg(long, value_name = "ENGINE")]
     pub engine: Option<InferenceEngine>,
-}
-
-/// `native` or `tract`.
-fn parse_engine(text: &str) -> Result<InferenceEngine, String> {
-    match text {
-        "native" => Ok(InferenceEngine::Native),
-        "tract" => Ok(InferenceEngine::Tract),
-        _ => Err(format!("'{text}' is not an engine: use native or tract")),
-    }
 }
 
 /// Why `primm serve` failed.

@@ -104,6 +104,26 @@ pub enum InferenceEngine {
     Tract,
 }
 
+/// An engine name that is neither `native` nor `tract`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown engine '{text}' (expected native or tract)")]
+pub struct UnknownEngine {
+    /// The text that names no engine.
+    pub text: String,
+}
+
+impl core::str::FromStr for InferenceEngine {
+    type Err = UnknownEngine;
+    /// The names of `predictor.engine`: `native`, `tract`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "native" => Ok(InferenceEngine::Native),
+            "tract" => Ok(InferenceEngine::Tract),
+            _ => Err(UnknownEngine { text: s.into() }),
+        }
+    }
+}
+
 /// The source of the PR mode's process noise `Q_PR` (`eq:pr_cov`). The default configuration
 /// uses [`Constant`](Self::Constant): on the validation splits it gave PR-IMM the lower error
 /// (`config/primm.toml` has the figures).
@@ -648,6 +668,13 @@ mod tests {
     fn an_empty_mode_set_is_rejected() {
         let config = Config::default().with_modes(ModeSet::EMPTY);
         assert_eq!(invalid_key(&config), "imm.modes");
+    }
+
+    #[test]
+    fn engine_names_parse_and_another_name_is_refused_with_it() {
+        assert_eq!("native".parse::<InferenceEngine>(), Ok(InferenceEngine::Native));
+        assert_eq!("tract".parse::<InferenceEngine>(), Ok(InferenceEngine::Tract));
+        assert_eq!("onnx".parse::<InferenceEngine>(), Err(UnknownEngine { text: "onnx".into() }));
     }
 
     #[test]

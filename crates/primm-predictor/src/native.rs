@@ -97,6 +97,12 @@ pub enum Unsupported {
         /// The shape the architecture needs.
         expected: Vec<usize>,
     },
+    /// The file has weights of a layer beyond the architecture's [`LAYERS`].
+    #[error("initializer `{name}` belongs to a layer beyond the {LAYERS} of this architecture")]
+    ExtraLayer {
+        /// The initializer's name.
+        name: String,
+    },
     /// A stacked query or output weight has a non-zero entry outside its head's channels.
     #[error("`{name}` mixes channels across heads")]
     HeadsNotSeparated {
@@ -373,12 +379,7 @@ impl NativeModel {
         // A third layer would be silently ignored: refuse it.
         let extra_layer = format!("layers.{LAYERS}.ff_in.weight_t");
         if weights.by_name.contains_key(extra_layer.as_str()) {
-            return Err(Unsupported::WeightShape {
-                name: extra_layer,
-                found: vec![],
-                datum: "F32".into(),
-                expected: vec![],
-            });
+            return Err(Unsupported::ExtraLayer { name: extra_layer });
         }
         let cholesky = if has_uncertainty {
             let floor = match weights.values("cholesky_floor", &[CHOLESKY_VALUES]) {

@@ -397,21 +397,25 @@ impl PrModel {
             model: loaded.source.clone(),
             reason: error.to_string(),
         })?;
-        if loaded.native.is_ok() {
-            let agreement = loaded.probe_agreement();
-            loaded.native = agreement.map_err(|error| ModelError::Preparation {
+        if let Ok(native) = loaded.native.clone() {
+            let difference = loaded.probe_difference(&native).map_err(|error| ModelError::Preparation {
                 model: loaded.source.clone(),
                 reason: error.to_string(),
             })?;
+            if difference > MAX_PROBE_DIFFERENCE_M {
+                loaded.native = Err(Unsupported::Disagrees {
+                    difference_m: difference,
+                    tolerance_m: MAX_PROBE_DIFFERENCE_M,
+                });
+            }
         }
         loaded.set_engine(InferenceEngine::Native);
         Ok(loaded)
     }
 
-    /// Runs the probe batch ([`probe_batch`]) on tract and on the native forward pass and keeps
-    /// the native model only if no output differs by more than [`MAX_PROBE_DIFFERENCE_M`].
-    fn probe_agreement(&mut self) -> Result<Result<Arc<NativeModel>, Unsupported>, InferenceError> {
-        let Ok(native) = self.native.clone() else { return Ok(self.native.clone()) };
+    /// The largest difference between tract's and `native`'s outputs on the probe batch
+    /// ([`probe_batch`]), m; infinite where either answer is not finite.
+    fn probe_difference(&mut self, native: &NativeModel) -> Result<f32, InferenceError> {
         let (features, valid) = probe_batch();
         let rows = valid.len() / MAX_HISTORY;
         let (mut tract_out, mut native_out) = (vec![0.0f32; rows * 2], vec![0.0f32; rows * 2]);
@@ -426,17 +430,12 @@ impl PrModel {
             &mut native_out,
             self.has_uncertainty.then_some(&mut native_factor[..]),
         );
-        let difference = tract_out
+        Ok(tract_out
             .iter()
             .zip(&native_out)
             .chain(tract_factor.iter().zip(&native_factor))
             .map(|(a, b)| if a.is_finite() && b.is_finite() { (a - b).abs() } else { f32::INFINITY })
-            .fold(0.0f32, f32::max);
-        if difference <= MAX_PROBE_DIFFERENCE_M {
-            Ok(Ok(native))
-        } else {
-            Ok(Err(Unsupported::Disagrees { difference_m: difference, tolerance_m: MAX_PROBE_DIFFERENCE_M }))
-        }
+            .fold(0.0f32, f32::max))
     }
 
     /// Chooses the engine batches run on and returns the one in use: [`Native`] where the
