@@ -18,6 +18,7 @@ static ALLOCATOR: CountingAllocator = CountingAllocator;
 mod assignment;
 mod assignment_allocation;
 mod association;
+mod class_imm;
 mod cli_offline;
 mod cli_soak;
 mod crate_layout;

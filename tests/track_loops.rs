@@ -15,7 +15,7 @@ use common::{lanes, measurement, scene_frames};
 use glam::DVec2;
 use primm_core::config::Config;
 use primm_core::gaussian::UpdateError;
-use primm_core::imm::{Imm, ImmPrior};
+use primm_core::imm::ImmPrior;
 use primm_core::measurement::{Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::motion::ModeModels;
@@ -78,31 +78,41 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
     for method in [Method::Imm, Method::PrImm] {
         let (config, tracks) = running_tracks(method, 40);
         assert!(tracks.len() >= 20, "{method}: only {} tracks", tracks.len());
-        let imm = Imm::new(&config.imm);
+        let imms = track_loops::class_imms(&config);
         let models = models(&config);
         let dt_s = 0.05;
 
         let mut dispatched = vec![ImmPrior::default(); tracks.len()];
-        track_loops::predict_physics(&imm, &models, &tracks, dt_s, &mut dispatched);
+        track_loops::predict_physics(&imms, &models, &tracks, dt_s, &mut dispatched);
         let mut plain = vec![ImmPrior::default(); tracks.len()];
         for (track, prior) in tracks.iter().zip(plain.iter_mut()) {
-            imm.predict_physics_into(&models[track.class.index()], &track.estimate, dt_s, prior);
+            imms[track.class.index()].predict_physics_into(
+                &models[track.class.index()],
+                &track.estimate,
+                dt_s,
+                prior,
+            );
         }
         assert_eq!(bits(&dispatched), bits(&plain), "{method}: predict_physics");
         let mut baseline = vec![ImmPrior::default(); tracks.len()];
-        track_loops::baseline::predict_physics(&imm, &models, &tracks, dt_s, &mut baseline);
+        track_loops::baseline::predict_physics(&imms, &models, &tracks, dt_s, &mut baseline);
         assert_eq!(bits(&dispatched), bits(&baseline), "{method}: predict_physics, wide vs baseline");
 
         // Every third track without a learned displacement.
         let displacements: Vec<Option<Displacement>> = (0..tracks.len())
             .map(|i| (i % 3 != 0).then(|| DVec2::new(0.4 + 0.01 * i as f64, -0.05).into()))
             .collect();
-        track_loops::complete_priors(&imm, &models, &tracks, dt_s, &displacements, &mut dispatched);
+        track_loops::complete_priors(&imms, &models, &tracks, dt_s, &displacements, &mut dispatched);
         for ((track, prior), displacement) in tracks.iter().zip(plain.iter_mut()).zip(&displacements) {
-            imm.complete_prior_in_place(&models[track.class.index()], prior, dt_s, *displacement);
+            imms[track.class.index()].complete_prior_in_place(
+                &models[track.class.index()],
+                prior,
+                dt_s,
+                *displacement,
+            );
         }
         assert_eq!(bits(&dispatched), bits(&plain), "{method}: complete_priors");
-        track_loops::baseline::complete_priors(&imm, &models, &tracks, dt_s, &displacements, &mut baseline);
+        track_loops::baseline::complete_priors(&imms, &models, &tracks, dt_s, &displacements, &mut baseline);
         assert_eq!(bits(&dispatched), bits(&baseline), "{method}: complete_priors, wide vs baseline");
 
         // Every fourth track without a measurement; the others measured 0.3 m off their prior.
@@ -115,11 +125,18 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             .collect();
         let mut dispatched_tracks = tracks.clone();
         let mut outcomes = vec![Err(UpdateError); tracks.len()];
-        track_loops::update(&imm, &models, &mut dispatched_tracks, &dispatched, &measurements, &mut outcomes);
+        track_loops::update(
+            &imms,
+            &models,
+            &mut dispatched_tracks,
+            &dispatched,
+            &measurements,
+            &mut outcomes,
+        );
         let mut plain_tracks = tracks.clone();
         for (i, track) in plain_tracks.iter_mut().enumerate() {
             let expected = match measurements[i] {
-                Some(z) => imm.update_into(
+                Some(z) => imms[track.class.index()].update_into(
                     &models[track.class.index()],
                     &plain[i],
                     z.position(),
@@ -134,7 +151,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
         let mut baseline_tracks = tracks.clone();
         let mut baseline_outcomes = vec![Err(UpdateError); tracks.len()];
         track_loops::baseline::update(
-            &imm,
+            &imms,
             &models,
             &mut baseline_tracks,
             &baseline,

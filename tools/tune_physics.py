@@ -66,6 +66,19 @@ without ca or ct, or a changed physics_switch, changes the IMM too; score it alo
     python3 tools/tune_physics.py --data out/tune/default/validation out/tune/robust/validation \\
         --parameters imm --modes pr,cv,ca,ct pr,cv,ct pr,cv pr,ct --out out/tune/imm.toml
 
+``--parameters imm-class`` (scored with ``--method pr-imm``) tunes the PR mode's weight per
+class: for cars and for pedestrians, the knobs ``pr_leave``, ``into_pr`` and ``initial_pr`` of
+the ``imm`` set, written as that class's overrides ``[classes.<class>.imm]`` (``transition`` and
+``initial_mode_probabilities``; absent keys mean the ``[imm]`` values). The physics modes keep
+the ``[imm]`` matrix among themselves: each physics row gives ``into_pr`` to PR and the rest in
+the proportions of its ``[imm]`` row, and a new track's physics modes share ``1 - initial_pr`` in
+the proportions of ``[imm]``, so ``--method imm`` (which renormalises over cv, ca, ct) is left as
+it was, to the 1e-8 rounding (see ``class_imm_arrays``). The knobs start from the class's
+overrides where present, else from ``[imm]``:
+
+    python3 tools/tune_physics.py --data out/tune/default/validation out/tune/robust/validation \\
+        --parameters imm-class --rounds 1 --out out/tune/imm_class.toml
+
 Needs only the Python standard library (3.11+) and a release build of primm.
 """
 
@@ -117,10 +130,14 @@ PR_NOISE_PARAMETERS = [
     for key in ("process_noise_covariance_m2", "measurement_noise_covariance_m2")
 ]
 
+# Per-class knobs of the PR mode's weight, written into [classes.<class>.imm] (see class_imm_arrays).
+CLASS_IMM_KNOBS = ("pr_leave", "into_pr", "initial_pr")
+CLASS_IMM_PARAMETERS = [(f"classes.{cls}.imm", key) for cls in ("car", "pedestrian") for key in CLASS_IMM_KNOBS]
+
 PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS, "imm": IMM_PARAMETERS,
-                  "pr-noise": PR_NOISE_PARAMETERS}
+                  "pr-noise": PR_NOISE_PARAMETERS, "imm-class": CLASS_IMM_PARAMETERS}
 # Sets tuned with the wide factors and scored with pr-imm by default.
-WIDE_SETS = ("imm", "pr-noise")
+WIDE_SETS = ("imm", "pr-noise", "imm-class")
 
 # Mode order of the vectors and matrices of [imm].
 MODES = ("pr", "cv", "ca", "ct")
@@ -211,6 +228,131 @@ def imm_knobs(config: dict) -> tuple:
     return {key: float(f"{value:.6g}") for key, value in knobs.items()}, modes
 
 
+def class_imm_arrays(knobs: dict, modes: tuple, transition: list, initial: list) -> tuple:
+    """A class's transition matrix and initial mode probabilities (order pr, cv, ca, ct) from the
+    knobs pr_leave, into_pr and initial_pr, around the [imm] ``transition`` and ``initial`` over
+    the active ``modes``.
+
+    PR stays with 1 - pr_leave and moves to each active physics mode with pr_leave / n. A
+    physics mode moves to PR with into_pr and shares 1 - into_pr among the physics modes in the
+    proportions of its [imm] row, so the physics block renormalised over the physics modes (what
+    ``--method imm`` uses) is that of [imm]. New tracks start in PR with initial_pr; the physics
+    modes share 1 - initial_pr in the proportions of [imm]'s initial probabilities (evenly over
+    the active ones where those are all 0). Entries are rounded to 1e-8, the diagonal (the
+    largest physics entry for an inactive mode's row; the largest initial physics entry) absorbing
+    the rounding, so rows and the initial probabilities sum to 1."""
+    physics = [mode for mode in PHYSICS_MODES if mode in modes]
+    n = len(physics)
+    if "pr" not in modes or n == 0:
+        raise ValueError(f"mode set {modes}: needs pr and a physics mode")
+    pr_leave, into_pr, initial_pr = knobs["pr_leave"], knobs["into_pr"], knobs["initial_pr"]
+    if not (0.0 <= pr_leave <= 1.0 and 0.0 <= into_pr < 1.0 and 0.0 < initial_pr < 1.0):
+        raise ValueError(f"knobs out of range: {knobs}")
+    matrix = []
+    for i, source in enumerate(MODES):
+        row = {mode: 0.0 for mode in MODES}
+        if source == "pr":
+            for mode in physics:
+                row[mode] = round(pr_leave / n, 8)
+            row["pr"] = round(1.0 - sum(row[mode] for mode in physics), 8)
+        else:
+            weights = {mode: float(transition[i][MODES.index(mode)]) for mode in PHYSICS_MODES}
+            total = sum(weights.values())
+            if total <= 0.0:
+                raise ValueError(f"[imm] transition row {source} has no mass on the physics modes")
+            row["pr"] = round(into_pr, 8)
+            for mode in PHYSICS_MODES:
+                row[mode] = round((1.0 - into_pr) * weights[mode] / total, 8)
+            absorbing = source if source in modes else max(PHYSICS_MODES, key=lambda mode: row[mode])
+            row[absorbing] = round(1.0 - sum(v for m, v in row.items() if m != absorbing), 8)
+        matrix.append([row[mode] for mode in MODES])
+    shares = {mode: float(initial[MODES.index(mode)]) for mode in physics}
+    if sum(shares.values()) <= 0.0:
+        shares = {mode: 1.0 for mode in physics}
+    total = sum(shares.values())
+    start = {mode: 0.0 for mode in MODES}
+    for mode in physics:
+        start[mode] = round((1.0 - initial_pr) * shares[mode] / total, 8)
+    start["pr"] = round(initial_pr, 8)
+    largest = max(physics, key=lambda mode: start[mode])
+    start[largest] = round(1.0 - sum(v for m, v in start.items() if m != largest), 8)
+    return matrix, [start[mode] for mode in MODES]
+
+
+def class_imm_config(config: dict, cls: str) -> dict:
+    """The [imm] section of ``config`` with ``[classes.<cls>.imm]`` applied, as primm applies it."""
+    imm = dict(config["imm"])
+    overrides = config.get("classes", {}).get(cls, {}).get("imm", {})
+    for key in ("transition", "initial_mode_probabilities"):
+        if key in overrides:
+            imm[key] = overrides[key]
+    return imm
+
+
+def class_imm_knobs(config: dict) -> dict:
+    """{class: {pr_leave, into_pr, initial_pr}} describing each tuned class's IMM (its overrides
+    over [imm]), as imm_knobs reads them."""
+    knobs = {}
+    for cls in ("car", "pedestrian"):
+        read, _ = imm_knobs({"imm": class_imm_config(config, cls)})
+        knobs[cls] = {key: read[key] for key in CLASS_IMM_KNOBS}
+    return knobs
+
+
+def class_imm_text(text: str, cls: str, matrix: list, initial: list) -> str:
+    """``text`` (TOML) with ``[classes.<cls>.imm]`` holding ``transition`` and
+    ``initial_mode_probabilities``: substituted where the section and key exist, the key added
+    under an existing section header, else the section appended to the class's block (after its
+    last subsection), with a comment line."""
+    section = f"classes.{cls}.imm"
+    values = {"transition": format_matrix(matrix),
+              "initial_mode_probabilities": "[" + ", ".join(repr(value) for value in initial) + "]"}
+    lines = text.splitlines(keepends=True)
+    headers = [(index, re.match(r"\s*\[([^\[\]]+)\]\s*(#.*)?$", line)) for index, line in enumerate(lines)]
+    headers = [(index, match.group(1).strip()) for index, match in headers if match]
+    if any(name == section for _, name in headers):
+        for key, value in values.items():
+            try:
+                text = substitute_raw(text, section, key, value)
+            except KeyError:
+                lines = text.splitlines(keepends=True)
+                at = next(index for index, line in enumerate(lines)
+                          if re.match(rf"\s*\[{re.escape(section)}\]\s*(#.*)?$", line))
+                lines.insert(at + 1, f"{key} = {value}\n")
+                text = "".join(lines)
+        return text
+    block = [i for i, (index, name) in enumerate(headers) if name == f"classes.{cls}" or
+             name.startswith(f"classes.{cls}.")]
+    if not block:
+        raise KeyError(f"[classes.{cls}] not found")
+    following = block[-1] + 1
+    end = headers[following][0] if following < len(headers) else len(lines)
+    while end > 0 and lines[end - 1].strip() == "":
+        end -= 1
+    # Comment lines just above the next header belong to it.
+    while end > 0 and lines[end - 1].lstrip().startswith("#") and following < len(headers):
+        end -= 1
+    while end > 0 and lines[end - 1].strip() == "":
+        end -= 1
+    if end > 0 and not lines[end - 1].endswith("\n"):
+        lines[end - 1] += "\n"
+    added = [f"[{section}]\n",
+             f"# The PR mode's weight for {cls}s (tools/tune_physics.py --parameters imm-class); absent keys: [imm].\n",
+             f"transition = {values['transition']}\n",
+             f"initial_mode_probabilities = {values['initial_mode_probabilities']}\n"]
+    lines[end:end] = added
+    return "".join(lines)
+
+
+def class_imm_full_text(text: str, knobs: dict, modes: tuple, transition: list, initial: list) -> str:
+    """``text`` with ``[classes.<class>.imm]`` generated from ``knobs`` ({class: knobs}) for every
+    class in ``knobs``."""
+    for cls, class_knobs in knobs.items():
+        matrix, start = class_imm_arrays(class_knobs, modes, transition, initial)
+        text = class_imm_text(text, cls, matrix, start)
+    return text
+
+
 def format_matrix(matrix: list) -> str:
     rows = "".join(f"    [{', '.join(repr(value) for value in row)}],\n" for row in matrix)
     return f"[\n{rows}]"
@@ -268,6 +410,8 @@ def parse_args(argv=None):
         parser.error("--factors must be positive")
     if args.modes is not None and args.parameters != "imm":
         parser.error("--modes goes with --parameters imm")
+    if args.parameters == "imm-class" and args.method != "pr-imm":
+        parser.error("--parameters imm-class scores the IMM with the PR mode: --method pr-imm")
     if args.parameters == "pr-noise" and args.method not in ("pr-imm", "pr"):
         parser.error("--parameters pr-noise scores a method with the PR mode: --method pr-imm (or pr)")
     return args
@@ -396,6 +540,8 @@ def main(argv=None) -> int:
         return tune_imm(args, text)
     if args.parameters == "pr-noise":
         return tune_pr_noise(args, text)
+    if args.parameters == "imm-class":
+        return tune_class_imm(args, text)
     config = tomllib.loads(text)
     start = score(args, text)
     best = objective(args, start, start)
@@ -514,6 +660,47 @@ def tune_pr_noise(args, text: str) -> int:
         print(f"after round {round_index + 1}: {[(name(p), s) for p, s in scales.items()]}  objective {best:.4f}",
               flush=True)
     log.append({"parameter": "chosen", "value": None, "scales": described(scales), "objective": best})
+    return write_result(args, text, log, best)
+
+
+def tune_class_imm(args, text: str) -> int:
+    """Coordinate descent over the per-class knobs of CLASS_IMM_PARAMETERS (cars first)."""
+    original = text
+    config = tomllib.loads(text)
+    modes = tuple(mode for mode in MODES if mode in config["imm"]["modes"])
+    if "pr" not in modes:
+        sys.exit("tune_physics: --parameters imm-class needs pr among imm.modes")
+    transition, initial = config["imm"]["transition"], config["imm"]["initial_mode_probabilities"]
+    knobs = class_imm_knobs(config)
+    start_knobs = {cls: dict(class_knobs) for cls, class_knobs in knobs.items()}
+    start = score(args, text)  # the configuration as given, unchanged
+    best = objective(args, start, start)
+    log = [{"parameter": None, "value": None, "knobs": knobs, "result": start, "objective": best}]
+    print(f"start: {knobs}  objective {best:.4f}  {start}", flush=True)
+    for round_index in range(args.rounds):
+        print(f"round {round_index + 1}", flush=True)
+        for section, key in CLASS_IMM_PARAMETERS:
+            cls = section.split(".")[1]
+            base = knobs[cls][key]
+            for factor in args.factors:
+                value = scaled_knob(key, base, factor)
+                if value is None or value == base:
+                    continue
+                candidate_knobs = {c: dict(k) for c, k in knobs.items()}
+                candidate_knobs[cls][key] = value
+                # Only classes moved off their starting knobs are written (the others keep their text).
+                moved = {c: k for c, k in candidate_knobs.items() if k != start_knobs[c]}
+                candidate = class_imm_full_text(original, moved, modes, transition, initial)
+                result = score(args, candidate)
+                value_objective = objective(args, result, start)
+                log.append({"parameter": f"{section}.{key}", "value": value, "knobs": candidate_knobs,
+                            "result": result, "objective": value_objective})
+                print(f"  {section}.{key} = {value}: objective {value_objective:.4f}  {result}", flush=True)
+                if value_objective < best - 1e-6:
+                    best, knobs, text = value_objective, candidate_knobs, candidate
+                    print(f"  -> kept {section}.{key} = {value}  objective {best:.4f}", flush=True)
+        print(f"after round {round_index + 1}: {knobs}  objective {best:.4f}", flush=True)
+    log.append({"parameter": "chosen", "value": None, "knobs": knobs, "objective": best})
     return write_result(args, text, log, best)
 
 

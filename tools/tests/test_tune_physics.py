@@ -46,8 +46,8 @@ def test_every_parameter_of_both_sets_exists_in_the_shipped_configuration_and_ca
     config = tomllib.loads(text)
     for name, parameters in tune_physics.PARAMETER_SETS.items():
         assert parameters, name
-        if name in ("imm", "pr-noise"):
-            continue  # knobs that generate [imm] arrays, and matrix scales (tested below)
+        if name in ("imm", "pr-noise", "imm-class"):
+            continue  # knobs that generate [imm] arrays (also per class), and matrix scales (tested below)
         for section, key in parameters:
             value = tune_physics.get_value(config, section, key)
             changed = tomllib.loads(tune_physics.substitute(text, section, key, value * 2.0))
@@ -270,3 +270,106 @@ def test_an_idf1_loss_outweighs_a_small_rmse_gain(tmp_path, monkeypatch):
     tune_physics.main(["--data", "a/validation", "--parameters", "pr-noise", "--rounds", "1", "--factors", "2",
                        "--config", os.path.join(ROOT, "config", "primm.toml"), "--out", str(out)])
     assert tomllib.loads(out.read_text()) == tomllib.loads(shipped_text())
+
+
+# --- imm-class: the PR mode's weight per class, in [classes.<class>.imm] ---
+
+def shipped_imm():
+    config = tomllib.loads(shipped_text())
+    return config["imm"]["transition"], config["imm"]["initial_mode_probabilities"]
+
+
+def test_the_imm_class_set_is_three_knobs_of_cars_and_pedestrians_scored_with_pr_imm():
+    assert tune_physics.PARAMETER_SETS["imm-class"] == [
+        (f"classes.{cls}.imm", key) for cls in ("car", "pedestrian") for key in ("pr_leave", "into_pr", "initial_pr")]
+    args = tune_physics.parse_args(["--data", "d", "--out", "o", "--parameters", "imm-class"])
+    assert args.method == "pr-imm" and args.factors == [0.25, 0.5, 2.0, 4.0]
+    with pytest.raises(SystemExit):
+        tune_physics.parse_args(["--data", "d", "--out", "o", "--parameters", "imm-class", "--method", "imm"])
+
+
+@pytest.mark.parametrize("modes", [("pr", "cv", "ca", "ct"), ("pr", "cv", "ct"), ("pr", "cv")])
+def test_class_arrays_follow_the_knobs_and_keep_the_physics_block_of_imm(modes):
+    transition, initial = shipped_imm()
+    knobs = {"pr_leave": 0.12, "into_pr": 0.04, "initial_pr": 0.3}
+    matrix, start = tune_physics.class_imm_arrays(knobs, modes, transition, initial)
+    for row in matrix:
+        assert sum(row) == pytest.approx(1.0, abs=1e-12) and all(0.0 <= p <= 1.0 for p in row)
+    assert sum(start) == pytest.approx(1.0, abs=1e-12)
+    physics = [i for i, mode in enumerate(tune_physics.MODES) if mode in modes and mode != "pr"]
+    assert matrix[0][0] == pytest.approx(0.88)
+    for j in range(1, 4):
+        assert matrix[0][j] == pytest.approx(0.12 / len(physics) if j in physics else 0.0)
+    assert start[0] == pytest.approx(0.3)
+    for i in range(1, 4):
+        assert matrix[i][0] == pytest.approx(0.04)
+    # --method imm renormalises over the active physics modes: the same as [imm]'s, to rounding.
+    for i in physics:
+        ours = sum(matrix[i][j] for j in physics)
+        theirs = sum(transition[i][j] for j in physics)
+        for j in physics:
+            assert matrix[i][j] / ours == pytest.approx(transition[i][j] / theirs, abs=1e-7)
+    ours, theirs = sum(start[j] for j in physics), sum(initial[j] for j in physics)
+    for j in physics:
+        assert start[j] / ours == pytest.approx(initial[j] / theirs, abs=1e-7)
+
+
+def test_class_arrays_at_the_starting_knobs_are_imm_itself():
+    transition, initial = shipped_imm()
+    knobs = tune_physics.class_imm_knobs(tomllib.loads(shipped_text()))
+    assert knobs["car"] == knobs["pedestrian"] == {"pr_leave": 0.03, "into_pr": 0.01, "initial_pr": 0.07692}
+    matrix, start = tune_physics.class_imm_arrays(knobs["car"], tune_physics.MODES, transition, initial)
+    assert matrix == transition
+    assert start == pytest.approx(initial, abs=1e-7)
+
+
+def test_class_imm_text_adds_a_section_to_its_class_only_and_round_trips():
+    text = shipped_text()
+    transition, initial = shipped_imm()
+    knobs = {"car": {"pr_leave": 0.12, "into_pr": 0.0025, "initial_pr": 0.02}}
+    changed = tune_physics.class_imm_full_text(text, knobs, tune_physics.MODES, transition, initial)
+    before, after = tomllib.loads(text), tomllib.loads(changed)
+    car = after["classes"]["car"].pop("imm")
+    assert set(car) == {"transition", "initial_mode_probabilities"}
+    assert after == before  # nothing else changed: not [imm], not the pedestrians
+    assert "[classes.car.imm]" in changed and "[classes.pedestrian.imm]" not in changed
+    # The section sits in the car block, before the pedestrians', and comments are kept.
+    assert changed.index("[classes.car.imm]") < changed.index("[classes.pedestrian]")
+    assert changed.count("#") == text.count("#") + 1
+    read = tune_physics.class_imm_knobs(tomllib.loads(changed))
+    assert read["car"] == knobs["car"]
+    assert read["pedestrian"] == {"pr_leave": 0.03, "into_pr": 0.01, "initial_pr": 0.07692}
+    # Written again (another value): the section is substituted, not duplicated.
+    knobs["car"]["pr_leave"] = 0.06
+    again = tune_physics.class_imm_full_text(changed, knobs, tune_physics.MODES, transition, initial)
+    assert again.count("[classes.car.imm]") == 1
+    assert tune_physics.class_imm_knobs(tomllib.loads(again))["car"]["pr_leave"] == 0.06
+    # A section with only one key gets the other added under its header.
+    partial = text + "\n[classes.pedestrian.imm]\ninitial_mode_probabilities = [0.5, 0.5, 0.0, 0.0]\n"
+    filled = tune_physics.class_imm_full_text(
+        partial, {"pedestrian": {"pr_leave": 0.01, "into_pr": 0.01, "initial_pr": 0.2}},
+        tune_physics.MODES, transition, initial)
+    pedestrian = tomllib.loads(filled)["classes"]["pedestrian"]["imm"]
+    assert pedestrian["transition"][0][0] == pytest.approx(0.99)
+    assert pedestrian["initial_mode_probabilities"][0] == pytest.approx(0.2)
+
+
+def test_imm_class_descent_writes_only_the_classes_it_moved(tmp_path, monkeypatch):
+    """A synthetic objective, lowest at a car pr_leave of 0.12 with everything else as it was."""
+    calls = []
+
+    def fake_score(args, candidate):
+        knobs = tune_physics.class_imm_knobs(tomllib.loads(candidate))
+        error = abs(knobs["car"]["pr_leave"] - 0.12) + abs(knobs["pedestrian"]["initial_pr"] - 0.07692)
+        calls.append(error)
+        return {"rmse_xy": [1.0 + error], "idf1": [0.9]}
+
+    monkeypatch.setattr(tune_physics, "score", fake_score)
+    out = tmp_path / "imm_class.toml"
+    assert tune_physics.main(["--data", "a/validation", "--parameters", "imm-class", "--rounds", "1",
+                              "--config", os.path.join(ROOT, "config", "primm.toml"), "--out", str(out)]) == 0
+    chosen = tomllib.loads(out.read_text())
+    assert tune_physics.class_imm_knobs(chosen)["car"]["pr_leave"] == 0.12
+    assert "imm" in chosen["classes"]["car"] and "imm" not in chosen["classes"]["pedestrian"]
+    chosen["classes"]["car"].pop("imm")
+    assert chosen == tomllib.loads(shipped_text())

@@ -239,6 +239,45 @@ pub struct ClassConfig {
     pub coordinated_turn: CoordinatedTurnConfig,
     /// Learned-predictor (PR) mode.
     pub learned: LearnedConfig,
+    /// This class's IMM transition matrix and initial mode probabilities, where they differ from
+    /// the `imm` section's (absent: the `imm` section's).
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "ClassImmConfig::is_empty"))]
+    pub imm: ClassImmConfig,
+}
+
+/// Per-class overrides of the `imm` section (`classes.<class>.imm`): each key absent takes the
+/// `imm` section's value. Same shapes and checks as there; the active modes, temperature and
+/// floor are shared by all classes.
+#[derive(Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+pub struct ClassImmConfig {
+    /// Mode-transition probabilities `π[i][j]` of this class, order PR, CV, CA, CT; rows sum to 1.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub transition: Option<[[f64; MODE_COUNT]; MODE_COUNT]>,
+    /// Mode probabilities of a new track of this class (renormalised over the active modes).
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub initial_mode_probabilities: Option<[f64; MODE_COUNT]>,
+}
+
+impl ClassImmConfig {
+    /// No override at all.
+    pub fn is_empty(&self) -> bool {
+        self.transition.is_none() && self.initial_mode_probabilities.is_none()
+    }
+}
+
+impl ImmConfig {
+    /// These settings with a class's overrides applied.
+    pub fn with_overrides(&self, overrides: &ClassImmConfig) -> ImmConfig {
+        ImmConfig {
+            transition: overrides.transition.unwrap_or(self.transition),
+            initial_mode_probabilities: overrides
+                .initial_mode_probabilities
+                .unwrap_or(self.initial_mode_probabilities),
+            ..self.clone()
+        }
+    }
 }
 
 /// Constant-velocity noise.
@@ -361,6 +400,7 @@ impl Default for Config {
                         process_noise_covariance_m2: diagonal(0.011, 0.011),
                         measurement_noise_covariance_m2: diagonal(0.18, 0.18),
                     },
+                    imm: ClassImmConfig::default(),
                 },
                 pedestrian: ClassConfig {
                     gate_m: 4.2,
@@ -382,6 +422,7 @@ impl Default for Config {
                         process_noise_covariance_m2: diagonal(0.00015, 0.00015),
                         measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     },
+                    imm: ClassImmConfig::default(),
                 },
                 two_wheeler: ClassConfig {
                     gate_m: 4.0,
@@ -403,6 +444,7 @@ impl Default for Config {
                         process_noise_covariance_m2: diagonal(0.05, 0.05),
                         measurement_noise_covariance_m2: diagonal(0.16, 0.16),
                     },
+                    imm: ClassImmConfig::default(),
                 },
             },
             predictor: PredictorConfig::default(),
@@ -455,6 +497,11 @@ impl Config {
         self
     }
 
+    /// The IMM settings of `class`: the `imm` section with `classes.<class>.imm` applied.
+    pub fn imm_for(&self, class: ObjectClass) -> ImmConfig {
+        self.imm.with_overrides(&self.classes.get(class).imm)
+    }
+
     /// Checks every value; the error names the first offending key.
     pub fn validate(&self) -> Result<(), ConfigError> {
         validate_imm(&self.imm)?;
@@ -465,6 +512,7 @@ impl Config {
         }
         for class in ObjectClass::ALL {
             validate_class(class, self.classes.get(class))?;
+            validate_class_imm(class, &self.imm, &self.classes.get(class).imm)?;
         }
         Ok(())
     }
@@ -475,18 +523,12 @@ fn validate_imm(imm: &ImmConfig) -> Result<(), ConfigError> {
     if imm.modes.is_empty() {
         return Err(invalid("imm.modes", "at least one mode must be active"));
     }
-    validate_transition(imm)?;
-    for (i, &p) in imm.initial_mode_probabilities.iter().enumerate() {
-        if !(0.0..=1.0).contains(&p) {
-            return Err(invalid(
-                format!("imm.initial_mode_probabilities[{i}]"),
-                format!("must be a probability in [0, 1], got {}", readable(p)),
-            ));
-        }
-    }
-    if imm.modes.iter().map(|m| imm.initial_mode_probabilities[m.index()]).sum::<f64>() <= 0.0 {
-        return Err(invalid("imm.initial_mode_probabilities", "no probability mass on the active modes"));
-    }
+    validate_transition("imm.transition", imm.modes, &imm.transition)?;
+    validate_initial_probabilities(
+        "imm.initial_mode_probabilities",
+        imm.modes,
+        &imm.initial_mode_probabilities,
+    )?;
     positive("imm.likelihood_temperature", imm.likelihood_temperature)?;
     let floor = imm.mode_probability_floor;
     if !(floor >= 0.0 && floor < 1.0 / imm.modes.len() as f64) {
@@ -498,14 +540,55 @@ fn validate_imm(imm: &ImmConfig) -> Result<(), ConfigError> {
     Ok(())
 }
 
-/// `imm.transition`: probabilities, rows summing to 1, and mass on the active modes in the row
-/// of every active mode.
-fn validate_transition(imm: &ImmConfig) -> Result<(), ConfigError> {
-    for (i, row) in imm.transition.iter().enumerate() {
+/// The section `classes.<class>.imm`: each override present is checked as its `imm` key is,
+/// against the `imm` section's active modes.
+fn validate_class_imm(
+    class: ObjectClass,
+    imm: &ImmConfig,
+    overrides: &ClassImmConfig,
+) -> Result<(), ConfigError> {
+    let prefix = format!("classes.{}.imm", class.name());
+    if let Some(transition) = &overrides.transition {
+        validate_transition(&format!("{prefix}.transition"), imm.modes, transition)?;
+    }
+    if let Some(initial) = &overrides.initial_mode_probabilities {
+        validate_initial_probabilities(&format!("{prefix}.initial_mode_probabilities"), imm.modes, initial)?;
+    }
+    Ok(())
+}
+
+/// Initial mode probabilities (key `key`): probabilities with mass on the active modes.
+fn validate_initial_probabilities(
+    key: &str,
+    modes: ModeSet,
+    initial: &[f64; MODE_COUNT],
+) -> Result<(), ConfigError> {
+    for (i, &p) in initial.iter().enumerate() {
+        if !(0.0..=1.0).contains(&p) {
+            return Err(invalid(
+                format!("{key}[{i}]"),
+                format!("must be a probability in [0, 1], got {}", readable(p)),
+            ));
+        }
+    }
+    if modes.iter().map(|m| initial[m.index()]).sum::<f64>() <= 0.0 {
+        return Err(invalid(key, "no probability mass on the active modes"));
+    }
+    Ok(())
+}
+
+/// A transition matrix (key `key`, e.g. `imm.transition`): probabilities, rows summing to 1,
+/// and mass on the active modes in the row of every active mode.
+fn validate_transition(
+    key: &str,
+    modes: ModeSet,
+    transition: &[[f64; MODE_COUNT]; MODE_COUNT],
+) -> Result<(), ConfigError> {
+    for (i, row) in transition.iter().enumerate() {
         for (j, &p) in row.iter().enumerate() {
             if !(0.0..=1.0).contains(&p) {
                 return Err(invalid(
-                    format!("imm.transition[{i}][{j}]"),
+                    format!("{key}[{i}][{j}]"),
                     format!("must be a probability in [0, 1], got {}", readable(p)),
                 ));
             }
@@ -513,19 +596,16 @@ fn validate_transition(imm: &ImmConfig) -> Result<(), ConfigError> {
         let sum: f64 = row.iter().sum();
         if (sum - 1.0).abs() > 1e-9 {
             return Err(invalid(
-                format!("imm.transition[{i}]"),
+                format!("{key}[{i}]"),
                 format!("row must sum to 1, sums to {}", readable(sum)),
             ));
         }
     }
-    for mode in imm.modes.iter() {
+    for mode in modes.iter() {
         let i = mode.index();
-        let active_sum: f64 = imm.modes.iter().map(|to| imm.transition[i][to.index()]).sum();
+        let active_sum: f64 = modes.iter().map(|to| transition[i][to.index()]).sum();
         if active_sum <= 0.0 {
-            return Err(invalid(
-                format!("imm.transition[{i}]"),
-                "row has no probability mass on the active modes",
-            ));
+            return Err(invalid(format!("{key}[{i}]"), "row has no probability mass on the active modes"));
         }
     }
     Ok(())
@@ -634,6 +714,29 @@ mod tests {
         let mut config = Config::default();
         config.imm.transition[0] = [1.01, -0.01, 0.0, 0.0];
         assert_eq!(invalid_key(&config), "imm.transition[0][0]");
+    }
+
+    #[test]
+    fn a_bad_class_override_is_named_with_its_key() {
+        let mut config = Config::default();
+        let mut transition = config.imm.transition;
+        transition[0] = [0.9, 0.2, 0.0, 0.0];
+        config.classes.car.imm.transition = Some(transition);
+        assert_eq!(invalid_key(&config), "classes.car.imm.transition[0]");
+        let mut config = Config::default();
+        config.classes.pedestrian.imm.initial_mode_probabilities = Some([-0.1, 0.5, 0.3, 0.3]);
+        assert_eq!(invalid_key(&config), "classes.pedestrian.imm.initial_mode_probabilities[0]");
+    }
+
+    #[test]
+    fn class_overrides_apply_to_their_class_only() {
+        let mut config = Config::default();
+        config.classes.car.imm.initial_mode_probabilities = Some([0.01, 0.33, 0.33, 0.33]);
+        config.validate().unwrap();
+        assert_eq!(config.imm_for(ObjectClass::Car).initial_mode_probabilities, [0.01, 0.33, 0.33, 0.33]);
+        assert_eq!(config.imm_for(ObjectClass::Car).transition, config.imm.transition);
+        assert_eq!(config.imm_for(ObjectClass::Pedestrian), config.imm);
+        assert_eq!(Config::default().imm_for(ObjectClass::TwoWheeler), Config::default().imm);
     }
 
     #[test]

@@ -25,48 +25,58 @@ use multiversion::multiversion;
 /// Per-class mode models, indexed by [`ObjectClass::index`].
 pub type ClassModels = [ModeModels; ObjectClass::COUNT];
 
+/// Per-class IMMs (transition matrix and initial probabilities of `classes.<class>.imm`, else
+/// of `imm`), indexed by [`ObjectClass::index`].
+pub type ClassImms = [Imm; ObjectClass::COUNT];
+
+/// Each class's IMM prepared from validated configuration.
+pub fn class_imms(config: &crate::config::Config) -> ClassImms {
+    ObjectClass::ALL.map(|class| Imm::new(&config.imm_for(class)))
+}
+
 /// Mixing and the CV, CA and CT predictions of every track into `priors` (same order, at
 /// least as long as `tracks`).
 #[cfg_attr(feature = "std", multiversion(targets("x86_64+avx+avx2+fma")))]
 pub fn predict_physics(
-    imm: &Imm,
+    imms: &ClassImms,
     models: &ClassModels,
     tracks: &[Track],
     dt_s: f64,
     priors: &mut [ImmPrior],
 ) {
-    predict_physics_loop(imm, models, tracks, dt_s, priors);
+    predict_physics_loop(imms, models, tracks, dt_s, priors);
 }
 
 #[inline(always)]
 fn predict_physics_loop(
-    imm: &Imm,
+    imms: &ClassImms,
     models: &ClassModels,
     tracks: &[Track],
     dt_s: f64,
     priors: &mut [ImmPrior],
 ) {
     for (track, prior) in tracks.iter().zip(priors.iter_mut()) {
-        imm.predict_physics_into(&models[track.class.index()], &track.estimate, dt_s, prior);
+        let class = track.class.index();
+        imms[class].predict_physics_into(&models[class], &track.estimate, dt_s, prior);
     }
 }
 
 /// The PR prior from each track's learned displacement and the fused prior of every track.
 #[cfg_attr(feature = "std", multiversion(targets("x86_64+avx+avx2+fma")))]
 pub fn complete_priors(
-    imm: &Imm,
+    imms: &ClassImms,
     models: &ClassModels,
     tracks: &[Track],
     dt_s: f64,
     displacements: &[Option<Displacement>],
     priors: &mut [ImmPrior],
 ) {
-    complete_priors_loop(imm, models, tracks, dt_s, displacements, priors);
+    complete_priors_loop(imms, models, tracks, dt_s, displacements, priors);
 }
 
 #[inline(always)]
 fn complete_priors_loop(
-    imm: &Imm,
+    imms: &ClassImms,
     models: &ClassModels,
     tracks: &[Track],
     dt_s: f64,
@@ -74,7 +84,8 @@ fn complete_priors_loop(
     priors: &mut [ImmPrior],
 ) {
     for ((track, prior), displacement) in tracks.iter().zip(priors.iter_mut()).zip(displacements) {
-        imm.complete_prior_in_place(&models[track.class.index()], prior, dt_s, *displacement);
+        let class = track.class.index();
+        imms[class].complete_prior_in_place(&models[class], prior, dt_s, *displacement);
     }
 }
 
@@ -83,19 +94,19 @@ fn complete_priors_loop(
 /// which are left untouched). A failed update leaves the track at its prior.
 #[cfg_attr(feature = "std", multiversion(targets("x86_64+avx+avx2+fma")))]
 pub fn update(
-    imm: &Imm,
+    imms: &ClassImms,
     models: &ClassModels,
     tracks: &mut [Track],
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
     outcomes: &mut [Result<(), UpdateError>],
 ) {
-    update_loop(imm, models, tracks, priors, measurements, outcomes);
+    update_loop(imms, models, tracks, priors, measurements, outcomes);
 }
 
 #[inline(always)]
 fn update_loop(
-    imm: &Imm,
+    imms: &ClassImms,
     models: &ClassModels,
     tracks: &mut [Track],
     priors: &[ImmPrior],
@@ -107,7 +118,8 @@ fn update_loop(
     {
         *outcome = match measurement {
             Some(z) => {
-                imm.update_into(&models[track.class.index()], prior, z.position(), &mut track.estimate)
+                let class = track.class.index();
+                imms[class].update_into(&models[class], prior, z.position(), &mut track.estimate)
             }
             None => Ok(()),
         };
@@ -156,36 +168,36 @@ pub mod baseline {
 
     /// [`predict_physics`](super::predict_physics), baseline build.
     pub fn predict_physics(
-        imm: &Imm,
+        imms: &ClassImms,
         models: &ClassModels,
         tracks: &[Track],
         dt_s: f64,
         priors: &mut [ImmPrior],
     ) {
-        predict_physics_loop(imm, models, tracks, dt_s, priors);
+        predict_physics_loop(imms, models, tracks, dt_s, priors);
     }
 
     /// [`complete_priors`](super::complete_priors), baseline build.
     pub fn complete_priors(
-        imm: &Imm,
+        imms: &ClassImms,
         models: &ClassModels,
         tracks: &[Track],
         dt_s: f64,
         displacements: &[Option<Displacement>],
         priors: &mut [ImmPrior],
     ) {
-        complete_priors_loop(imm, models, tracks, dt_s, displacements, priors);
+        complete_priors_loop(imms, models, tracks, dt_s, displacements, priors);
     }
 
     /// [`update`](super::update), baseline build.
     pub fn update(
-        imm: &Imm,
+        imms: &ClassImms,
         models: &ClassModels,
         tracks: &mut [Track],
         priors: &[ImmPrior],
         measurements: &[Option<Measurement>],
         outcomes: &mut [Result<(), UpdateError>],
     ) {
-        update_loop(imm, models, tracks, priors, measurements, outcomes);
+        update_loop(imms, models, tracks, priors, measurements, outcomes);
     }
 }

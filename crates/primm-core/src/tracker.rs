@@ -13,7 +13,7 @@ use crate::association::associator::{AssociationStats, Associator};
 use crate::config::{Config, ConfigError, LearnedProcessNoise};
 use crate::displacement_check::{check_answer, DisplacementRejection};
 use crate::gaussian::UpdateError;
-use crate::imm::{Imm, ImmPrior};
+use crate::imm::ImmPrior;
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::mode::{Mode, ModeSet};
 use crate::motion::ModeModels;
@@ -21,7 +21,7 @@ use crate::pose::{EgoPose, RigidTransform};
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput, TrackStatus};
-use crate::track_loops;
+use crate::track_loops::{self, ClassImms};
 use crate::track_table::{TrackTable, MAX_TRACKS};
 use crate::tracking_frame::TrackingFrame;
 use crate::validated_frame::ValidatedFrame;
@@ -199,7 +199,8 @@ const EMPTY_ROW: RowRecord =
 #[derive(Debug)]
 pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     config: Config,
-    imm: Imm,
+    /// Each class's IMM (`classes.<class>.imm` over `imm`), indexed by [`ObjectClass::index`].
+    imms: ClassImms,
     models: [ModeModels; ObjectClass::COUNT],
     predictor: P,
     table: TrackTable,
@@ -246,7 +247,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     pub fn with_predictor(config: Config, predictor: P) -> Result<Self, ConfigError> {
         config.validate()?;
         Ok(Self {
-            imm: Imm::new(&config.imm),
+            imms: track_loops::class_imms(&config),
             models: ObjectClass::ALL.map(|class| ModeModels::from_config(config.classes.get(class))),
             config,
             predictor,
@@ -281,7 +282,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.outputs.clear();
         let outputs = &mut self.outputs;
         let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
-        report(&self.table, &self.rows[..], &self.imm, to_vehicle, |output| outputs.push(*output));
+        report(&self.table, &self.rows[..], &self.imms, to_vehicle, |output| outputs.push(*output));
         Ok(&self.outputs)
     }
 
@@ -307,7 +308,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     ) -> Result<StepSummary, StepError> {
         self.advance(frame, observer)?;
         let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
-        report(&self.table, &self.rows[..], &self.imm, to_vehicle, sink);
+        report(&self.table, &self.rows[..], &self.imms, to_vehicle, sink);
         observer.stage_finished(Stage::Report);
         Ok(self.last_step)
     }
@@ -448,7 +449,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// Hands every track's history (`eq:pr_input`) to the learned predictor.
     fn request_learned_predictions(&mut self, t: f64) {
         self.requests.clear();
-        if !self.imm.modes().contains(Mode::Learned) {
+        if !self.config.imm.modes.contains(Mode::Learned) {
             return;
         }
         for track in self.table.tracks() {
@@ -468,7 +469,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     fn predict_physics(&mut self, dt_s: f64) {
         self.dt_s = dt_s;
         track_loops::predict_physics(
-            &self.imm,
+            &self.imms,
             &self.models,
             self.table.tracks(),
             dt_s,
@@ -514,7 +515,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.last_step.predictions_missing = displacements.iter().filter(|d| d.is_none()).count();
         }
         track_loops::complete_priors(
-            &self.imm,
+            &self.imms,
             &self.models,
             self.table.tracks(),
             self.dt_s,
@@ -549,7 +550,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         track_loops::update(
-            &self.imm,
+            &self.imms,
             &self.models,
             self.table.tracks_mut(),
             &self.priors[..count],
@@ -584,7 +585,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
             let measurement_index = self.track_to_measurement[i];
             if measurement_index.is_none() {
-                track.estimate = self.imm.coast(&self.priors[i]);
+                track.estimate = self.imms[track.class.index()].coast(&self.priors[i]);
                 track.record_miss();
             }
             track.age_frames = track.age_frames.saturating_add(1);
@@ -605,7 +606,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
             let Some(measurement) = self.validated.accepted(index) else { continue };
             let sensor_position_m = self.sensor_position(&measurement);
-            let estimate = self.imm.initiate_seen_from(
+            let estimate = self.imms[measurement.class.index()].initiate_seen_from(
                 &self.models[measurement.class.index()],
                 &measurement,
                 sensor_position_m,
@@ -620,7 +621,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     }
                     self.rows[self.table.len() - 1] = RowRecord {
                         prior_position_m: None,
-                        available: self.imm.modes(),
+                        available: self.config.imm.modes,
                         measurement_index: Some(index as u16),
                     };
                     self.fates[index] = MeasurementFate::Assigned;
@@ -722,11 +723,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
 fn report(
     table: &TrackTable,
     rows: &[RowRecord],
-    imm: &Imm,
+    imms: &ClassImms,
     world_to_vehicle: Option<RigidTransform>,
     mut sink: impl FnMut(&TrackOutput),
 ) {
     for (track, row) in table.tracks().iter().zip(rows.iter()) {
+        let imm = &imms[track.class.index()];
         let fused = imm.fuse_posterior(&track.estimate, row.available);
         let velocity = imm.fuse_velocity(&track.estimate, row.available);
         let (position_m, position_covariance_m2, velocity_mps, prior_position_m) = match world_to_vehicle {

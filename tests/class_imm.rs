@@ -1,0 +1,156 @@
+//! Per-class IMM overrides (`classes.<class>.imm`): a class's transition matrix and initial mode
+//! probabilities reach that class's tracks only, a bad override is refused with its key, and a
+//! configuration without overrides (or with overrides equal to `imm`) tracks exactly as before.
+
+use crate::common::{scene_frames, SceneObject};
+use primm_core::config::{Config, ConfigError};
+use primm_core::imm::Imm;
+use primm_core::measurement::ObjectClass;
+use primm_core::track::TrackOutput;
+use primm_core::tracker::Tracker;
+
+/// Three cars and three pedestrians, each class in its own region 200 m from the other, so that
+/// no track of one class ever meets a measurement of the other.
+fn scene() -> Vec<SceneObject> {
+    (0..6)
+        .map(|i| {
+            let car = i < 3;
+            SceneObject {
+                id: i as u64 + 1,
+                class: if car { ObjectClass::Car } else { ObjectClass::Pedestrian },
+                start: [10.0 + 3.0 * i as f64, if car { -100.0 } else { 100.0 } + 20.0 * (i % 3) as f64],
+                velocity: if car { [9.0, 1.0] } else { [1.3, -0.2] },
+                visible: (0.0, f64::INFINITY),
+            }
+        })
+        .collect()
+}
+
+/// Every frame's outputs of a tracker with `config` on the scene.
+fn outputs(config: Config) -> Vec<Vec<TrackOutput>> {
+    let mut tracker = Tracker::new(config).unwrap();
+    scene_frames(&scene(), 60, 0.05, 0.2, 11)
+        .iter()
+        .map(|frame| tracker.step(frame).unwrap().to_vec())
+        .collect()
+}
+
+/// The outputs of one class, as text (equal exactly when every bit agrees).
+fn of_class(outputs: &[Vec<TrackOutput>], class: ObjectClass) -> String {
+    format!(
+        "{:?}",
+        outputs
+            .iter()
+            .map(|frame| frame.iter().filter(|o| o.class == class).collect::<Vec<_>>())
+            .collect::<Vec<_>>()
+    )
+}
+
+/// A transition matrix in which PR is left quickly and rarely entered.
+fn leaky_pr(config: &Config) -> [[f64; 4]; 4] {
+    let mut transition = config.imm.transition;
+    transition[0] = [0.7, 0.1, 0.1, 0.1];
+    for row in transition.iter_mut().skip(1) {
+        row[0] = 0.0;
+        row[1..].iter_mut().for_each(|p| *p /= 0.99);
+        let sum: f64 = row.iter().sum();
+        row[1] += 1.0 - sum;
+    }
+    transition
+}
+
+#[test]
+fn an_override_reaches_its_class_only() {
+    let default = outputs(Config::default());
+    let mut config = Config::default();
+    config.classes.car.imm.initial_mode_probabilities = Some([0.4, 0.2, 0.2, 0.2]);
+    config.classes.car.imm.transition = Some(leaky_pr(&config));
+    let overridden = outputs(config.clone());
+
+    // A new car track starts with the car's initial probabilities, a pedestrian with imm's.
+    let first = &overridden[0];
+    let car = first.iter().find(|o| o.class == ObjectClass::Car).unwrap();
+    let pedestrian = first.iter().find(|o| o.class == ObjectClass::Pedestrian).unwrap();
+    assert_eq!(car.mode_probabilities, [0.4, 0.2, 0.2, 0.2]);
+    let expected = Imm::new(&Config::default().imm).initiate(
+        &primm_core::motion::ModeModels::from_config(&config.classes.pedestrian),
+        &crate::common::measurement(1.0, 2.0, 0.0),
+    );
+    assert_eq!(pedestrian.mode_probabilities, expected.probabilities);
+
+    // Pedestrians track bit for bit as without the override; cars do not.
+    assert_eq!(of_class(&overridden, ObjectClass::Pedestrian), of_class(&default, ObjectClass::Pedestrian));
+    assert_ne!(of_class(&overridden, ObjectClass::Car), of_class(&default, ObjectClass::Car));
+    // PR (which never gets a displacement here and sits every step out) keeps far less weight.
+    let last_car = overridden.last().unwrap().iter().find(|o| o.class == ObjectClass::Car).unwrap();
+    let last_car_default = default.last().unwrap().iter().find(|o| o.class == ObjectClass::Car).unwrap();
+    assert!(
+        last_car.mode_probabilities[0] < 0.5 * last_car_default.mode_probabilities[0],
+        "PR {} vs {}",
+        last_car.mode_probabilities[0],
+        last_car_default.mode_probabilities[0]
+    );
+}
+
+#[test]
+fn overrides_equal_to_imm_or_absent_change_nothing() {
+    let default = outputs(Config::default());
+    let mut config = Config::default();
+    for class in ObjectClass::ALL {
+        let imm = config.imm.clone();
+        let section = match class {
+            ObjectClass::Car => &mut config.classes.car,
+            ObjectClass::Pedestrian => &mut config.classes.pedestrian,
+            ObjectClass::TwoWheeler => &mut config.classes.two_wheeler,
+        };
+        section.imm.transition = Some(imm.transition);
+        section.imm.initial_mode_probabilities = Some(imm.initial_mode_probabilities);
+    }
+    assert_eq!(format!("{:?}", outputs(config)), format!("{default:?}"));
+    // The shipped file has no overrides, and reads back as the defaults.
+    let shipped = primm_config::from_toml_str(primm_config::DEFAULT_CONFIG_TOML).unwrap();
+    assert!(ObjectClass::ALL.iter().all(|&class| shipped.classes.get(class).imm.is_empty()));
+    assert_eq!(shipped, Config::default());
+}
+
+fn invalid_key(result: Result<impl std::fmt::Debug, ConfigError>) -> String {
+    match result {
+        Err(ConfigError::Invalid { key, .. }) => key,
+        other => panic!("expected an invalid key, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_bad_override_is_refused_naming_its_key() {
+    let mut config = Config::default();
+    let mut transition = config.imm.transition;
+    transition[2] = [0.1, 0.1, 0.7, 0.2];
+    config.classes.car.imm.transition = Some(transition);
+    assert_eq!(invalid_key(Tracker::new(config)), "classes.car.imm.transition[2]");
+
+    let mut config = Config::default();
+    config.classes.pedestrian.imm.initial_mode_probabilities = Some([0.1, 1.5, 0.0, 0.0]);
+    assert_eq!(invalid_key(Tracker::new(config)), "classes.pedestrian.imm.initial_mode_probabilities[1]");
+
+    // No mass on the active modes: PR only, with the override putting none on it.
+    let mut config = Config::default().with_modes(primm_core::mode::Method::Learned.modes());
+    config.classes.two_wheeler.imm.initial_mode_probabilities = Some([0.0, 0.5, 0.5, 0.0]);
+    assert_eq!(invalid_key(Tracker::new(config)), "classes.two_wheeler.imm.initial_mode_probabilities");
+
+    // From TOML: an unknown key of the section is refused, a good section read.
+    let text = primm_config::DEFAULT_CONFIG_TOML;
+    let with = |section: &str| format!("{text}\n{section}\n");
+    assert!(primm_config::from_toml_str(&with("[classes.car.imm]\npr_leave = 0.1")).is_err());
+    let read = primm_config::from_toml_str(&with(
+        "[classes.car.imm]\ninitial_mode_probabilities = [0.4, 0.2, 0.2, 0.2]",
+    ))
+    .unwrap();
+    assert_eq!(read.classes.car.imm.initial_mode_probabilities, Some([0.4, 0.2, 0.2, 0.2]));
+    assert_eq!(read.classes.car.imm.transition, None);
+    match primm_config::from_toml_str(&with("[classes.car.imm]\ntransition = [[0.5, 0.5, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.3, 0.0, 0.0, 0.6]]")) {
+        Err(primm_config::ConfigError::Invalid(ConfigError::Invalid { key, .. })) => {
+            assert_eq!(key, "classes.car.imm.transition[3]")
+        }
+        other => panic!("expected an invalid key, got {other:?}"),
+    }
+}
