@@ -1,9 +1,10 @@
 //! Per-class IMM overrides (`classes.<class>.imm`): a class's transition matrix and initial mode
-//! probabilities reach that class's tracks only, a bad override is refused with its key, and a
-//! configuration without overrides (or with overrides equal to `imm`) tracks exactly as before.
+//! probabilities reach that class's tracks only, a bad override is refused with its key, a
+//! configuration without overrides (or with overrides equal to `imm`) tracks exactly as before, and
+//! the shipped overrides leave the physics modes' switching (the `imm` method) as `imm` has it.
 
 use crate::common::{scene_frames, SceneObject};
-use primm_core::config::{Config, ConfigError};
+use primm_core::config::{Config, ConfigError, ImmConfig};
 use primm_core::imm::Imm;
 use primm_core::measurement::ObjectClass;
 use primm_core::track::TrackOutput;
@@ -24,6 +25,19 @@ fn scene() -> Vec<SceneObject> {
             }
         })
         .collect()
+}
+
+/// The shipped configuration without its per-class overrides.
+fn without_overrides() -> Config {
+    let mut config = Config::default();
+    for class in ObjectClass::ALL {
+        *class_imm(&mut config, class) = Default::default();
+    }
+    config
+}
+
+fn class_imm(config: &mut Config, class: ObjectClass) -> &mut primm_core::config::ClassImmConfig {
+    &mut config.classes.get_mut(class).imm
 }
 
 /// Every frame's outputs of a tracker with `config` on the scene.
@@ -61,8 +75,8 @@ fn leaky_pr(config: &Config) -> [[f64; 4]; 4] {
 
 #[test]
 fn an_override_reaches_its_class_only() {
-    let default = outputs(Config::default());
-    let mut config = Config::default();
+    let default = outputs(without_overrides());
+    let mut config = without_overrides();
     config.classes.car.imm.initial_mode_probabilities = Some([0.4, 0.2, 0.2, 0.2]);
     config.classes.car.imm.transition = Some(leaky_pr(&config));
     let overridden = outputs(config.clone());
@@ -72,7 +86,7 @@ fn an_override_reaches_its_class_only() {
     let car = first.iter().find(|o| o.class == ObjectClass::Car).unwrap();
     let pedestrian = first.iter().find(|o| o.class == ObjectClass::Pedestrian).unwrap();
     assert_eq!(car.mode_probabilities, [0.4, 0.2, 0.2, 0.2]);
-    let expected = Imm::new(&Config::default().imm).initiate(
+    let expected = Imm::new(&without_overrides().imm).initiate(
         &primm_core::motion::ModeModels::from_config(&config.classes.pedestrian),
         &crate::common::measurement(1.0, 2.0, 0.0),
     );
@@ -94,23 +108,53 @@ fn an_override_reaches_its_class_only() {
 
 #[test]
 fn overrides_equal_to_imm_or_absent_change_nothing() {
-    let default = outputs(Config::default());
-    let mut config = Config::default();
+    let default = outputs(without_overrides());
+    let mut config = without_overrides();
     for class in ObjectClass::ALL {
         let imm = config.imm.clone();
-        let section = match class {
-            ObjectClass::Car => &mut config.classes.car,
-            ObjectClass::Pedestrian => &mut config.classes.pedestrian,
-            ObjectClass::TwoWheeler => &mut config.classes.two_wheeler,
-        };
-        section.imm.transition = Some(imm.transition);
-        section.imm.initial_mode_probabilities = Some(imm.initial_mode_probabilities);
+        let section = class_imm(&mut config, class);
+        section.transition = Some(imm.transition);
+        section.initial_mode_probabilities = Some(imm.initial_mode_probabilities);
     }
     assert_eq!(format!("{:?}", outputs(config)), format!("{default:?}"));
-    // The shipped file has no overrides, and reads back as the defaults.
+    // The shipped file reads back as the defaults, overrides included.
     let shipped = primm_config::from_toml_str(primm_config::DEFAULT_CONFIG_TOML).unwrap();
-    assert!(ObjectClass::ALL.iter().all(|&class| shipped.classes.get(class).imm.is_empty()));
     assert_eq!(shipped, Config::default());
+}
+
+#[test]
+fn the_shipped_overrides_change_pr_only_and_leave_the_imm_method_as_it_was() {
+    let shipped = Config::default();
+    let mut changed = 0;
+    for class in ObjectClass::ALL {
+        let overridden = shipped.imm_for(class);
+        changed += usize::from(overridden != shipped.imm);
+        // Without PR (the `imm` method) the renormalised switching of the physics modes and
+        // their initial probabilities are those of `imm`.
+        let imm_method = primm_core::mode::Method::Imm.modes();
+        let with_class = Imm::new(&ImmConfig { modes: imm_method, ..overridden.clone() });
+        let without = Imm::new(&ImmConfig { modes: imm_method, ..shipped.imm.clone() });
+        for (row, row_without) in with_class.transition().iter().zip(without.transition()) {
+            for (p, q) in row.iter().zip(row_without) {
+                assert!((p - q).abs() < 1e-6, "{class:?}: {p} vs {q}");
+            }
+        }
+        let models = primm_core::motion::ModeModels::from_config(shipped.classes.get(class));
+        let z = crate::common::measurement(1.0, 2.0, 0.0);
+        let (a, b) =
+            (with_class.initiate(&models, &z).probabilities, without.initiate(&models, &z).probabilities);
+        for (p, q) in a.iter().zip(b.iter()) {
+            assert!((p - q).abs() < 1e-6, "{class:?}: {a:?} vs {b:?}");
+        }
+        // With PR, the class's own settings are used.
+        let full = Imm::new(&overridden);
+        for (row, row_class) in full.transition().iter().zip(&overridden.transition) {
+            for (p, q) in row.iter().zip(row_class) {
+                assert!((p - q).abs() < 1e-9, "{class:?}: {p} vs {q}");
+            }
+        }
+    }
+    assert_eq!(changed, 2, "cars and pedestrians carry overrides, two-wheelers none");
 }
 
 fn invalid_key(result: Result<impl std::fmt::Debug, ConfigError>) -> String {
@@ -140,16 +184,17 @@ fn a_bad_override_is_refused_naming_its_key() {
     // From TOML: an unknown key of the section is refused, a good section read.
     let text = primm_config::DEFAULT_CONFIG_TOML;
     let with = |section: &str| format!("{text}\n{section}\n");
-    assert!(primm_config::from_toml_str(&with("[classes.car.imm]\npr_leave = 0.1")).is_err());
+    // (two-wheelers: the shipped file has no section of theirs to collide with)
+    assert!(primm_config::from_toml_str(&with("[classes.two_wheeler.imm]\npr_leave = 0.1")).is_err());
     let read = primm_config::from_toml_str(&with(
-        "[classes.car.imm]\ninitial_mode_probabilities = [0.4, 0.2, 0.2, 0.2]",
+        "[classes.two_wheeler.imm]\ninitial_mode_probabilities = [0.4, 0.2, 0.2, 0.2]",
     ))
     .unwrap();
-    assert_eq!(read.classes.car.imm.initial_mode_probabilities, Some([0.4, 0.2, 0.2, 0.2]));
-    assert_eq!(read.classes.car.imm.transition, None);
-    match primm_config::from_toml_str(&with("[classes.car.imm]\ntransition = [[0.5, 0.5, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.3, 0.0, 0.0, 0.6]]")) {
+    assert_eq!(read.classes.two_wheeler.imm.initial_mode_probabilities, Some([0.4, 0.2, 0.2, 0.2]));
+    assert_eq!(read.classes.two_wheeler.imm.transition, None);
+    match primm_config::from_toml_str(&with("[classes.two_wheeler.imm]\ntransition = [[0.5, 0.5, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.3, 0.0, 0.0, 0.6]]")) {
         Err(primm_config::ConfigError::Invalid(ConfigError::Invalid { key, .. })) => {
-            assert_eq!(key, "classes.car.imm.transition[3]")
+            assert_eq!(key, "classes.two_wheeler.imm.transition[3]")
         }
         other => panic!("expected an invalid key, got {other:?}"),
     }

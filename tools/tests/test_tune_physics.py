@@ -2,6 +2,7 @@
 evaluation data."""
 
 import os
+import re
 import sys
 import tomllib
 
@@ -57,6 +58,37 @@ def test_every_parameter_of_both_sets_exists_in_the_shipped_configuration_and_ca
 def shipped_text():
     with open(os.path.join(ROOT, "config", "primm.toml")) as handle:
         return handle.read()
+
+
+def without_class_imm(text):
+    """``text`` without its [classes.<class>.imm] sections: one IMM for all classes."""
+    kept, skipping = [], False
+    for line in text.splitlines(keepends=True):
+        header = re.match(r"\[\[?([A-Za-z_.]+)\]\]?\s*(#.*)?$", line)
+        if header:
+            skipping = re.fullmatch(r"classes\.[a-z_]+\.imm", header.group(1)) is not None
+        if not skipping:
+            kept.append(line)
+    return "".join(kept)
+
+
+def test_the_shipped_class_sections_read_back_as_the_knobs_that_made_them():
+    text = shipped_text()
+    config = tomllib.loads(text)
+    knobs = tune_physics.class_imm_knobs(config)
+    assert knobs["car"] == {"pr_leave": 0.48, "into_pr": 0.000625, "initial_pr": 0.005182}
+    assert knobs["pedestrian"] == {"pr_leave": 0.015, "into_pr": 0.01, "initial_pr": 0.04}
+    base = tomllib.loads(without_class_imm(text))
+    assert "imm" not in base["classes"]["car"] and "imm" not in base["classes"]["pedestrian"]
+    # Regenerated from those knobs around [imm], the sections are the shipped ones.
+    imm = base["imm"]
+    for cls in ("car", "pedestrian"):
+        matrix, start = tune_physics.class_imm_arrays(knobs[cls], tune_physics.MODES, imm["transition"],
+                                                      imm["initial_mode_probabilities"])
+        shipped = config["classes"][cls]["imm"]
+        for row, shipped_row in zip(matrix, shipped["transition"], strict=True):
+            assert row == pytest.approx(shipped_row, abs=1e-6)
+        assert start == pytest.approx(shipped["initial_mode_probabilities"], abs=1e-6)
 
 
 KNOBS = {"pr_leave": 0.06, "into_pr": 0.004, "physics_switch": 0.03, "initial_pr": 0.6,
@@ -316,7 +348,7 @@ def test_class_arrays_follow_the_knobs_and_keep_the_physics_block_of_imm(modes):
 
 def test_class_arrays_at_the_starting_knobs_are_imm_itself():
     transition, initial = shipped_imm()
-    knobs = tune_physics.class_imm_knobs(tomllib.loads(shipped_text()))
+    knobs = tune_physics.class_imm_knobs(tomllib.loads(without_class_imm(shipped_text())))
     assert knobs["car"] == knobs["pedestrian"] == {"pr_leave": 0.03, "into_pr": 0.01, "initial_pr": 0.07692}
     matrix, start = tune_physics.class_imm_arrays(knobs["car"], tune_physics.MODES, transition, initial)
     assert matrix == transition
@@ -324,7 +356,7 @@ def test_class_arrays_at_the_starting_knobs_are_imm_itself():
 
 
 def test_class_imm_text_adds_a_section_to_its_class_only_and_round_trips():
-    text = shipped_text()
+    text = without_class_imm(shipped_text())
     transition, initial = shipped_imm()
     knobs = {"car": {"pr_leave": 0.12, "into_pr": 0.0025, "initial_pr": 0.02}}
     changed = tune_physics.class_imm_full_text(text, knobs, tune_physics.MODES, transition, initial)
@@ -365,11 +397,13 @@ def test_imm_class_descent_writes_only_the_classes_it_moved(tmp_path, monkeypatc
         return {"rmse_xy": [1.0 + error], "idf1": [0.9]}
 
     monkeypatch.setattr(tune_physics, "score", fake_score)
+    base = tmp_path / "one_imm.toml"
+    base.write_text(without_class_imm(shipped_text()))
     out = tmp_path / "imm_class.toml"
     assert tune_physics.main(["--data", "a/validation", "--parameters", "imm-class", "--rounds", "1",
-                              "--config", os.path.join(ROOT, "config", "primm.toml"), "--out", str(out)]) == 0
+                              "--config", str(base), "--out", str(out)]) == 0
     chosen = tomllib.loads(out.read_text())
     assert tune_physics.class_imm_knobs(chosen)["car"]["pr_leave"] == 0.12
     assert "imm" in chosen["classes"]["car"] and "imm" not in chosen["classes"]["pedestrian"]
     chosen["classes"]["car"].pop("imm")
-    assert chosen == tomllib.loads(shipped_text())
+    assert chosen == tomllib.loads(base.read_text())

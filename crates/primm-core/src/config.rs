@@ -216,6 +216,15 @@ impl ClassTable {
             ObjectClass::TwoWheeler => &self.two_wheeler,
         }
     }
+
+    /// The section of `class`, to change.
+    pub fn get_mut(&mut self, class: ObjectClass) -> &mut ClassConfig {
+        match class {
+            ObjectClass::Car => &mut self.car,
+            ObjectClass::Pedestrian => &mut self.pedestrian,
+            ObjectClass::TwoWheeler => &mut self.two_wheeler,
+        }
+    }
 }
 
 /// Parameters of one object class.
@@ -400,7 +409,16 @@ impl Default for Config {
                         process_noise_covariance_m2: diagonal(0.011, 0.011),
                         measurement_noise_covariance_m2: diagonal(0.18, 0.18),
                     },
-                    imm: ClassImmConfig::default(),
+                    // PR all but off for cars, chosen on validation (`config/primm.toml`).
+                    imm: ClassImmConfig {
+                        transition: Some([
+                            [0.52, 0.16, 0.16, 0.16],
+                            [0.000625, 0.9791856, 0.0100947, 0.0100947],
+                            [0.000625, 0.0100947, 0.9791856, 0.0100947],
+                            [0.000625, 0.0100947, 0.0100947, 0.9791856],
+                        ]),
+                        initial_mode_probabilities: Some([0.005182, 0.331606, 0.331606, 0.331606]),
+                    },
                 },
                 pedestrian: ClassConfig {
                     gate_m: 4.2,
@@ -422,7 +440,16 @@ impl Default for Config {
                         process_noise_covariance_m2: diagonal(0.00015, 0.00015),
                         measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     },
-                    imm: ClassImmConfig::default(),
+                    // Chosen on validation with the car's (`config/primm.toml`).
+                    imm: ClassImmConfig {
+                        transition: Some([
+                            [0.985, 0.005, 0.005, 0.005],
+                            [off, stay, off, off],
+                            [off, off, stay, off],
+                            [off, off, off, stay],
+                        ]),
+                        initial_mode_probabilities: Some([0.04, 0.32, 0.32, 0.32]),
+                    },
                 },
                 two_wheeler: ClassConfig {
                     gate_m: 4.0,
@@ -731,12 +758,24 @@ mod tests {
     #[test]
     fn class_overrides_apply_to_their_class_only() {
         let mut config = Config::default();
+        for class in ObjectClass::ALL {
+            config.classes.get_mut(class).imm = ClassImmConfig::default();
+        }
         config.classes.car.imm.initial_mode_probabilities = Some([0.01, 0.33, 0.33, 0.33]);
         config.validate().unwrap();
         assert_eq!(config.imm_for(ObjectClass::Car).initial_mode_probabilities, [0.01, 0.33, 0.33, 0.33]);
         assert_eq!(config.imm_for(ObjectClass::Car).transition, config.imm.transition);
         assert_eq!(config.imm_for(ObjectClass::Pedestrian), config.imm);
         assert_eq!(Config::default().imm_for(ObjectClass::TwoWheeler), Config::default().imm);
+        // The shipped overrides: cars' and pedestrians' own, whole.
+        let shipped = Config::default();
+        for class in [ObjectClass::Car, ObjectClass::Pedestrian] {
+            let own = &shipped.classes.get(class).imm;
+            let imm = shipped.imm_for(class);
+            assert_eq!(Some(imm.transition), own.transition);
+            assert_eq!(Some(imm.initial_mode_probabilities), own.initial_mode_probabilities);
+            assert_eq!(imm.likelihood_temperature, shipped.imm.likelihood_temperature);
+        }
     }
 
     #[test]

@@ -59,6 +59,9 @@ pub struct MethodResult {
     /// Prior RMSE per object class.
     #[serde(default)]
     pub class_rmse: BTreeMap<ObjectClass, RmseAccumulator>,
+    /// Posterior mode probabilities of the updates per object class (classes with updates only).
+    #[serde(default)]
+    pub class_modes: BTreeMap<ObjectClass, ModeProbabilityAccumulator>,
     /// Prior RMSE per ego motion (sequences with ego poses only).
     #[serde(default)]
     pub ego_rmse: BTreeMap<EgoMotion, RmseAccumulator>,
@@ -82,6 +85,7 @@ impl MethodResult {
             missed_detection: BTreeMap::new(),
             modes: ModeProbabilityAccumulator::new(),
             class_rmse: BTreeMap::new(),
+            class_modes: BTreeMap::new(),
             ego_rmse: BTreeMap::new(),
             ego_identity: BTreeMap::new(),
         }
@@ -110,6 +114,9 @@ impl MethodResult {
         self.modes.merge(&other.modes);
         for (class, acc) in &other.class_rmse {
             self.class_rmse.entry(*class).or_default().merge(acc);
+        }
+        for (class, acc) in &other.class_modes {
+            self.class_modes.entry(*class).or_default().merge(acc);
         }
         for (motion, acc) in &other.ego_rmse {
             self.ego_rmse.entry(*motion).or_default().merge(acc);
@@ -167,7 +174,9 @@ impl MethodEvaluator {
         for (record, label) in records.iter().zip(&labels) {
             result.rmse.push_record(record);
             result.class_rmse.entry(record.class).or_default().push_record(record);
-            result.modes.push_record(record);
+            if result.modes.push_record(record) {
+                result.class_modes.entry(record.class).or_default().push_record(record);
+            }
             if let Some(label) = label {
                 let category = label.category();
                 result.scenario_rmse.entry(category).or_default().push_record(record);
@@ -449,7 +458,36 @@ impl EvaluationReport {
             };
             let _ = writeln!(text, "n/a PR-IMM: {reason}");
         }
+        let by_class = self.mode_probability_by_class_table();
+        if !by_class.is_empty() {
+            text.push('\n');
+            text.push_str(&by_class);
+        }
         text
+    }
+
+    /// PR-IMM's mean posterior mode probabilities per object class (rows) and mode (columns);
+    /// empty without updates. The classes' mixes differ between data sets, and the shipped
+    /// configuration weighs PR per class, so this is the table to compare PR's weight across
+    /// data sets with.
+    pub fn mode_probability_by_class_table(&self) -> String {
+        let Some(result) = self.result(Method::PrImm) else { return String::new() };
+        let rows: Vec<Vec<String>> = result
+            .class_modes
+            .iter()
+            .filter_map(|(class, acc)| {
+                let mean = acc.mean()?;
+                let mut row = vec![format!("{} ({})", class.name(), group_thousands(acc.count()))];
+                row.extend(mean.iter().map(|p| format!("{p:.3}")));
+                Some(row)
+            })
+            .collect();
+        if rows.is_empty() {
+            return String::new();
+        }
+        let mut header = vec!["Class (updates)".to_string()];
+        header.extend(MODE_NAMES.iter().map(|name| name.to_string()));
+        render_table("Mean mode probability of PR-IMM by class", &header, &rows)
     }
 
     /// Tables II and IV split by ego motion: RMSE_xy, IDSW and IDF1 per ego state (rows) and
@@ -516,7 +554,8 @@ impl EvaluationReport {
     /// (`close_proximity`, `crossing_motion`, `miss_<percent>`: `idsw`, `idf1`, IDTP/IDFP/IDFN and
     /// frame counts). Unavailable methods have `"available": false`, a `reason`, `null` metrics and
     /// empty `scenarios`. `mode_probabilities` holds PR-IMM's mean probabilities per mode and the
-    /// number of updates (`null` values without updates).
+    /// number of updates (`null` values without updates), and `by_class` the same per object
+    /// class that has updates (`{"car": {"samples", "pr", "cv", "ca", "ct"}, …}`).
     pub fn to_json(&self) -> Value {
         let mut methods = Map::new();
         for method in Method::ALL {
@@ -541,6 +580,18 @@ impl EvaluationReport {
         for (index, name) in MODE_NAMES.iter().enumerate() {
             mode_probabilities.insert(name.to_ascii_lowercase(), json!(mean.map(|m| m[index])));
         }
+        let mut by_class = Map::new();
+        if let Some(result) = self.result(Method::PrImm) {
+            for (class, acc) in &result.class_modes {
+                let mut entry = Map::new();
+                entry.insert("samples".into(), json!(acc.count()));
+                for (index, name) in MODE_NAMES.iter().enumerate() {
+                    entry.insert(name.to_ascii_lowercase(), json!(acc.mean().map(|m| m[index])));
+                }
+                by_class.insert(class.name().to_string(), Value::Object(entry));
+            }
+        }
+        mode_probabilities.insert("by_class".into(), Value::Object(by_class));
         json!({ "methods": methods, "mode_probabilities": mode_probabilities })
     }
 
@@ -861,6 +912,34 @@ mod tests {
     }
 
     #[test]
+    fn mode_probabilities_are_averaged_per_class_as_well() {
+        let mut records = sequence(0.5);
+        // Object 2's rows become pedestrians: (0.1, 0.2, 0.3, 0.4) there, (0.4, 0.3, 0.2, 0.1)
+        // for the cars; a row without a track is counted nowhere.
+        for record in records.iter_mut().filter(|r| r.ground_truth_id == Some(2)) {
+            record.class = ObjectClass::Pedestrian;
+        }
+        records[0].track_id = None;
+        let mut evaluator = MethodEvaluator::new(Method::PrImm);
+        evaluator.add_sequence(&records);
+        let result = evaluator.finish();
+        let car = result.class_modes[&ObjectClass::Car];
+        let pedestrian = result.class_modes[&ObjectClass::Pedestrian];
+        assert_eq!((car.count(), pedestrian.count()), (11, 12));
+        assert_eq!(car.count() + pedestrian.count(), result.modes.count());
+        let close = |got: [f64; 4], want: [f64; 4]| got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-12);
+        assert!(close(car.mean().unwrap(), [0.4, 0.3, 0.2, 0.1]), "{car:?}");
+        assert!(close(pedestrian.mean().unwrap(), [0.1, 0.2, 0.3, 0.4]), "{pedestrian:?}");
+        assert!(!result.class_modes.contains_key(&ObjectClass::TwoWheeler));
+        // Single-model methods have none.
+        let mut evaluator = MethodEvaluator::new(Method::ConstantVelocity);
+        let mut plain = records.clone();
+        plain.iter_mut().for_each(|r| r.mode_probabilities = None);
+        evaluator.add_sequence(&plain);
+        assert!(evaluator.finish().class_modes.is_empty());
+    }
+
+    #[test]
     fn merged_results_equal_joint_evaluation() {
         let mut joint = MethodEvaluator::new(Method::ConstantVelocity);
         joint.add_sequence(&sequence(1.0));
@@ -877,6 +956,7 @@ mod tests {
         assert_eq!(merged.rmse.count(), joint.rmse.count());
         assert!((merged.rmse.rmse_xy().unwrap() - joint.rmse.rmse_xy().unwrap()).abs() < 1e-12);
         assert_eq!(merged.modes, joint.modes);
+        assert_eq!(merged.class_modes, joint.class_modes);
         assert_eq!(merged.sequences, 2);
         assert_eq!(merged.identity.idsw, 2);
         // RMSE over both: sqrt((21·1 + 21·4) / 42) = sqrt(2.5).
