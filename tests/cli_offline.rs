@@ -92,6 +92,77 @@ fn eval_prints_the_tables_and_writes_json_and_figures() {
 }
 
 #[test]
+fn eval_with_the_displacement_oracle_gives_pr_the_true_motion_and_refuses_what_it_cannot_do() {
+    let dir = tempdir("oracle");
+    generate(&dir);
+    let data = dir.join("evaluation");
+    let pr_rmse = |extra: &[&str]| {
+        let json = dir.join("oracle.json");
+        let mut args = vec![
+            "eval",
+            "--data",
+            data.to_str().unwrap(),
+            "--methods",
+            "pr",
+            "--json",
+            json.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let output = primm(&args);
+        let value: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (value, output)
+    };
+    let (exact, output) = pr_rmse(&["--displacement-oracle"]);
+    assert!(String::from_utf8_lossy(&output.stdout).contains("replaced by the true displacement"));
+    assert_eq!(exact["displacement_oracle"], serde_json::json!(true));
+    // Every request whose track's latest measurement belongs to an object is answered.
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let counts = stderr
+        .lines()
+        .find_map(|line| line.strip_prefix("pr: displacement oracle: "))
+        .expect("oracle counts");
+    let numbers: Vec<u64> = counts.split(' ').filter_map(|word| word.parse().ok()).collect();
+    assert!(numbers[0] > 0 && numbers[0] * 10 >= numbers[1] * 9, "{counts}");
+    // A perfect displacement beats a 1 m noisy one and the model, which it replaced.
+    let (noisy, _) = pr_rmse(&["--displacement-oracle", "--displacement-oracle-noise-m", "1.0"]);
+    let (model, _) = pr_rmse(&[]);
+    let rmse = |value: &serde_json::Value| value["methods"]["pr"]["rmse_xy"].as_f64().unwrap();
+    assert!(
+        rmse(&exact) < rmse(&noisy) && rmse(&exact) < rmse(&model),
+        "{} {} {}",
+        rmse(&exact),
+        rmse(&noisy),
+        rmse(&model)
+    );
+    assert_eq!(model["displacement_oracle"], serde_json::json!(false));
+
+    let refused = |args: &[&str]| {
+        let output = Command::new(env!("CARGO_BIN_EXE_primm")).args(args).output().unwrap();
+        assert!(!output.status.success(), "{args:?} ran");
+        String::from_utf8_lossy(&output.stderr).into_owned()
+    };
+    let data = data.to_str().unwrap();
+    let stderr =
+        refused(&["eval", "--data", data, "--methods", "pr", "--displacement-oracle-noise-m", "0.1"]);
+    assert!(stderr.contains("--displacement-oracle"), "{stderr}");
+    let stderr = refused(&[
+        "eval",
+        "--data",
+        data,
+        "--methods",
+        "pr",
+        "--displacement-oracle",
+        "--tracking-frame",
+        "vehicle",
+    ]);
+    assert!(stderr.contains("needs the world frame"), "{stderr}");
+    let stderr =
+        refused(&["eval", "--data", data, "--displacement-oracle", "--displacement-oracle-noise-m=-1"]);
+    assert!(stderr.contains("standard deviation"), "{stderr}");
+}
+
+#[test]
 fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
     let dir = tempdir("score");
     generate(&dir);

@@ -393,6 +393,11 @@ def parse_args(argv=None):
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--idf1-weight", type=float, default=20.0, help="metres of RMSE per unit of IDF1 lost")
     parser.add_argument("--tracking-frame", choices=["world", "vehicle"], default="world")
+    parser.add_argument("--displacement-oracle", action="store_true",
+                        help="score with `primm eval --displacement-oracle`: PR gets the true displacement "
+                             "(a diagnostic: what a perfect learned predictor could reach; never for shipped values)")
+    parser.add_argument("--displacement-oracle-noise-m", type=float, default=None,
+                        help="with --displacement-oracle: noise added to the true displacement, m per axis")
     parser.add_argument("--parameters", choices=sorted(PARAMETER_SETS), default="physics",
                         help="which parameters to tune")
     parser.add_argument("--method", default=None,
@@ -499,7 +504,8 @@ def score(args, text: str) -> dict:
             report = os.path.join(tmp, "report.json")
             subprocess.run(
                 [args.primm, "eval", "--data", data, "--methods", args.method, "--config", config,
-                 "--tracking-frame", args.tracking_frame, "--json", report],
+                 "--tracking-frame", args.tracking_frame, "--json", report]
+                + oracle_arguments(args),
                 check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             )
             with open(report) as handle:
@@ -510,6 +516,14 @@ def score(args, text: str) -> dict:
             if pr_probability is not None:
                 result.setdefault("pr_probability", []).append(pr_probability)
     return result
+
+
+def oracle_arguments(args) -> list:
+    """The `primm eval` options of the displacement oracle, if asked for."""
+    if not getattr(args, "displacement_oracle", False):
+        return []
+    noise = getattr(args, "displacement_oracle_noise_m", None)
+    return ["--displacement-oracle"] + ([] if noise is None else ["--displacement-oracle-noise-m", repr(noise)])
 
 
 def scored_pr_probability(report: str, method: str):

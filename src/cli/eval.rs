@@ -16,6 +16,7 @@ use primm_sim::eval::record::{AssociationRecord, EvalError};
 use primm_sim::eval::report::{EvaluationReport, MethodEvaluator, DEFAULT_MISS_PERCENTS};
 use primm_sim::io::{read_dataset_dir, CsvError, Sequence};
 use primm_sim::offline::{association_records, track_sequence, OfflineError};
+use primm_sim::oracle::{DisplacementOracle, OracleError, SequenceTruth};
 use std::path::{Path, PathBuf};
 
 /// Seed of the measurement removal for the missed-detection rows of Table V.
@@ -83,6 +84,23 @@ pub struct Args {
     /// `measurement` (the next measurement, the paper's RadarScenes protocol).
     #[arg(long, value_enum, default_value_t = Truth::Centre)]
     pub truth: Truth,
+    /// PR and PR-IMM get each track's true displacement from the data's true centres instead of
+    /// the PR model's (a diagnostic: how far a perfect learned predictor would go; simulated
+    /// data only). See `primm_sim::oracle`.
+    #[arg(long)]
+    pub displacement_oracle: bool,
+    /// With `--displacement-oracle`: Gaussian noise of this standard deviation per axis added to
+    /// every true displacement (independent per request, seeded), m.
+    #[arg(long, value_name = "M", requires = "displacement_oracle", value_parser = parse_noise_std)]
+    pub displacement_oracle_noise_m: Option<f64>,
+}
+
+/// A standard deviation: finite and not negative.
+fn parse_noise_std(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(value) if value.is_finite() && value >= 0.0 => Ok(value),
+        _ => Err(format!("`{text}` is not a standard deviation in metres (a finite number >= 0)")),
+    }
 }
 
 /// Why `primm eval` failed.
@@ -115,6 +133,9 @@ pub enum EvaluateError {
     /// The directory of the figures could not be created.
     #[error(transparent)]
     Io(#[from] std::io::Error),
+    /// `--displacement-oracle` needs true centres in the tracker's frame.
+    #[error("--displacement-oracle: {0}")]
+    Oracle(#[from] OracleError),
     /// The tracked rows of a sequence with measurements removed did not match the measurements
     /// kept (an internal error).
     #[error("missed-detection rows out of step")]
@@ -134,6 +155,13 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
     if sequences.is_empty() {
         return Err(EvaluateError::NoData { dir: args.data.clone() });
     }
+    // The oracle's truth is read before a measurement protocol drops it from the rows.
+    let oracle_truths = if args.displacement_oracle {
+        let frame = base_config.frame.tracking_frame;
+        sequences.iter().map(|sequence| SequenceTruth::new(sequence, frame)).collect::<Result<Vec<_>, _>>()?
+    } else {
+        Vec::new()
+    };
     if args.truth == Truth::Measurement {
         forget_true_positions(&mut sequences);
     }
@@ -150,7 +178,14 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
     let mut panels = Vec::new();
     let mut ground_truth = Vec::new();
     for &method in &args.methods {
-        let predictor = match predictor_for(method, args.model.as_deref(), base_config.predictor.engine) {
+        let oracle = (args.displacement_oracle && method.needs_predictor()).then(|| {
+            DisplacementOracle::with_noise(args.displacement_oracle_noise_m.unwrap_or(0.0), args.miss_seed)
+        });
+        let predictor = match &oracle {
+            Some(oracle) => Ok(Box::new(oracle.clone()) as Box<dyn DisplacementPredictor + Send>),
+            None => predictor_for(method, args.model.as_deref(), base_config.predictor.engine),
+        };
+        let predictor = match predictor {
             Ok(predictor) => predictor,
             Err(reason) => {
                 eprintln!("{method}: unavailable: {reason}");
@@ -162,6 +197,9 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
         let mut tracker = Tracker::with_predictor(base_config.clone().with_modes(method.modes()), predictor)?;
         let mut evaluator = MethodEvaluator::new(method);
         for (index, sequence) in sequences.iter().enumerate() {
+            if let Some(oracle) = &oracle {
+                oracle.set_truth(oracle_truths[index].clone());
+            }
             let mut records = Vec::with_capacity(sequence.measurement_count());
             let mut points = Vec::new();
             track_sequence(&mut tracker, sequence, |recorded, outputs| {
@@ -190,13 +228,30 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
         }
         report.insert(evaluator.finish());
         eprintln!("{method}: {} sequences in {:.1} s", sequences.len(), started.elapsed().as_secs_f64());
+        if let Some(summary) = oracle.as_ref().and_then(|oracle| oracle.report()) {
+            eprintln!("{method}: {summary}");
+        }
     }
 
-    println!("RMSE reference: {}\n", truth_description(args.truth));
+    println!("RMSE reference: {}", truth_description(args.truth));
+    if args.displacement_oracle {
+        match args.displacement_oracle_noise_m {
+            Some(std_m) if std_m > 0.0 => println!(
+                "PR and PR-IMM: the PR model replaced by the true displacement plus {std_m} m noise per axis (--displacement-oracle)"
+            ),
+            _ => println!("PR and PR-IMM: the PR model replaced by the true displacement (--displacement-oracle)"),
+        }
+    }
+    println!();
     println!("{}", report.to_text());
     if let Some(path) = &args.json {
         let mut json = report.to_json();
         json["truth"] = serde_json::Value::from(args.truth.key());
+        json["displacement_oracle"] = serde_json::Value::from(args.displacement_oracle);
+        if args.displacement_oracle {
+            json["displacement_oracle_noise_m"] =
+                serde_json::Value::from(args.displacement_oracle_noise_m.unwrap_or(0.0));
+        }
         let text = serde_json::to_string_pretty(&json).map_err(EvalError::from)?;
         std::fs::write(path, text + "\n")?;
         eprintln!("wrote {}", path.display());

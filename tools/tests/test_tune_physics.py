@@ -407,3 +407,25 @@ def test_imm_class_descent_writes_only_the_classes_it_moved(tmp_path, monkeypatc
     assert "imm" in chosen["classes"]["car"] and "imm" not in chosen["classes"]["pedestrian"]
     chosen["classes"]["car"].pop("imm")
     assert chosen == tomllib.loads(base.read_text())
+
+
+def test_the_oracle_flag_reaches_every_primm_eval_call(tmp_path, monkeypatch):
+    commands = []
+
+    def fake_run(command, **_):
+        commands.append(command)
+        report = command[command.index("--json") + 1]
+        with open(report, "w") as handle:
+            handle.write('{"methods": {"pr_imm": {"rmse_xy": 1.0, "idf1": 0.9}}, "mode_probabilities": {}}')
+
+    monkeypatch.setattr(tune_physics.subprocess, "run", fake_run)
+    for flag, expected in (([], False), (["--displacement-oracle"], True),
+                           (["--displacement-oracle", "--displacement-oracle-noise-m", "0.1"], True)):
+        args = tune_physics.parse_args(["--data", "a/validation", "b/validation", "--out", str(tmp_path / "o.toml"),
+                                        "--parameters", "imm", "--method", "pr-imm"] + flag)
+        commands.clear()
+        assert tune_physics.score(args, shipped_text()) == {"rmse_xy": [1.0, 1.0], "idf1": [0.9, 0.9]}
+        assert len(commands) == 2
+        assert all(("--displacement-oracle" in command) == expected for command in commands)
+        noise = "0.1" in flag
+        assert all((command[-2:] == ["--displacement-oracle-noise-m", "0.1"]) == noise for command in commands)

@@ -8,6 +8,8 @@
 //! * [`io`]: the measurement CSV format (also written by `tools/radarscenes_to_csv.py` from
 //!   RadarScenes), the track CSV format and the association CSV format;
 //! * [`offline`]: running a tracker over a recorded sequence;
+//! * [`oracle`]: a displacement predictor that reads the true motion (a diagnostic: the ceiling
+//!   of any learned predictor);
 //! * [`eval`]: the metrics and tables of the paper's Section IV, JSON and SVG figures.
 //!
 //! ```
@@ -30,4 +32,5 @@
 pub mod eval;
 pub mod io;
 pub mod offline;
+pub mod oracle;
 pub mod scenario;
