@@ -67,3 +67,34 @@ def test_the_command_prints_and_writes_json_and_refuses_data_without_truth(tmp_p
     (empty / "a.csv").write_text(HEADER + "0,0.0,,car,3.0,4.0,0.0,1.0,,,0,0,0,0\n")
     assert floor.main(["--data", str(empty)]) == 2
     assert "no measurement" in capsys.readouterr().err
+
+
+def test_the_one_step_motion_splits_along_and_across_the_line_of_sight(tmp_path: Path) -> None:
+    # A car measured at its centre, moving at (2, 1) m/s from (10, 0); the ego stands at the
+    # origin; each row's radial velocity is the true one along its own line of sight, so the
+    # radial velocity explains the motion along the line of sight up to the sight's turning.
+    rows = [HEADER]
+    velocity = (2.0, 1.0)
+    expected_along, expected_across, expected_left = [], [], []
+    positions = [(10.0 + velocity[0] * 0.1 * k, velocity[1] * 0.1 * k) for k in range(3)]
+    for k, (x, y) in enumerate(positions):
+        norm = math.hypot(x, y)
+        u = (x / norm, y / norm)
+        vr = velocity[0] * u[0] + velocity[1] * u[1]
+        rows.append(f"{k},{0.1 * k},3,car,{x},{y},{vr},1.0,{x},{y},0,0,0,0\n")
+        if k + 1 < len(positions):
+            motion = (positions[k + 1][0] - x, positions[k + 1][1] - y)
+            along = motion[0] * u[0] + motion[1] * u[1]
+            expected_along.append(along)
+            expected_across.append(-motion[0] * u[1] + motion[1] * u[0])
+            expected_left.append(along - vr * 0.1)
+    (tmp_path / "s.csv").write_text("".join(rows))
+    budget = floor.motion_budget(sorted(tmp_path.glob("*.csv")))
+    rms = lambda values: math.sqrt(sum(v * v for v in values) / len(values))  # noqa: E731
+    car = budget["car"]
+    assert car["steps"] == 2
+    assert math.isclose(car["along_sight_m"], rms(expected_along))
+    assert math.isclose(car["across_sight_m"], rms(expected_across))
+    assert math.isclose(car["along_after_radial_velocity_m"], rms(expected_left), abs_tol=1e-12)
+    assert car["along_after_radial_velocity_m"] < 1e-12 and car["across_sight_m"] > 0.09
+    assert budget["all"] == car
