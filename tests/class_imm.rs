@@ -31,13 +31,9 @@ fn scene() -> Vec<SceneObject> {
 fn without_overrides() -> Config {
     let mut config = Config::default();
     for class in ObjectClass::ALL {
-        *class_imm(&mut config, class) = Default::default();
+        config.classes.get_mut(class).imm = Default::default();
     }
     config
-}
-
-fn class_imm(config: &mut Config, class: ObjectClass) -> &mut primm_core::config::ClassImmConfig {
-    &mut config.classes.get_mut(class).imm
 }
 
 /// Every frame's outputs of a tracker with `config` on the scene.
@@ -112,7 +108,7 @@ fn overrides_equal_to_imm_or_absent_change_nothing() {
     let mut config = without_overrides();
     for class in ObjectClass::ALL {
         let imm = config.imm.clone();
-        let section = class_imm(&mut config, class);
+        let section = &mut config.classes.get_mut(class).imm;
         section.transition = Some(imm.transition);
         section.initial_mode_probabilities = Some(imm.initial_mode_probabilities);
     }

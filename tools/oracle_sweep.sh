@@ -25,17 +25,8 @@ generate out/held_out/evaluation --split evaluation --scenario training/scenario
 # The starting point: the shipped configuration with one IMM for all classes.
 out=out/tune/oracle
 mkdir -p "$out"
-python3 - "$out/start.toml" <<'PY'
-import re, sys
-kept, skipping = [], False
-for line in open("config/primm.toml"):
-    header = re.match(r"\[\[?([A-Za-z_.]+)\]\]?\s*(#.*)?$", line)
-    if header:
-        skipping = re.fullmatch(r"classes\.[a-z_]+\.imm", header.group(1)) is not None
-    if not skipping:
-        kept.append(line)
-open(sys.argv[1], "w").write("".join(kept))
-PY
+python3 -c 'import sys; sys.path.insert(0, "tools"); import tune_physics
+open(sys.argv[1], "w").write(tune_physics.without_class_imm(open("config/primm.toml").read()))' "$out/start.toml"
 
 splits=(validation_default:out/tune/default/validation validation_robustness:out/tune/robust/validation
         evaluation_default:out/evaluation/data/evaluation evaluation_robustness:out/evaluation/robustness/evaluation

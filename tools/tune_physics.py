@@ -289,6 +289,18 @@ def class_imm_config(config: dict, cls: str) -> dict:
     return imm
 
 
+def without_class_imm(text: str) -> str:
+    """``text`` (TOML) without its ``[classes.<class>.imm]`` sections: one IMM for all classes."""
+    kept, skipping = [], False
+    for line in text.splitlines(keepends=True):
+        header = re.match(r"\[\[?([A-Za-z_.]+)\]\]?\s*(#.*)?$", line)
+        if header:
+            skipping = re.fullmatch(r"classes\.[a-z_]+\.imm", header.group(1)) is not None
+        if not skipping:
+            kept.append(line)
+    return "".join(kept)
+
+
 def class_imm_knobs(config: dict) -> dict:
     """{class: {pr_leave, into_pr, initial_pr}} describing each tuned class's IMM (its overrides
     over [imm]), as imm_knobs reads them."""
@@ -520,9 +532,9 @@ def score(args, text: str) -> dict:
 
 def oracle_arguments(args) -> list:
     """The `primm eval` options of the displacement oracle, if asked for."""
-    if not getattr(args, "displacement_oracle", False):
+    if not args.displacement_oracle:
         return []
-    noise = getattr(args, "displacement_oracle_noise_m", None)
+    noise = args.displacement_oracle_noise_m
     return ["--displacement-oracle"] + ([] if noise is None else ["--displacement-oracle-noise-m", repr(noise)])
 
 

@@ -174,13 +174,13 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
         None => 0,
     };
 
+    let oracle_noise_m = args.displacement_oracle_noise_m.unwrap_or(0.0);
     let mut report = EvaluationReport::new();
     let mut panels = Vec::new();
     let mut ground_truth = Vec::new();
     for &method in &args.methods {
-        let oracle = (args.displacement_oracle && method.needs_predictor()).then(|| {
-            DisplacementOracle::with_noise(args.displacement_oracle_noise_m.unwrap_or(0.0), args.miss_seed)
-        });
+        let oracle = (args.displacement_oracle && method.needs_predictor())
+            .then(|| DisplacementOracle::with_noise(oracle_noise_m, args.miss_seed));
         let predictor = match &oracle {
             Some(oracle) => Ok(Box::new(oracle.clone()) as Box<dyn DisplacementPredictor + Send>),
             None => predictor_for(method, args.model.as_deref(), base_config.predictor.engine),
@@ -235,12 +235,14 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
 
     println!("RMSE reference: {}", truth_description(args.truth));
     if args.displacement_oracle {
-        match args.displacement_oracle_noise_m {
-            Some(std_m) if std_m > 0.0 => println!(
-                "PR and PR-IMM: the PR model replaced by the true displacement plus {std_m} m noise per axis (--displacement-oracle)"
-            ),
-            _ => println!("PR and PR-IMM: the PR model replaced by the true displacement (--displacement-oracle)"),
-        }
+        let noise = if oracle_noise_m > 0.0 {
+            format!(" plus {oracle_noise_m} m noise per axis")
+        } else {
+            String::new()
+        };
+        println!(
+            "PR and PR-IMM: the PR model replaced by the true displacement{noise} (--displacement-oracle)"
+        );
     }
     println!();
     println!("{}", report.to_text());
@@ -249,8 +251,7 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
         json["truth"] = serde_json::Value::from(args.truth.key());
         json["displacement_oracle"] = serde_json::Value::from(args.displacement_oracle);
         if args.displacement_oracle {
-            json["displacement_oracle_noise_m"] =
-                serde_json::Value::from(args.displacement_oracle_noise_m.unwrap_or(0.0));
+            json["displacement_oracle_noise_m"] = serde_json::Value::from(oracle_noise_m);
         }
         let text = serde_json::to_string_pretty(&json).map_err(EvalError::from)?;
         std::fs::write(path, text + "\n")?;

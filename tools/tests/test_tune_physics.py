@@ -2,7 +2,6 @@
 evaluation data."""
 
 import os
-import re
 import sys
 import tomllib
 
@@ -60,16 +59,7 @@ def shipped_text():
         return handle.read()
 
 
-def without_class_imm(text):
-    """``text`` without its [classes.<class>.imm] sections: one IMM for all classes."""
-    kept, skipping = [], False
-    for line in text.splitlines(keepends=True):
-        header = re.match(r"\[\[?([A-Za-z_.]+)\]\]?\s*(#.*)?$", line)
-        if header:
-            skipping = re.fullmatch(r"classes\.[a-z_]+\.imm", header.group(1)) is not None
-        if not skipping:
-            kept.append(line)
-    return "".join(kept)
+without_class_imm = tune_physics.without_class_imm
 
 
 def test_the_shipped_class_sections_read_back_as_the_knobs_that_made_them():

@@ -185,24 +185,6 @@ impl DisplacementOracle {
         Self { noise_std_m: std_m, seed, ..Self::default() }
     }
 
-    /// The noise added to the answer for object `id` and `request`.
-    fn noise(&self, id: u64, request: &PredictionRequest) -> DVec2 {
-        if self.noise_std_m == 0.0 {
-            return DVec2::ZERO;
-        }
-        let key = [
-            id,
-            request.anchor_time_s.to_bits(),
-            request.step_start_s.to_bits(),
-            request.prediction_time_s.to_bits(),
-        ]
-        .iter()
-        .fold(self.seed, |hash, value| split_mix(hash ^ value));
-        let mut rng = ChaCha8Rng::seed_from_u64(key);
-        let (x, y): (f64, f64) = (StandardNormal.sample(&mut rng), StandardNormal.sample(&mut rng));
-        DVec2::new(x, y) * self.noise_std_m
-    }
-
     /// Makes `truth` the sequence the oracle answers for (call it before tracking that sequence).
     pub fn set_truth(&self, truth: SequenceTruth) {
         self.shared.lock().unwrap_or_else(PoisonError::into_inner).truth = truth;
@@ -218,14 +200,11 @@ impl DisplacementPredictor for DisplacementOracle {
     fn submit(&mut self, requests: &[PredictionRequest]) {
         let mut shared = self.shared.lock().unwrap_or_else(PoisonError::into_inner);
         self.pending.clear();
-        let answers = requests.iter().map(|request| {
-            shared
-                .truth
-                .object_displacement(request)
-                .map(|(id, motion)| Displacement::new(motion + self.noise(id, request)))
-        });
-        let answers: Vec<_> = answers.collect();
-        self.pending.extend(answers);
+        let (std_m, seed) = (self.noise_std_m, self.seed);
+        self.pending.extend(requests.iter().map(|request| {
+            let (id, motion) = shared.truth.object_displacement(request)?;
+            Some(Displacement::new(motion + noise(std_m, seed, id, request)))
+        }));
         shared.counts.requests += requests.len() as u64;
         shared.counts.answered += self.pending.iter().filter(|d| d.is_some()).count() as u64;
     }
@@ -242,6 +221,24 @@ impl DisplacementPredictor for DisplacementOracle {
         let counts = self.counts();
         Some(format!("displacement oracle: {} of {} requests answered", counts.answered, counts.requests))
     }
+}
+
+/// Gaussian noise of `std_m` per axis for object `id` and `request`, drawn from `seed` and both.
+fn noise(std_m: f64, seed: u64, id: u64, request: &PredictionRequest) -> DVec2 {
+    if std_m == 0.0 {
+        return DVec2::ZERO;
+    }
+    let key = [
+        id,
+        request.anchor_time_s.to_bits(),
+        request.step_start_s.to_bits(),
+        request.prediction_time_s.to_bits(),
+    ]
+    .iter()
+    .fold(seed, |hash, value| split_mix(hash ^ value));
+    let mut rng = ChaCha8Rng::seed_from_u64(key);
+    let (x, y): (f64, f64) = (StandardNormal.sample(&mut rng), StandardNormal.sample(&mut rng));
+    DVec2::new(x, y) * std_m
 }
 
 /// SplitMix64's finaliser: spreads the request's fields over the seed.

@@ -572,25 +572,14 @@ impl EvaluationReport {
             };
             methods.insert(method.key().to_string(), value);
         }
-        let modes = self.result(Method::PrImm).map(|r| r.modes).unwrap_or_default();
-        let mean = modes.mean();
-        let mut mode_probabilities = Map::new();
+        let pr_imm = self.result(Method::PrImm);
+        let mut mode_probabilities = mode_means_json(&pr_imm.map(|r| r.modes).unwrap_or_default());
         mode_probabilities.insert("method".into(), json!(Method::PrImm.key()));
-        mode_probabilities.insert("samples".into(), json!(modes.count()));
-        for (index, name) in MODE_NAMES.iter().enumerate() {
-            mode_probabilities.insert(name.to_ascii_lowercase(), json!(mean.map(|m| m[index])));
-        }
-        let mut by_class = Map::new();
-        if let Some(result) = self.result(Method::PrImm) {
-            for (class, acc) in &result.class_modes {
-                let mut entry = Map::new();
-                entry.insert("samples".into(), json!(acc.count()));
-                for (index, name) in MODE_NAMES.iter().enumerate() {
-                    entry.insert(name.to_ascii_lowercase(), json!(acc.mean().map(|m| m[index])));
-                }
-                by_class.insert(class.name().to_string(), Value::Object(entry));
-            }
-        }
+        let by_class: Map<String, Value> = pr_imm
+            .into_iter()
+            .flat_map(|result| &result.class_modes)
+            .map(|(class, acc)| (class.name().to_string(), Value::Object(mode_means_json(acc))))
+            .collect();
         mode_probabilities.insert("by_class".into(), Value::Object(by_class));
         json!({ "methods": methods, "mode_probabilities": mode_probabilities })
     }
@@ -805,6 +794,17 @@ fn count_text(values: &[u64]) -> String {
 }
 
 /// Renders a title, a header and rows; the first column is left-aligned, the others right-aligned.
+/// `{"samples", "pr", "cv", "ca", "ct"}` of one accumulator (`null` means without samples).
+fn mode_means_json(acc: &ModeProbabilityAccumulator) -> Map<String, Value> {
+    let mean = acc.mean();
+    let mut entry = Map::new();
+    entry.insert("samples".into(), json!(acc.count()));
+    for (index, name) in MODE_NAMES.iter().enumerate() {
+        entry.insert(name.to_ascii_lowercase(), json!(mean.map(|m| m[index])));
+    }
+    entry
+}
+
 fn render_table(title: &str, header: &[String], rows: &[Vec<String>]) -> String {
     render_table_aligned(title, header, rows, 1)
 }
