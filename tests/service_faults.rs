@@ -25,7 +25,8 @@ fn lane_frames(count: usize) -> Vec<Frame> {
 fn answer(client: &TestClient) -> (u64, Option<FrameStatus>, Vec<u64>, u16, u8) {
     client
         .next_answer(Duration::from_secs(10), |a| {
-            let confirmed = a.valid_tracks().iter().filter(|t| t.status == 1).map(|t| t.id).collect();
+            let confirmed =
+                a.valid_tracks().iter().filter(|t| matches!(t.status, 1 | 2)).map(|t| t.id).collect();
             (a.input_sequence, a.frame_status(), confirmed, a.measurements_rejected, a.flags)
         })
         .expect("the tracker answers")

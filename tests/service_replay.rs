@@ -45,7 +45,8 @@ fn replay_against_offline<P: primm_core::predictor::DisplacementPredictor>(
         if tracks != expected && replay.first_difference.is_none() {
             replay.first_difference = Some(k);
         }
-        replay.confirmed_seen = replay.confirmed_seen.max(tracks.iter().filter(|t| t.status == 1).count());
+        replay.confirmed_seen =
+            replay.confirmed_seen.max(tracks.iter().filter(|t| matches!(t.status, 1 | 2)).count());
     }
     replay
 }

@@ -386,10 +386,7 @@ fn each_step_summarises_its_frame_and_the_summaries_add_up_to_the_statistics() {
         let outputs = tracker.step(frame).unwrap().to_vec();
         let summary = *tracker.last_step();
         assert_eq!(summary.live_tracks, outputs.len());
-        assert_eq!(
-            summary.confirmed_tracks,
-            outputs.iter().filter(|o| o.status == TrackStatus::Confirmed).count()
-        );
+        assert_eq!(summary.confirmed_tracks, outputs.iter().filter(|o| o.status.is_confirmed()).count());
         assert_eq!(
             summary.assigned + summary.initiated,
             outputs.iter().filter(|o| o.measurement_index.is_some()).count()

@@ -208,8 +208,11 @@ fn the_python_subscriber_on_the_far_host_reads_the_tracks_of_a_tracker_on_the_ne
         client.send(frame, k as u64, 0);
         let answer = client
             .next_answer(Duration::from_secs(10), |answer| {
-                let tracks: PrintedTracks =
-                    answer.valid_tracks().iter().map(|t| (t.id, t.x_m, t.y_m, t.status == 1)).collect();
+                let tracks: PrintedTracks = answer
+                    .valid_tracks()
+                    .iter()
+                    .map(|t| (t.id, t.x_m, t.y_m, matches!(t.status, 1 | 2)))
+                    .collect();
                 (answer.input_sequence, tracks)
             })
             .expect("the tracker answers");

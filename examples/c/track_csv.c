@@ -15,7 +15,8 @@
  * fields are trimmed, lines starting with '#' are comments, and a row with an empty class is
  * the one row of a frame without measurements. Rows of one frame are consecutive.
  *
- * Output: header frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct and
+ * Output: header frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,
+ * existence_probability and
  * one row per track updated by a measurement in that frame; a file with an ego pose adds the
  * world-frame columns world_x,world_y,world_vx,world_vy (the tracker then tracks in the world
  * frame, see primm_tracker_step_with_pose). Numbers are written with
@@ -213,6 +214,20 @@ static int read_pose(const struct input *in, PrimmEgoPose *pose) {
     return 1;
 }
 
+/* The track file's name of a status code. */
+static const char *track_status_name(PrimmTrackStatus status) {
+    switch (status) {
+    case PRIMM_TRACK_STATUS_TENTATIVE:
+        return "tentative";
+    case PRIMM_TRACK_STATUS_CONFIRMED:
+        return "confirmed";
+    case PRIMM_TRACK_STATUS_COASTING:
+        return "coasting";
+    default:
+        return "unknown";
+    }
+}
+
 /* Tracks one frame (with its ego pose, or NULL) and writes the rows of the tracks a measurement
  * updated; with `world_columns`, each row ends with the world-frame estimate (empty without). */
 static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double timestamp_s,
@@ -251,6 +266,8 @@ static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double
             fputc(',', out);
             print_double(out, track->mode_probabilities[mode]);
         }
+        fprintf(out, ",%s,", track_status_name(track->status));
+        print_double(out, track->existence_probability);
         if (world_columns && track->has_world_estimate) {
             const double world[4] = {track->world_x_m, track->world_y_m, track->world_velocity_x_mps,
                                      track->world_velocity_y_mps};
@@ -305,7 +322,7 @@ int main(int argc, char **argv) {
     if (!world_columns) {
         in.columns[COL_EGO_X] = -1; /* an incomplete pose group is ignored */
     }
-    fputs("frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct", out);
+    fputs("frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,existence_probability", out);
     fputs(world_columns ? ",world_x,world_y,world_vx,world_vy\n" : "\n", out);
 
     static PrimmMeasurement measurements[PRIMM_MAX_MEASUREMENTS_PER_FRAME];

@@ -59,7 +59,7 @@ def frame_record(frame):
             {
                 "id": track.id,
                 "class": CLASS_NAMES.get(track.class_code, str(track.class_code)),
-                "confirmed": track.status == 1,
+                "confirmed": track.status in (1, 2),  # confirmed or coasting
                 "x_m": track.x_m,
                 "y_m": track.y_m,
                 "vx_mps": track.vx_mps,

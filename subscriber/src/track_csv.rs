@@ -2,6 +2,7 @@
 //! [`primm_sim::io::track_csv`], written by its [`TrackCsvWriter`].
 
 use primm_core::measurement::ObjectClass;
+use primm_core::track::TrackStatus;
 use primm_sim::io::track_csv::{TrackCsvWriter, TrackRow};
 use primm_wire::{FrameStatus, TrackFrame};
 use std::io::Write;
@@ -18,6 +19,11 @@ pub fn write_track_frame<W: Write>(csv: &mut TrackCsvWriter<W>, frame: &TrackFra
             Some(class) => class.name(),
             None => class_code.as_str(),
         };
+        let status_code = track.status.to_string();
+        let status = match TrackStatus::from_code(track.status) {
+            Some(status) => status.name(),
+            None => status_code.as_str(),
+        };
         csv.write(&TrackRow {
             frame: frame.source_frame,
             timestamp_s: frame.sensor_timestamp_s,
@@ -27,6 +33,8 @@ pub fn write_track_frame<W: Write>(csv: &mut TrackCsvWriter<W>, frame: &TrackFra
             prior_position_m: track.prior_m(),
             ground_truth_id: u64::try_from(track.gt_id).ok(),
             mode_probabilities: track.mode_probabilities,
+            status,
+            existence_probability: track.existence_probability,
             world: track.world(),
         })?;
     }

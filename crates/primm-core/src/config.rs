@@ -5,6 +5,7 @@
 //! checks that the file and the defaults here are equal. [`Config::validate`] checks every
 //! value and names the offending key.
 
+pub use crate::existence::{ExistenceConfig, Lifecycle};
 use crate::measurement::ObjectClass;
 use crate::mode::{ModeSet, MODE_COUNT};
 use crate::readable_number::readable;
@@ -173,6 +174,58 @@ pub struct AssociationConfig {
     pub velocity_weight_s: f64,
     /// `v_max`, cap on the radial-velocity difference, m/s.
     pub velocity_cap_mps: f64,
+    /// Which cost pairs tracks with measurements (absent: `paper`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub cost: AssociationCost,
+    /// Whether confirmed tracks choose their measurements before tentative ones (absent:
+    /// `joint`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub stages: AssociationStages,
+    /// Gate of the `likelihood` cost: largest squared Mahalanobis distance of position and
+    /// radial-velocity residual together (χ² with 3 degrees of freedom; 16.27 keeps 99.9 % of
+    /// true pairs), dimensionless (absent: 16.27).
+    #[cfg_attr(feature = "serde", serde(default = "default_likelihood_gate_chi2"))]
+    pub likelihood_gate_chi2: f64,
+}
+
+/// The default of `association.likelihood_gate_chi2`: the 99.9 % quantile of χ² with 3 degrees
+/// of freedom.
+pub const DEFAULT_LIKELIHOOD_GATE_CHI2: f64 = 16.27;
+
+#[cfg(feature = "serde")]
+fn default_likelihood_gate_chi2() -> f64 {
+    DEFAULT_LIKELIHOOD_GATE_CHI2
+}
+
+/// The association cost (`association.cost`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum AssociationCost {
+    /// `eq:association_cost`: Euclidean distance to the fused prior plus the capped, weighted
+    /// radial-velocity difference, gated at `classes.<class>.gate_m`.
+    #[default]
+    Paper,
+    /// Negative log-likelihood: the squared Mahalanobis distance of the position (innovation
+    /// covariance `S = P⁻ + R`) and of the radial-velocity difference (variance
+    /// `classes.<class>.radial_velocity_residual_std_mps²`), plus `ln det S`, gated at
+    /// `association.likelihood_gate_chi2` on the distance.
+    Likelihood,
+}
+
+/// The order in which tracks choose measurements (`association.stages`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum AssociationStages {
+    /// One optimal assignment per class over all tracks, tentative and confirmed alike.
+    #[default]
+    Joint,
+    /// Per class, first an optimal assignment of the confirmed tracks, then one of the
+    /// tentative tracks over the measurements left; what remains starts new tracks. A
+    /// tentative track (often born of clutter) can no longer take a confirmed track's
+    /// measurement.
+    ConfirmedFirst,
 }
 
 /// Frame validation and track lifecycle settings.
@@ -192,6 +245,49 @@ pub struct TrackerConfig {
     pub confirmed_max_misses: u32,
     /// Longest time a track may coast without an update before it is deleted, s.
     pub max_coast_s: f64,
+    /// How tracks are confirmed and deleted (absent: `counts`).
+    #[cfg_attr(feature = "serde", serde(default = "counts"))]
+    pub lifecycle: Lifecycle,
+    /// Existence probability of a track started by one measurement, in (0, 1) (absent: 0.5).
+    #[cfg_attr(feature = "serde", serde(default = "one_half"))]
+    pub initial_existence_probability: f64,
+    /// With `lifecycle = "existence"`: existence probability that confirms a tentative track,
+    /// in (0, 1) (absent: 0.9).
+    #[cfg_attr(feature = "serde", serde(default = "default_confirmation_existence"))]
+    pub confirmation_existence_probability: f64,
+    /// With `lifecycle = "existence"`: a track whose existence probability falls below this is
+    /// deleted, in [0, confirmation) (absent: 0.05).
+    #[cfg_attr(feature = "serde", serde(default = "default_deletion_existence"))]
+    pub deletion_existence_probability: f64,
+    /// Mean time an object goes on existing, s: the existence probability is multiplied by
+    /// `exp(−Δt / T)` every frame (absent: 10 s).
+    #[cfg_attr(feature = "serde", serde(default = "default_persistence_time_s"))]
+    pub existence_persistence_time_s: f64,
+}
+
+#[cfg(feature = "serde")]
+fn counts() -> Lifecycle {
+    Lifecycle::Counts
+}
+
+#[cfg(feature = "serde")]
+fn one_half() -> f64 {
+    0.5
+}
+
+#[cfg(feature = "serde")]
+fn default_confirmation_existence() -> f64 {
+    0.9
+}
+
+#[cfg(feature = "serde")]
+fn default_deletion_existence() -> f64 {
+    0.05
+}
+
+#[cfg(feature = "serde")]
+fn default_persistence_time_s() -> f64 {
+    10.0
 }
 
 /// Per-class parameter sections.
@@ -240,6 +336,16 @@ pub struct ClassConfig {
     pub radial_velocity_std_mps: f64,
     /// Standard deviation of the velocity across the line of sight at initiation, m/s.
     pub initial_tangential_speed_std_mps: f64,
+    /// Standard deviation of the difference between a measurement's radial velocity and the
+    /// track's last one, as the `likelihood` association cost scores it, m/s (absent: 1 m/s).
+    /// Wider than the sensor's noise: the two may come from different sensors, whose lines of
+    /// sight differ, and the object accelerates between them.
+    #[cfg_attr(feature = "serde", serde(default = "default_radial_velocity_residual_std_mps"))]
+    pub radial_velocity_residual_std_mps: f64,
+    /// Detection probability and clutter density of this class, for the existence probability
+    /// (absent: 0.9 and 1e-4 /m²).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub existence: ExistenceConfig,
     /// Constant-velocity mode.
     pub constant_velocity: ConstantVelocityConfig,
     /// Constant-acceleration mode.
@@ -287,6 +393,11 @@ impl ImmConfig {
             ..self.clone()
         }
     }
+}
+
+#[cfg(feature = "serde")]
+fn default_radial_velocity_residual_std_mps() -> f64 {
+    1.0
 }
 
 /// Constant-velocity noise.
@@ -379,7 +490,13 @@ impl Default for Config {
                 likelihood_temperature: 0.1,
                 mode_probability_floor: 0.001,
             },
-            association: AssociationConfig { velocity_weight_s: 0.1, velocity_cap_mps: 5.0 },
+            association: AssociationConfig {
+                velocity_weight_s: 0.1,
+                velocity_cap_mps: 5.0,
+                cost: AssociationCost::Paper,
+                stages: AssociationStages::Joint,
+                likelihood_gate_chi2: DEFAULT_LIKELIHOOD_GATE_CHI2,
+            },
             tracker: TrackerConfig {
                 max_frame_interval_s: 1.0,
                 confirmation_hits: 3,
@@ -387,6 +504,11 @@ impl Default for Config {
                 tentative_max_coast_s: 0.3,
                 confirmed_max_misses: 100,
                 max_coast_s: 1.0,
+                lifecycle: Lifecycle::Counts,
+                initial_existence_probability: 0.5,
+                confirmation_existence_probability: 0.9,
+                deletion_existence_probability: 0.05,
+                existence_persistence_time_s: 10.0,
             },
             classes: ClassTable {
                 car: ClassConfig {
@@ -394,6 +516,8 @@ impl Default for Config {
                     measurement_noise_covariance_m2: diagonal(0.36, 0.36),
                     radial_velocity_std_mps: 0.5,
                     initial_tangential_speed_std_mps: 2.0,
+                    radial_velocity_residual_std_mps: 1.0,
+                    existence: ExistenceConfig { detection_probability: 0.8, clutter_density_per_m2: 1e-4 },
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 5.0,
@@ -425,6 +549,8 @@ impl Default for Config {
                     measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     radial_velocity_std_mps: 0.3,
                     initial_tangential_speed_std_mps: 0.525,
+                    radial_velocity_residual_std_mps: 0.5,
+                    existence: ExistenceConfig { detection_probability: 0.7, clutter_density_per_m2: 1e-4 },
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 1.75,
@@ -456,6 +582,8 @@ impl Default for Config {
                     measurement_noise_covariance_m2: diagonal(0.16, 0.16),
                     radial_velocity_std_mps: 0.4,
                     initial_tangential_speed_std_mps: 5.0,
+                    radial_velocity_residual_std_mps: 1.0,
+                    existence: ExistenceConfig { detection_probability: 0.8, clutter_density_per_m2: 1e-4 },
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 3.0 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 15.0,
@@ -494,6 +622,15 @@ fn positive(key: &str, value: f64) -> Result<(), ConfigError> {
         Ok(())
     } else {
         Err(invalid(key, format!("must be a finite number > 0, got {}", readable(value))))
+    }
+}
+
+/// A probability strictly between 0 and 1.
+fn open_probability(key: &str, value: f64) -> Result<(), ConfigError> {
+    if value > 0.0 && value < 1.0 {
+        Ok(())
+    } else {
+        Err(invalid(key, format!("must be a probability in (0, 1), got {}", readable(value))))
     }
 }
 
@@ -646,6 +783,7 @@ fn validate_association(association: &AssociationConfig) -> Result<(), ConfigErr
     if !(association.velocity_cap_mps.is_finite() && association.velocity_cap_mps >= 0.0) {
         return Err(invalid("association.velocity_cap_mps", "must be a finite number >= 0"));
     }
+    positive("association.likelihood_gate_chi2", association.likelihood_gate_chi2)?;
     Ok(())
 }
 
@@ -670,6 +808,19 @@ fn validate_tracker_and_predictor(
     if tracker.confirmation_hits == 0 {
         return Err(invalid("tracker.confirmation_hits", "must be at least 1"));
     }
+    open_probability("tracker.initial_existence_probability", tracker.initial_existence_probability)?;
+    open_probability(
+        "tracker.confirmation_existence_probability",
+        tracker.confirmation_existence_probability,
+    )?;
+    let deletion = tracker.deletion_existence_probability;
+    if !(deletion >= 0.0 && deletion < tracker.confirmation_existence_probability) {
+        return Err(invalid(
+            "tracker.deletion_existence_probability",
+            format!("must be in [0, tracker.confirmation_existence_probability), got {}", readable(deletion)),
+        ));
+    }
+    positive("tracker.existence_persistence_time_s", tracker.existence_persistence_time_s)?;
     Ok(())
 }
 
@@ -680,6 +831,15 @@ fn validate_class(class: ObjectClass, section: &ClassConfig) -> Result<(), Confi
     covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
     positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
     positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
+    positive(&key("radial_velocity_residual_std_mps"), section.radial_velocity_residual_std_mps)?;
+    open_probability(&key("existence.detection_probability"), section.existence.detection_probability)?;
+    let clutter = section.existence.clutter_density_per_m2;
+    if !(clutter.is_finite() && clutter >= 0.0) {
+        return Err(invalid(
+            key("existence.clutter_density_per_m2"),
+            format!("must be a finite number >= 0, got {}", readable(clutter)),
+        ));
+    }
     positive(
         &key("constant_velocity.acceleration_psd_m2_per_s3"),
         section.constant_velocity.acceleration_psd_m2_per_s3,

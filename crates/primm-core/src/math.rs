@@ -28,6 +28,15 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     return libm::sincos(x);
 }
 
+/// Square root.
+#[inline(always)]
+pub fn sqrt(x: f64) -> f64 {
+    #[cfg(feature = "std")]
+    return x.sqrt();
+    #[cfg(not(feature = "std"))]
+    return libm::sqrt(x);
+}
+
 /// `x²`.
 #[inline(always)]
 pub fn square(x: f64) -> f64 {

@@ -137,6 +137,41 @@ pub struct SensorMount {
     pub y_m: f64,
     /// Boresight heading, rad, counter-clockwise from the vehicle's x axis.
     pub yaw_rad: f64,
+    /// Half opening angle of the field of view, rad, in (0, π] (absent: π, the sensor sees
+    /// all around, so every miss counts against a track's existence).
+    #[cfg_attr(feature = "serde", serde(default = "default_half_fov_rad"))]
+    pub half_fov_rad: f64,
+    /// Largest detection range, m (absent: 1000 m).
+    #[cfg_attr(feature = "serde", serde(default = "default_max_range_m"))]
+    pub max_range_m: f64,
+    /// Factor on every class's `existence.detection_probability` for this sensor,
+    /// dimensionless (absent: 1); the product must stay below 1.
+    #[cfg_attr(feature = "serde", serde(default = "one"))]
+    pub detection_probability_factor: f64,
+    /// Factor on every class's `existence.clutter_density_per_m2` for this sensor,
+    /// dimensionless (absent: 1).
+    #[cfg_attr(feature = "serde", serde(default = "one"))]
+    pub clutter_density_factor: f64,
+}
+
+/// The default of [`SensorMount::half_fov_rad`]: all around.
+pub const DEFAULT_HALF_FOV_RAD: f64 = core::f64::consts::PI;
+/// The default of [`SensorMount::max_range_m`], m.
+pub const DEFAULT_MAX_RANGE_M: f64 = 1000.0;
+
+#[cfg(feature = "serde")]
+fn default_half_fov_rad() -> f64 {
+    DEFAULT_HALF_FOV_RAD
+}
+
+#[cfg(feature = "serde")]
+fn default_max_range_m() -> f64 {
+    DEFAULT_MAX_RANGE_M
+}
+
+#[cfg(feature = "serde")]
+fn one() -> f64 {
+    1.0
 }
 
 impl SensorMount {

@@ -16,8 +16,43 @@ use heapless::HistoryBuf;
 pub enum TrackStatus {
     /// Started by an unassigned measurement, not yet confirmed by enough hits.
     Tentative = 0,
-    /// Confirmed by `tracker.confirmation_hits` hits.
+    /// Confirmed (by `tracker.confirmation_hits` hits, or by its existence probability) and
+    /// detected the last time a sensor had it in view.
     Confirmed = 1,
+    /// Confirmed, but missed the last time a sensor had it in view: its state is a
+    /// prediction since then. The next detection makes it [`Confirmed`](Self::Confirmed) again.
+    Coasting = 2,
+}
+
+impl TrackStatus {
+    /// Whether the track has been confirmed ([`Confirmed`](Self::Confirmed) or
+    /// [`Coasting`](Self::Coasting)).
+    pub fn is_confirmed(self) -> bool {
+        matches!(self, TrackStatus::Confirmed | TrackStatus::Coasting)
+    }
+
+    /// The short name used in files (`tentative`, `confirmed`, `coasting`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TrackStatus::Tentative => "tentative",
+            TrackStatus::Confirmed => "confirmed",
+            TrackStatus::Coasting => "coasting",
+        }
+    }
+
+    /// The status of a wire code (0, 1, 2), `None` for any other.
+    pub fn from_code(code: u8) -> Option<Self> {
+        [TrackStatus::Tentative, TrackStatus::Confirmed, TrackStatus::Coasting]
+            .get(usize::from(code))
+            .copied()
+    }
+
+    /// The status of a short name, `None` for any other.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [TrackStatus::Tentative, TrackStatus::Confirmed, TrackStatus::Coasting]
+            .into_iter()
+            .find(|status| status.name() == name)
+    }
 }
 
 /// A live track. A small `Copy` value; the table holds them in place.
@@ -43,13 +78,22 @@ pub struct Track {
     pub hits: u32,
     /// Consecutive frames without an associated measurement.
     pub misses: u32,
+    /// Probability that the track's object exists (see [`crate::existence`]).
+    pub existence_probability: f64,
     /// Ground-truth id of the last associated measurement (evaluation only).
     pub ground_truth_id: Option<u64>,
 }
 
 impl Track {
-    /// A new tentative track from its first measurement and timestamp.
-    pub fn new(id: u64, measurement: &Measurement, timestamp_s: f64, estimate: ImmState) -> Self {
+    /// A new tentative track from its first measurement and timestamp, with existence
+    /// probability `existence_probability`.
+    pub fn new(
+        id: u64,
+        measurement: &Measurement,
+        timestamp_s: f64,
+        estimate: ImmState,
+        existence_probability: f64,
+    ) -> Self {
         let mut track = Track {
             id,
             class: measurement.class,
@@ -61,6 +105,7 @@ impl Track {
             age_frames: 0,
             hits: 1,
             misses: 0,
+            existence_probability,
             ground_truth_id: measurement.ground_truth_id,
         };
         track.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
@@ -84,15 +129,16 @@ impl Track {
         }
     }
 
-    /// Records an associated measurement.
-    pub fn record_hit(&mut self, measurement: &Measurement, timestamp_s: f64, confirmation_hits: u32) {
+    /// Records an associated measurement (a coasting track is confirmed again; confirming a
+    /// tentative one is the lifecycle's decision).
+    pub fn record_hit(&mut self, measurement: &Measurement, timestamp_s: f64) {
         self.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
         self.last_radial_velocity_mps = measurement.radial_velocity_mps;
         self.last_update_s = timestamp_s;
         self.hits = self.hits.saturating_add(1);
         self.misses = 0;
         self.ground_truth_id = measurement.ground_truth_id;
-        if self.hits >= confirmation_hits {
+        if self.status == TrackStatus::Coasting {
             self.status = TrackStatus::Confirmed;
         }
     }
@@ -150,6 +196,8 @@ pub struct TrackOutput {
     pub hits: u32,
     /// Consecutive frames without measurement (0 when updated in this frame).
     pub misses: u32,
+    /// Probability that the track's object exists (see [`crate::existence`]).
+    pub existence_probability: f64,
     /// Ground-truth id of the measurement that updated or started the track in this frame.
     pub ground_truth_id: Option<u64>,
     /// Index in this frame of the measurement that updated or started the track; `None` when

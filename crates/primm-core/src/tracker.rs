@@ -12,8 +12,10 @@ use crate::association::assignment::AssignmentError;
 use crate::association::associator::{AssociationStats, Associator};
 use crate::config::{Config, ConfigError, LearnedProcessNoise};
 use crate::displacement_check::{check_answer, DisplacementRejection};
+use crate::existence::{self, Evidence, FieldOfView, Lifecycle};
 use crate::gaussian::UpdateError;
 use crate::imm::ImmPrior;
+use crate::limits::MAX_SENSORS;
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::mode::{Mode, ModeSet};
 use crate::motion::ModeModels;
@@ -29,7 +31,7 @@ use crate::validation::{validate_frame, validate_measurement, FrameError, Measur
 use alloc::boxed::Box;
 use alloc::vec;
 use arrayvec::ArrayVec;
-use glam::DVec2;
+use glam::{DMat2, DVec2};
 
 /// Why a step failed. The tracker's tracks are exactly as before the frame (after an
 /// association failure, up to a change of their frame; see [`TrackingFrame`]).
@@ -108,6 +110,9 @@ pub struct TrackerStats {
     pub update_failures: u64,
     /// Calls to [`Tracker::reset`].
     pub resets: u64,
+    /// Frames with a measurement whose sensor has no configured mount (or no sensor id): every
+    /// track counted as in view of that sensor, so misses counted against existence.
+    pub frames_with_unknown_sensor: u64,
 }
 
 /// What one step did: the per-frame counterpart of [`TrackerStats`]. Returned by
@@ -152,6 +157,12 @@ pub struct StepSummary {
     pub tracking_frame_changed: bool,
     /// Tracks started by a measurement whose sensor has no configured mount (world frame only).
     pub initiations_from_unknown_sensor: usize,
+    /// Tracks without a measurement that a sensor of the frame had in view (their existence
+    /// fell); the others without one were out of every scanning sensor's view.
+    pub missed_in_view: usize,
+    /// Whether a measurement of the frame named no configured sensor (see
+    /// [`TrackerStats::frames_with_unknown_sensor`]).
+    pub unknown_sensor: bool,
 }
 
 impl TrackerStats {
@@ -173,6 +184,7 @@ impl TrackerStats {
         self.update_failures += count(step.update_failures);
         self.initiations_from_unknown_sensor += count(step.initiations_from_unknown_sensor);
         self.tracking_frame_changes += u64::from(step.tracking_frame_changed);
+        self.frames_with_unknown_sensor += u64::from(step.unknown_sensor);
     }
 }
 
@@ -194,6 +206,18 @@ struct RowRecord {
 
 const EMPTY_ROW: RowRecord =
     RowRecord { prior_position_m: None, available: ModeSet::EMPTY, measurement_index: None };
+
+/// A sensor that scanned in the current frame, in the tracking frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ScanningSensor {
+    id: u16,
+    field_of_view: FieldOfView,
+    detection_probability_factor: f64,
+    clutter_density_factor: f64,
+}
+
+/// The detection probabilities are kept below 1, so that a miss never makes existence 0.
+const MAX_DETECTION_PROBABILITY: f64 = 0.999;
 
 /// The PR-IMM multi-object tracker with a learned-displacement predictor `P`.
 #[derive(Debug)]
@@ -230,6 +254,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     rows: Box<[RowRecord; MAX_TRACKS]>,
     fates: Box<[MeasurementFate; MAX_MEASUREMENTS_PER_FRAME]>,
     accepted: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// The fields of view of the sensors that scanned in the current frame, with their
+    /// detection-probability and clutter-density factors.
+    scanning_sensors: Box<ArrayVec<ScanningSensor, MAX_SENSORS>>,
     /// The current frame as read once during validation; every later stage reads this copy.
     validated: Box<ValidatedFrame>,
     outputs: Box<ArrayVec<TrackOutput, MAX_TRACKS>>,
@@ -269,6 +296,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
             accepted: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
+            scanning_sensors: Box::new(ArrayVec::new()),
             validated: Box::new(ValidatedFrame::new()),
             outputs: Box::new(ArrayVec::new()),
         })
@@ -324,7 +352,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let result = self.run_stages(frame, observer);
         self.last_step.live_tracks = self.table.len();
         self.last_step.confirmed_tracks =
-            self.table.tracks().iter().filter(|track| track.status == TrackStatus::Confirmed).count();
+            self.table.tracks().iter().filter(|track| track.status.is_confirmed()).count();
         self.stats.add_step(&self.last_step);
         result
     }
@@ -343,8 +371,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if let Some(vehicle_to_world) = self.step_pose.map(|pose| pose.vehicle_to_world()) {
             self.validated.move_positions(&vehicle_to_world);
         }
+        self.find_scanning_sensors();
         self.request_learned_predictions(t);
         self.predict_physics(dt_s);
+        self.predict_existence(dt_s);
         observer.stage_finished(Stage::Predict);
         self.fuse_priors();
         observer.stage_finished(Stage::LearnedWait);
@@ -477,6 +507,53 @@ impl<P: DisplacementPredictor> Tracker<P> {
         );
     }
 
+    /// Every track's object may have ceased to exist since the last frame: `r⁻ = p_s · r`.
+    fn predict_existence(&mut self, dt_s: f64) {
+        let survival = existence::survival_probability(dt_s, &self.config.tracker);
+        for track in self.table.tracks_mut() {
+            track.existence_probability *= survival;
+        }
+    }
+
+    /// The sensors that scanned in this frame, as its measurements name them, with their fields
+    /// of view in the tracking frame. A measurement without a sensor id or of a sensor without a
+    /// configured mount marks the frame (every track then counts as in view).
+    fn find_scanning_sensors(&mut self) {
+        self.scanning_sensors.clear();
+        for index in 0..self.validated.len() {
+            let Some(measurement) = self.validated.accepted(index) else { continue };
+            let mount = measurement.sensor_id.and_then(|id| self.config.frame.sensor(id));
+            let Some(mount) = mount else {
+                self.last_step.unknown_sensor = true;
+                continue;
+            };
+            if self.scanning_sensors.iter().any(|sensor| sensor.id == mount.id) {
+                continue;
+            }
+            // There are at most MAX_SENSORS configured mounts, so this never overflows.
+            let _ = self.scanning_sensors.try_push(ScanningSensor {
+                id: mount.id,
+                field_of_view: FieldOfView::of(mount, self.step_pose),
+                detection_probability_factor: mount.detection_probability_factor,
+                clutter_density_factor: mount.clutter_density_factor,
+            });
+        }
+    }
+
+    /// The detection probability and clutter density of `class` for the sensor `sensor_id`
+    /// (the class's own for a sensor without a configured mount).
+    fn detection_and_clutter(&self, class: ObjectClass, sensor_id: Option<u16>) -> (f64, f64) {
+        let existence = &self.config.classes.get(class).existence;
+        let (detection, clutter) = match sensor_id.and_then(|id| self.config.frame.sensor(id)) {
+            Some(mount) => (mount.detection_probability_factor, mount.clutter_density_factor),
+            None => (1.0, 1.0),
+        };
+        (
+            (existence.detection_probability * detection).min(MAX_DETECTION_PROBABILITY),
+            existence.clutter_density_per_m2 * clutter,
+        )
+    }
+
     /// Collects and checks the displacements (`displacement_check.rs`); the PR priors and the
     /// fused priors (`eq:prior_fusion`).
     fn fuse_priors(&mut self) {
@@ -557,19 +634,35 @@ impl<P: DisplacementPredictor> Tracker<P> {
             &self.assigned_measurements[..count],
             &mut self.update_outcomes[..count],
         );
-        let confirmation_hits = self.config.tracker.confirmation_hits;
-        for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
+        for i in 0..count {
             let (Some(index), Some(measurement)) =
                 (self.track_to_measurement[i], self.assigned_measurements[i])
             else {
                 continue;
             };
             if self.update_outcomes[i].is_ok() {
-                let was_confirmed = track.status == TrackStatus::Confirmed;
-                track.record_hit(&measurement, t, confirmation_hits);
+                let class = self.table.tracks()[i].class;
+                let (detection, clutter) = self.detection_and_clutter(class, measurement.sensor_id);
+                let prior = &self.priors[i].fused;
+                let likelihood = existence::gaussian_density_per_m2(
+                    measurement.position() - prior.mean,
+                    prior.covariance
+                        + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2),
+                );
+                let tracker = &self.config.tracker;
+                let track = &mut self.table.tracks_mut()[i];
+                track.existence_probability = existence::updated_existence(
+                    track.existence_probability,
+                    Evidence::Detected { likelihood_per_m2: likelihood },
+                    detection,
+                    clutter,
+                );
+                track.record_hit(&measurement, t);
+                if track.status == TrackStatus::Tentative && confirms(track, tracker) {
+                    track.status = TrackStatus::Confirmed;
+                    self.last_step.newly_confirmed += 1;
+                }
                 self.last_step.assigned += 1;
-                self.last_step.newly_confirmed +=
-                    usize::from(!was_confirmed && track.status == TrackStatus::Confirmed);
                 self.fates[usize::from(index)] = MeasurementFate::Assigned;
             } else {
                 // Numerically unusable: the track coasts and the measurement is free to start a
@@ -580,14 +673,47 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Tracks without a measurement keep their priors; every existing track's frame record.
+    /// Tracks without a measurement keep their priors, and lose existence if a sensor of the
+    /// frame had them in view (a confirmed one then coasts); every existing track's frame
+    /// record.
     fn coast(&mut self) {
-        for (i, track) in self.table.tracks_mut().iter_mut().enumerate() {
+        for i in 0..self.table.len() {
             let measurement_index = self.track_to_measurement[i];
             if measurement_index.is_none() {
+                let track = &self.table.tracks()[i];
+                let mut existence_probability = track.existence_probability;
+                let mut missed = false;
+                let prior_m = self.priors[i].fused.mean;
+                for sensor in self.scanning_sensors.iter().filter(|s| s.field_of_view.contains(prior_m)) {
+                    let (detection, clutter) = self.detection_and_clutter(track.class, Some(sensor.id));
+                    existence_probability = existence::updated_existence(
+                        existence_probability,
+                        Evidence::MissedInView,
+                        detection,
+                        clutter,
+                    );
+                    missed = true;
+                }
+                if self.last_step.unknown_sensor {
+                    let (detection, clutter) = self.detection_and_clutter(track.class, None);
+                    existence_probability = existence::updated_existence(
+                        existence_probability,
+                        Evidence::MissedInView,
+                        detection,
+                        clutter,
+                    );
+                    missed = true;
+                }
+                self.last_step.missed_in_view += usize::from(missed);
+                let track = &mut self.table.tracks_mut()[i];
                 track.estimate = self.imms[track.class.index()].coast(&self.priors[i]);
                 track.record_miss();
+                track.existence_probability = existence_probability;
+                if missed && track.status == TrackStatus::Confirmed {
+                    track.status = TrackStatus::Coasting;
+                }
             }
+            let track = &mut self.table.tracks_mut()[i];
             track.age_frames = track.age_frames.saturating_add(1);
             self.rows[i] = RowRecord {
                 prior_position_m: Some(self.priors[i].fused.mean),
@@ -599,7 +725,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Every accepted, unassigned measurement starts a tentative track.
     fn initiate(&mut self, t: f64) {
-        let confirmation_hits = self.config.tracker.confirmation_hits;
+        let initial_existence = self.config.tracker.initial_existence_probability;
         for index in 0..self.validated.len() {
             if self.fates[index] != MeasurementFate::Unassigned {
                 continue;
@@ -611,11 +737,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 &measurement,
                 sensor_position_m,
             );
-            match self.table.insert(|id| Track::new(id, &measurement, t, estimate)) {
+            let tracker = &self.config.tracker;
+            match self.table.insert(|id| Track::new(id, &measurement, t, estimate, initial_existence)) {
                 Ok(track) => {
                     self.last_step.initiated += 1;
-                    // A confirmation threshold of one hit confirms at once.
-                    if track.hits >= confirmation_hits {
+                    // A confirmation threshold of one hit (or an initial existence at the
+                    // threshold) confirms at once.
+                    if confirms(track, tracker) {
                         track.status = TrackStatus::Confirmed;
                         self.last_step.newly_confirmed += 1;
                     }
@@ -631,18 +759,27 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Removes tentative tracks after `tentative_max_misses` misses or `tentative_max_coast_s`
-    /// without update, confirmed ones after `confirmed_max_misses` or `max_coast_s`.
+    /// Removes tentative tracks after `tentative_max_coast_s` without update, confirmed ones
+    /// after `max_coast_s`; and by the lifecycle: tracks whose existence probability fell below
+    /// `deletion_existence_probability`, or (counting) tentative tracks after
+    /// `tentative_max_misses` misses and confirmed ones after `confirmed_max_misses`.
     fn delete(&mut self, t: f64) {
         let lifecycle = &self.config.tracker;
         let rows = &mut self.rows;
         let (mut read, mut write) = (0, 0);
         let deleted = self.table.retain(|track| {
-            let (max_misses, max_coast_s) = match track.status {
-                TrackStatus::Tentative => (lifecycle.tentative_max_misses, lifecycle.tentative_max_coast_s),
-                TrackStatus::Confirmed => (lifecycle.confirmed_max_misses, lifecycle.max_coast_s),
+            let (max_misses, max_coast_s) = if track.status.is_confirmed() {
+                (lifecycle.confirmed_max_misses, lifecycle.max_coast_s)
+            } else {
+                (lifecycle.tentative_max_misses, lifecycle.tentative_max_coast_s)
             };
-            let keep = track.misses <= max_misses && t - track.last_update_s <= max_coast_s;
+            let alive = match lifecycle.lifecycle {
+                Lifecycle::Counts => track.misses <= max_misses,
+                Lifecycle::Existence => {
+                    track.existence_probability >= lifecycle.deletion_existence_probability
+                }
+            };
+            let keep = alive && t - track.last_update_s <= max_coast_s;
             if keep {
                 rows[write] = rows[read];
                 write += 1;
@@ -717,6 +854,20 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 }
 
+/// Whether a tentative `track` has earned confirmation under the configured lifecycle.
+fn confirms(track: &Track, tracker: &crate::config::TrackerConfig) -> bool {
+    match tracker.lifecycle {
+        Lifecycle::Counts => track.hits >= tracker.confirmation_hits,
+        Lifecycle::Existence => track.existence_probability >= tracker.confirmation_existence_probability,
+    }
+}
+
+/// A configuration covariance as a matrix, m².
+fn covariance(value: &crate::config::Covariance2) -> DMat2 {
+    let [[xx, xy], [yx, yy]] = *value;
+    DMat2::from_cols(DVec2::new(xx, yx), DVec2::new(xy, yy))
+}
+
 /// The output record of every live track, handed to `sink`. Tracks in the world frame are
 /// reported in the vehicle frame of the current frame (`world_to_vehicle`) with their world
 /// position and velocity beside.
@@ -754,6 +905,7 @@ fn report(
             age_frames: track.age_frames,
             hits: track.hits,
             misses: track.misses,
+            existence_probability: track.existence_probability,
             ground_truth_id: row.measurement_index.and(track.ground_truth_id),
             measurement_index: row.measurement_index,
         });

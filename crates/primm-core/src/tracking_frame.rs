@@ -64,7 +64,17 @@ impl Default for FrameConfig {
     /// World frame; RadarScenes' four front and side radars (ids 1–4), as the scenario
     /// generator mounts them.
     fn default() -> Self {
-        let mount = |id, x_m, y_m, yaw_deg: f64| SensorMount { id, x_m, y_m, yaw_rad: yaw_deg.to_radians() };
+        // Opening ±60° and range 100 m, as the generator's radars (`primm_sim::scenario`).
+        let mount = |id, x_m, y_m, yaw_deg: f64| SensorMount {
+            id,
+            x_m,
+            y_m,
+            yaw_rad: yaw_deg.to_radians(),
+            half_fov_rad: 60f64.to_radians(),
+            max_range_m: 100.0,
+            detection_probability_factor: 1.0,
+            clutter_density_factor: 1.0,
+        };
         let mut sensors = ArrayVec::new();
         sensors.push(mount(1, 3.66, -0.87, -85.0));
         sensors.push(mount(2, 3.86, -0.70, -25.0));
@@ -91,6 +101,21 @@ impl FrameConfig {
                     "frame.sensors",
                     "a sensor is mounted more than 100 m from the reference point",
                 ));
+            }
+            if !(mount.half_fov_rad > 0.0 && mount.half_fov_rad <= core::f64::consts::PI) {
+                return Some(("frame.sensors", "every half_fov_rad must lie in (0, pi]"));
+            }
+            if !(mount.max_range_m > 0.0 && mount.max_range_m.is_finite()) {
+                return Some(("frame.sensors", "every max_range_m must be a finite number > 0"));
+            }
+            if !(mount.detection_probability_factor > 0.0 && mount.detection_probability_factor.is_finite()) {
+                return Some((
+                    "frame.sensors",
+                    "every detection_probability_factor must be a finite number > 0",
+                ));
+            }
+            if !(mount.clutter_density_factor >= 0.0 && mount.clutter_density_factor.is_finite()) {
+                return Some(("frame.sensors", "every clutter_density_factor must be a finite number >= 0"));
             }
             if self.sensors[..index].iter().any(|other| other.id == mount.id) {
                 return Some(("frame.sensors", "sensor ids must be unique"));

@@ -50,8 +50,11 @@ pub const PRIMM_OBJECT_CLASS_TWO_WHEELER: PrimmObjectClass = 2;
 pub type PrimmTrackStatus = u8;
 /// Started by an unassigned measurement, not yet confirmed.
 pub const PRIMM_TRACK_STATUS_TENTATIVE: PrimmTrackStatus = 0;
-/// Confirmed by `tracker.confirmation_hits` hits.
+/// Confirmed (by hits or by its existence probability) and detected the last time a sensor had
+/// it in view.
 pub const PRIMM_TRACK_STATUS_CONFIRMED: PrimmTrackStatus = 1;
+/// Confirmed, but missed the last time a sensor had it in view (its state is a prediction since).
+pub const PRIMM_TRACK_STATUS_COASTING: PrimmTrackStatus = 2;
 
 /// `ground_truth_id` value meaning "unknown".
 pub const PRIMM_NO_GROUND_TRUTH_ID: i64 = -1;
@@ -71,6 +74,7 @@ const _: () = {
     assert!(PRIMM_OBJECT_CLASS_TWO_WHEELER == ObjectClass::TwoWheeler as u8);
     assert!(PRIMM_TRACK_STATUS_TENTATIVE == TrackStatus::Tentative as u8);
     assert!(PRIMM_TRACK_STATUS_CONFIRMED == TrackStatus::Confirmed as u8);
+    assert!(PRIMM_TRACK_STATUS_COASTING == TrackStatus::Coasting as u8);
 };
 
 /// The method of a code: `Ok(None)` for [`PRIMM_METHOD_CONFIG`], `Err(code)` for an unknown code.
@@ -189,6 +193,8 @@ pub struct PrimmTrack {
     pub hits: u32,
     /// Consecutive frames without measurement (0 when updated in this step).
     pub misses: u32,
+    /// Probability that the track's object exists, in (0, 1).
+    pub existence_probability: f64,
     /// Index, in this step's measurement array, of the measurement that updated or started the
     /// track, or `PRIMM_NO_MEASUREMENT_INDEX` when the track coasted.
     pub measurement_index: i32,
@@ -244,6 +250,7 @@ impl PrimmTrack {
         age_frames: 0,
         hits: 0,
         misses: 0,
+        existence_probability: 0.0,
         measurement_index: PRIMM_NO_MEASUREMENT_INDEX,
         class_code: PRIMM_OBJECT_CLASS_CAR,
         status: PRIMM_TRACK_STATUS_TENTATIVE,
@@ -277,6 +284,7 @@ impl From<&TrackOutput> for PrimmTrack {
             age_frames: output.age_frames,
             hits: output.hits,
             misses: output.misses,
+            existence_probability: output.existence_probability,
             measurement_index: output.measurement_index.map_or(PRIMM_NO_MEASUREMENT_INDEX, i32::from),
             class_code: output.class.code(),
             status: output.status as u8,
@@ -401,6 +409,9 @@ pub struct PrimmStats {
     pub update_failures: u64,
     /// Calls to `primm_tracker_reset`.
     pub resets: u64,
+    /// Frames with a measurement whose sensor has no configured mount (or no sensor id): every
+    /// track counted as in view of that sensor.
+    pub frames_with_unknown_sensor: u64,
 }
 
 impl From<&TrackerStats> for PrimmStats {
@@ -432,6 +443,7 @@ impl From<&TrackerStats> for PrimmStats {
             learned_predictions_rejected_invalid_covariance,
             update_failures,
             resets,
+            frames_with_unknown_sensor,
         } = *stats;
         PrimmStats {
             frames_tracked,
@@ -459,6 +471,7 @@ impl From<&TrackerStats> for PrimmStats {
             learned_predictions_rejected_invalid_covariance,
             update_failures,
             resets,
+            frames_with_unknown_sensor,
         }
     }
 }

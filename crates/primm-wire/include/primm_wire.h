@@ -15,7 +15,7 @@
 
 #include <stdint.h>
 
-#define PRIMM_WIRE_VERSION 2 /* layout version; primm_track_frame.wire_version carries the writer's */
+#define PRIMM_WIRE_VERSION 3 /* layout version; primm_track_frame.wire_version carries the writer's */
 #define PRIMM_MEASUREMENT_CAPACITY 256
 #define PRIMM_TRACK_CAPACITY 512
 #define PRIMM_STAGE_CAPACITY 12
@@ -78,7 +78,7 @@ typedef struct primm_measurement_frame {
     primm_wire_measurement measurements[PRIMM_MEASUREMENT_CAPACITY];
 } primm_measurement_frame;
 
-/* One track: 184 bytes. With world_valid == 1 the frame was tracked in the world frame: x, y,
+/* One track: 192 bytes. With world_valid == 1 the frame was tracked in the world frame: x, y,
  * covariance, prior and velocity are in the vehicle frame of the input frame (velocity over
  * ground in the vehicle's axes), world_* in the world frame. */
 typedef struct primm_wire_track {
@@ -95,19 +95,20 @@ typedef struct primm_wire_track {
     double world_y_m;
     double world_vx_mps;
     double world_vy_mps;
+    double existence_probability; /* probability that the object exists, (0, 1) */
     int64_t gt_id;                /* -1: none */
     uint32_t age_frames;
     uint32_t hits;
     uint32_t misses;
     int32_t measurement_index;    /* PRIMM_MEASUREMENT_INDEX_NONE: coasted */
     uint8_t class_code;
-    uint8_t status;               /* 0 tentative, 1 confirmed */
+    uint8_t status;               /* 0 tentative, 1 confirmed, 2 coasting */
     uint8_t prior_valid;
     uint8_t world_valid;
     uint8_t _pad0[4];
 } primm_wire_track;
 
-/* "primm::TrackFrame": 94272 bytes. */
+/* "primm::TrackFrame": 98368 bytes. */
 typedef struct primm_track_frame {
     uint64_t input_sequence;
     uint64_t source_frame;

@@ -9,7 +9,7 @@ nanoseconds (``time.monotonic_ns()``), ``_s`` times are sensor seconds.
 
 import ctypes
 
-WIRE_VERSION = 2  # layout version; TrackFrame.wire_version carries the writer's
+WIRE_VERSION = 3  # layout version; TrackFrame.wire_version carries the writer's
 MEASUREMENT_CAPACITY = 256
 TRACK_CAPACITY = 512
 STAGE_CAPACITY = 12
@@ -94,7 +94,7 @@ class MeasurementFrame(ctypes.Structure):
 
 
 class WireTrack(ctypes.Structure):
-    """One track's fused state (184 bytes)."""
+    """One track's fused state (192 bytes)."""
 
     _fields_ = [
         ("id", ctypes.c_uint64),
@@ -110,6 +110,7 @@ class WireTrack(ctypes.Structure):
         ("world_y_m", ctypes.c_double),
         ("world_vx_mps", ctypes.c_double),
         ("world_vy_mps", ctypes.c_double),
+        ("existence_probability", ctypes.c_double),
         ("gt_id", ctypes.c_int64),
         ("age_frames", ctypes.c_uint32),
         ("hits", ctypes.c_uint32),
@@ -128,7 +129,7 @@ class WireTrack(ctypes.Structure):
 
 
 class TrackFrame(ctypes.Structure):
-    """The tracker's answer to one measurement frame (94272 bytes)."""
+    """The tracker's answer to one measurement frame (98368 bytes)."""
 
     _fields_ = [
         ("input_sequence", ctypes.c_uint64),

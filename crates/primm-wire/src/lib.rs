@@ -56,9 +56,10 @@
 /// Version of the payload layouts. It changes whenever a layout changes; the tracker writes it
 /// into every [`TrackFrame`] (`wire_version`), and the C header (`PRIMM_WIRE_VERSION`) and the
 /// Python module (`WIRE_VERSION`) declare it beside their layouts. Version 2 added the
-/// world-frame fields of [`WireTrack`] and [`FrameStatus::RejectedInvalidEgoPose`]. (iceoryx2
+/// world-frame fields of [`WireTrack`] and [`FrameStatus::RejectedInvalidEgoPose`]; version 3
+/// its `existence_probability` and the status code 2 (coasting). (iceoryx2
 /// also refuses to connect a publisher and a subscriber whose payload sizes differ.)
-pub const WIRE_VERSION: u16 = 2;
+pub const WIRE_VERSION: u16 = 3;
 
 mod latency_report;
 mod measurement_frame;

@@ -4,7 +4,7 @@
 use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 use iceoryx2::prelude::ZeroCopySend;
-use primm_core::track::{TrackOutput, TrackStatus};
+use primm_core::track::TrackOutput;
 use primm_core::track_table::MAX_TRACKS;
 use primm_core::tracker::StepError;
 use primm_core::validation::FrameError;
@@ -100,7 +100,7 @@ impl FrameStatus {
     }
 }
 
-/// One track's fused state: 184 bytes, alignment 8.
+/// One track's fused state: 192 bytes, alignment 8.
 ///
 /// When the frame was tracked in the world frame (`world_valid` 1), the position, covariance,
 /// prior and velocity are in the vehicle frame of the input frame (the velocity is the velocity
@@ -136,6 +136,8 @@ pub struct WireTrack {
     pub world_vx_mps: f64,
     /// Fused velocity over ground in the world frame, m/s (valid when `world_valid` is 1).
     pub world_vy_mps: f64,
+    /// Probability that the track's object exists, in (0, 1).
+    pub existence_probability: f64,
     /// Ground-truth id of the measurement that updated or started the track in this frame;
     /// -1 when none (coasting, or no ground truth).
     pub gt_id: i64,
@@ -150,7 +152,8 @@ pub struct WireTrack {
     pub measurement_index: i32,
     /// Object class code (0 car, 1 pedestrian, 2 two-wheeler).
     pub class_code: u8,
-    /// Lifecycle status (0 tentative, 1 confirmed).
+    /// Lifecycle status (0 tentative, 1 confirmed, 2 coasting: confirmed but missed the last
+    /// time a sensor had it in view).
     pub status: u8,
     /// 1 when `prior_x_m`/`prior_y_m` are valid (0 for a track started in this frame).
     pub prior_valid: u8,
@@ -189,16 +192,14 @@ impl WireTrack {
             world_y_m: world_position.map_or(0.0, |p| p.y),
             world_vx_mps: world_velocity.map_or(0.0, |v| v.x),
             world_vy_mps: world_velocity.map_or(0.0, |v| v.y),
+            existence_probability: output.existence_probability,
             gt_id: output.ground_truth_id.and_then(|id| i64::try_from(id).ok()).unwrap_or(-1),
             age_frames: output.age_frames,
             hits: output.hits,
             misses: output.misses,
             measurement_index: output.measurement_index.map_or(MEASUREMENT_INDEX_NONE, i32::from),
             class_code: output.class.code(),
-            status: match output.status {
-                TrackStatus::Tentative => 0,
-                TrackStatus::Confirmed => 1,
-            },
+            status: output.status as u8,
             prior_valid: u8::from(prior.is_some()),
             world_valid: u8::from(world_position.is_some()),
             _pad0: [0; 4],
@@ -226,7 +227,7 @@ impl WireTrack {
     }
 }
 
-/// The tracker's output for one input frame: 94 272 bytes, alignment 8.
+/// The tracker's output for one input frame: 98 368 bytes, alignment 8.
 #[repr(C)]
 #[derive(Debug, ZeroCopySend)]
 #[type_name("primm::TrackFrame")]

@@ -99,6 +99,7 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 world_y_m,
                 world_vx_mps,
                 world_vy_mps,
+                existence_probability,
                 gt_id,
                 age_frames,
                 hits,
@@ -211,8 +212,8 @@ fn the_rust_types_have_no_implicit_padding() {
     }
     assert_eq!(size_of::<WireMeasurement>(), 64);
     assert_eq!(size_of::<MeasurementFrame>(), 16_448);
-    assert_eq!(size_of::<WireTrack>(), 184);
-    assert_eq!(size_of::<TrackFrame>(), 94_272);
+    assert_eq!(size_of::<WireTrack>(), 192);
+    assert_eq!(size_of::<TrackFrame>(), 98_368);
     assert_eq!(size_of::<LatencyReport>(), 1032);
 }
 

@@ -21,13 +21,27 @@
 //!    on its own: a lone track-measurement pair directly, larger clusters by the optimal solver
 //!    on their own small dense matrix.
 //!
+//! # Stages
+//!
+//! With `association.stages = "confirmed_first"` each class is associated in two stages, each
+//! optimal within itself: the confirmed tracks first, over all of the class's measurements,
+//! then the tentative tracks over the measurements the first stage left. A tentative track,
+//! often born of a false detection, can then never take a measurement that a confirmed track
+//! gates in and prefers. With `"joint"` all tracks of the class are one problem.
+//!
+//! # Costs
+//!
+//! `association.cost = "paper"` is `eq:association_cost` gated at `classes.<class>.gate_m`;
+//! `"likelihood"` is the negative log-likelihood of [`LikelihoodPrior`] gated by χ². Both
+//! bound `|Δx|` per track, which is all the x-sorted gating needs.
+//!
 //! The result is the same optimum as one dense solve (a property test checks it against a dense
 //! solve and against the `pathfinding` crate's Kuhn–Munkres), at a cost of
 //! `O(T log M + pairs + Σ cluster³)` instead of `O(T·M + T²·M)`. All buffers are allocated once.
 
 use super::assignment::{AssignmentError, AssignmentSolver};
-use super::cost::association_cost;
-use crate::config::Config;
+use super::cost::{association_cost, LikelihoodPrior};
+use crate::config::{AssociationCost, AssociationStages, Config};
 use crate::imm::ImmPrior;
 use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::track::Track;
@@ -86,7 +100,30 @@ pub struct Associator {
     /// Position of a column inside its cluster's dense matrix.
     local_column: Box<[u16]>,
     row_to_column: Box<[Option<usize>]>,
+    /// Whether each measurement of the frame was assigned in an earlier stage.
+    taken: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
     stats: AssociationStats,
+}
+
+/// Which tracks of a class one stage associates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// Every track.
+    All,
+    /// Confirmed tracks (coasting ones included).
+    Confirmed,
+    /// Tentative tracks.
+    Tentative,
+}
+
+impl Stage {
+    fn admits(self, track: &Track) -> bool {
+        match self {
+            Stage::All => true,
+            Stage::Confirmed => track.status.is_confirmed(),
+            Stage::Tentative => !track.status.is_confirmed(),
+        }
+    }
 }
 
 impl Default for Associator {
@@ -112,11 +149,13 @@ impl Associator {
             member_start: vec![0; NODES + 1].into_boxed_slice(),
             local_column: vec![0; MAX_MEASUREMENTS_PER_FRAME].into_boxed_slice(),
             row_to_column: vec![None; MAX_TRACKS].into_boxed_slice(),
+            taken: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
             stats: AssociationStats::default(),
         }
     }
 
-    /// Assigns measurements to tracks of the same class.
+    /// Assigns measurements to tracks of the same class, in the stages of
+    /// `association.stages`.
     ///
     /// `accepted[j]` says whether measurement `j` passed validation; `priors[i]` is track `i`'s
     /// fused prior. On return `track_to_measurement[i]` holds the measurement assigned to track
@@ -132,29 +171,74 @@ impl Associator {
     ) -> Result<(), AssignmentError> {
         track_to_measurement[..tracks.len()].fill(None);
         self.stats = AssociationStats::default();
+        self.taken[..frame.len()].fill(false);
+        let stages: &[Stage] = match config.association.stages {
+            AssociationStages::Joint => &[Stage::All],
+            AssociationStages::ConfirmedFirst => &[Stage::Confirmed, Stage::Tentative],
+        };
         for class in ObjectClass::ALL {
-            self.rows.clear();
-            self.rows.extend((0..tracks.len()).filter(|&i| tracks[i].class == class).map(|i| i as u16));
-            self.columns.clear();
-            self.sorted_x.clear();
-            for j in 0..frame.len() {
-                if !accepted[j] {
-                    continue;
-                }
-                if let Ok(measurement) = frame.measurement(j) {
-                    if measurement.class == class {
-                        self.sorted_x.push((measurement.x_m, self.columns.len() as u16));
-                        self.columns.push(j as u16);
-                    }
-                }
+            for &stage in stages {
+                self.associate_stage(
+                    tracks,
+                    priors,
+                    frame,
+                    accepted,
+                    config,
+                    class,
+                    stage,
+                    track_to_measurement,
+                )?;
             }
-            if self.rows.is_empty() || self.columns.is_empty() {
+        }
+        Ok(())
+    }
+
+    /// One optimal assignment: the tracks of `class` that `stage` admits, the accepted
+    /// measurements of `class` that no earlier stage took.
+    fn associate_stage<F: FrameView + ?Sized>(
+        &mut self,
+        tracks: &[Track],
+        priors: &[ImmPrior],
+        frame: &F,
+        accepted: &[bool],
+        config: &Config,
+        class: ObjectClass,
+        stage: Stage,
+        track_to_measurement: &mut [Option<u16>],
+    ) -> Result<(), AssignmentError> {
+        self.rows.clear();
+        self.rows.extend(
+            (0..tracks.len())
+                .filter(|&i| tracks[i].class == class && stage.admits(&tracks[i]))
+                .map(|i| i as u16),
+        );
+        self.columns.clear();
+        self.sorted_x.clear();
+        for j in 0..frame.len() {
+            if !accepted[j] || self.taken[j] {
                 continue;
             }
-            self.sorted_x.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-            self.gate(tracks, priors, frame, config, class);
-            self.cluster();
-            self.solve_clusters(track_to_measurement)?;
+            if let Ok(measurement) = frame.measurement(j) {
+                if measurement.class == class {
+                    self.sorted_x.push((measurement.x_m, self.columns.len() as u16));
+                    self.columns.push(j as u16);
+                }
+            }
+        }
+        if self.rows.is_empty() || self.columns.is_empty() {
+            return Ok(());
+        }
+        self.sorted_x.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        match config.association.cost {
+            AssociationCost::Paper => self.gate_paper(tracks, priors, frame, config, class),
+            AssociationCost::Likelihood => self.gate_likelihood(tracks, priors, frame, config, class),
+        }
+        self.cluster();
+        self.solve_clusters(track_to_measurement)?;
+        for &track_index in self.rows.iter() {
+            if let Some(column) = track_to_measurement[usize::from(track_index)] {
+                self.taken[usize::from(column)] = true;
+            }
         }
         Ok(())
     }
@@ -164,8 +248,9 @@ impl Associator {
         &self.stats
     }
 
-    /// Fills `pairs` with every allowed pair of the current class, row by row.
-    fn gate<F: FrameView + ?Sized>(
+    /// Fills `pairs` with every pair of the current class that `eq:association_cost` gates in,
+    /// row by row.
+    fn gate_paper<F: FrameView + ?Sized>(
         &mut self,
         tracks: &[Track],
         priors: &[ImmPrior],
@@ -195,6 +280,51 @@ impl Associator {
                     &config.association,
                 );
                 if cost <= gate {
+                    self.pairs[count] = Pair { row: r as u16, column, cost };
+                    count += 1;
+                }
+            }
+        }
+        self.row_start[self.rows.len()] = count as u32;
+        self.stats.allowed_pairs += count;
+    }
+
+    /// Fills `pairs` with every pair of the current class that the likelihood cost's χ² gate
+    /// lets through, row by row.
+    fn gate_likelihood<F: FrameView + ?Sized>(
+        &mut self,
+        tracks: &[Track],
+        priors: &[ImmPrior],
+        frame: &F,
+        config: &Config,
+        class: ObjectClass,
+    ) {
+        let section = config.classes.get(class);
+        let [[xx, xy], [yx, yy]] = section.measurement_noise_covariance_m2;
+        let noise = glam::DMat2::from_cols(glam::DVec2::new(xx, yx), glam::DVec2::new(xy, yy));
+        let mut count = 0usize;
+        for (r, &track_index) in self.rows.iter().enumerate() {
+            self.row_start[r] = count as u32;
+            let track = &tracks[usize::from(track_index)];
+            let prepared = LikelihoodPrior::new(
+                &priors[usize::from(track_index)].fused,
+                noise,
+                track.last_radial_velocity_mps,
+                section.radial_velocity_residual_std_mps,
+                config.association.likelihood_gate_chi2,
+            );
+            let Some(prepared) = prepared else { continue };
+            let (x, half) = (prepared.mean_m().x, prepared.x_half_window_m());
+            let first = self.sorted_x.partition_point(|&(mx, _)| mx < x - half);
+            for &(mx, column) in &self.sorted_x[first..] {
+                if mx > x + half {
+                    break;
+                }
+                let Ok(measurement) = frame.measurement(usize::from(self.columns[usize::from(column)]))
+                else {
+                    continue;
+                };
+                if let Some(cost) = prepared.cost(&measurement) {
                     self.pairs[count] = Pair { row: r as u16, column, cost };
                     count += 1;
                 }

@@ -1,8 +1,11 @@
-//! The association cost of `eq:association_cost`.
+//! The association costs: the paper's `eq:association_cost`, and a negative log-likelihood with
+//! a χ² gate.
 
 use crate::config::AssociationConfig;
+use crate::gaussian::PositionEstimate;
+use crate::math;
 use crate::measurement::Measurement;
-use glam::DVec2;
+use glam::{DMat2, DVec2};
 
 /// `d = ‖z − p⁻‖ + λ_v·min(|v_r − v_r^last|, v_max)`: Euclidean distance from the track's fused
 /// prior to the measurement plus the capped, weighted radial-velocity difference, in metres.
@@ -17,9 +20,74 @@ pub fn association_cost(
     distance + config.velocity_weight_s * velocity_difference.min(config.velocity_cap_mps)
 }
 
+/// A track's prior prepared for the `likelihood` cost (`association.cost = "likelihood"`):
+/// the inverse and log-determinant of the innovation covariance `S = P⁻ + R`, computed once per
+/// track and frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LikelihoodPrior {
+    mean_m: DVec2,
+    inverse_m2: DMat2,
+    log_determinant: f64,
+    last_radial_velocity_mps: f64,
+    inverse_velocity_variance: f64,
+    gate_chi2: f64,
+    x_half_window_m: f64,
+}
+
+impl LikelihoodPrior {
+    /// The prepared prior of a track with fused prior `prior`, the class's measurement noise
+    /// `measurement_noise_m2` and radial-velocity residual spread, and the χ² gate. `None` when
+    /// `S` is not positive definite (the track takes no measurement this frame).
+    pub fn new(
+        prior: &PositionEstimate,
+        measurement_noise_m2: DMat2,
+        last_radial_velocity_mps: f64,
+        radial_velocity_residual_std_mps: f64,
+        gate_chi2: f64,
+    ) -> Option<Self> {
+        let innovation_covariance = prior.covariance + measurement_noise_m2;
+        let determinant = innovation_covariance.determinant();
+        let xx = innovation_covariance.x_axis.x;
+        if !(determinant > 0.0 && determinant.is_finite() && xx > 0.0) {
+            return None;
+        }
+        Some(LikelihoodPrior {
+            mean_m: prior.mean,
+            inverse_m2: innovation_covariance.inverse(),
+            log_determinant: math::ln(determinant),
+            last_radial_velocity_mps,
+            inverse_velocity_variance: 1.0 / math::square(radial_velocity_residual_std_mps),
+            gate_chi2,
+            // Within the gate, (Δx)² ≤ χ² · S_xx.
+            x_half_window_m: math::sqrt(gate_chi2 * xx),
+        })
+    }
+
+    /// The prior position, m.
+    pub fn mean_m(&self) -> DVec2 {
+        self.mean_m
+    }
+
+    /// Half width of the x-window holding every measurement the gate can let through, m.
+    pub fn x_half_window_m(&self) -> f64 {
+        self.x_half_window_m
+    }
+
+    /// `νᵀS⁻¹ν + (Δv_r)²/σ_v² + ln det S` for a measurement inside the gate (the first two
+    /// terms at most `likelihood_gate_chi2`), `None` beyond it.
+    pub fn cost(&self, measurement: &Measurement) -> Option<f64> {
+        let innovation = measurement.position() - self.mean_m;
+        let velocity_difference = measurement.radial_velocity_mps - self.last_radial_velocity_mps;
+        let squared_distance = innovation.dot(self.inverse_m2 * innovation)
+            + math::square(velocity_difference) * self.inverse_velocity_variance;
+        (squared_distance <= self.gate_chi2).then_some(squared_distance + self.log_determinant)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::Config;
     use crate::measurement::ObjectClass;
 
     fn measurement(x: f64, y: f64, radial_velocity: f64) -> Measurement {
@@ -36,15 +104,58 @@ mod tests {
 
     #[test]
     fn cost_is_distance_plus_weighted_velocity_difference() {
-        let config = AssociationConfig { velocity_weight_s: 0.1, velocity_cap_mps: 5.0 };
+        let config = AssociationConfig {
+            velocity_weight_s: 0.1,
+            velocity_cap_mps: 5.0,
+            ..Config::default().association
+        };
         let cost = association_cost(DVec2::new(0.0, 0.0), 2.0, &measurement(3.0, 4.0, 4.5), &config);
         assert!((cost - (5.0 + 0.1 * 2.5)).abs() < 1e-12);
     }
 
     #[test]
     fn the_velocity_difference_is_capped() {
-        let config = AssociationConfig { velocity_weight_s: 0.1, velocity_cap_mps: 5.0 };
+        let config = AssociationConfig {
+            velocity_weight_s: 0.1,
+            velocity_cap_mps: 5.0,
+            ..Config::default().association
+        };
         let cost = association_cost(DVec2::new(1.0, 1.0), -20.0, &measurement(1.0, 1.0, 20.0), &config);
         assert!((cost - 0.5).abs() < 1e-12);
+    }
+
+    fn prior(covariance: DMat2) -> PositionEstimate {
+        PositionEstimate { mean: DVec2::new(10.0, -2.0), covariance }
+    }
+
+    #[test]
+    fn the_likelihood_cost_is_the_mahalanobis_distance_plus_the_log_determinant() {
+        let p = DMat2::from_cols(DVec2::new(0.5, 0.1), DVec2::new(0.1, 0.3));
+        let r = DMat2::from_diagonal(DVec2::new(0.2, 0.2));
+        let prepared = LikelihoodPrior::new(&prior(p), r, 3.0, 0.5, 16.27).unwrap();
+        let m = measurement(10.6, -2.4, 3.4);
+        let s = p + r;
+        let nu = DVec2::new(0.6, -0.4);
+        let expected = nu.dot(s.inverse() * nu) + (0.4f64 / 0.5).powi(2) + s.determinant().ln();
+        assert!((prepared.cost(&m).unwrap() - expected).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_likelihood_gate_refuses_what_lies_beyond_it_and_the_window_covers_the_gate() {
+        let p = DMat2::from_diagonal(DVec2::new(1.0, 4.0));
+        let prepared = LikelihoodPrior::new(&prior(p), DMat2::ZERO, 0.0, 1.0, 9.0).unwrap();
+        assert!((prepared.x_half_window_m() - 3.0).abs() < 1e-12);
+        assert!(prepared.cost(&measurement(12.9, -2.0, 0.0)).is_some());
+        assert!(prepared.cost(&measurement(13.1, -2.0, 0.0)).is_none());
+        // Along y the spread is twice as wide; the radial velocity adds to the distance.
+        assert!(prepared.cost(&measurement(10.0, 3.9, 0.0)).is_some());
+        assert!(prepared.cost(&measurement(10.0, 3.9, 1.0)).is_none());
+    }
+
+    #[test]
+    fn an_innovation_covariance_that_is_not_positive_definite_gives_no_prepared_prior() {
+        assert!(LikelihoodPrior::new(&prior(DMat2::ZERO), DMat2::ZERO, 0.0, 1.0, 9.0).is_none());
+        let nan = DMat2::from_diagonal(DVec2::new(f64::NAN, 1.0));
+        assert!(LikelihoodPrior::new(&prior(nan), DMat2::ZERO, 0.0, 1.0, 9.0).is_none());
     }
 }

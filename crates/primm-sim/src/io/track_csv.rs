@@ -1,10 +1,13 @@
 //! The track file format written by `primm track` and `primm-subscriber --csv`.
 //!
-//! Header `frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct`; one row
-//! per track updated by a measurement in that frame: `x`,`y` the fused posterior position (m),
-//! `prior_*` the fused one-step prior before the update (m; empty for a track started in that
-//! frame), `gt_id` the ground-truth id of the measurement (-1 when unknown), `mu_*` the posterior
-//! mode probabilities (0 for modes the method does not use).
+//! Header
+//! `frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,existence_probability`;
+//! one row per track updated by a measurement in that frame: `x`,`y` the fused posterior
+//! position (m), `prior_*` the fused one-step prior before the update (m; empty for a track
+//! started in that frame), `gt_id` the ground-truth id of the measurement (-1 when unknown),
+//! `mu_*` the posterior mode probabilities (0 for modes the method does not use), `status` the
+//! track's lifecycle status after the frame (`tentative`, `confirmed` or `coasting`) and
+//! `existence_probability` the probability that its object exists (dimensionless).
 //!
 //! A file of frames tracked in the world frame (they carried an ego pose) adds the columns
 //! `world_x,world_y,world_vx,world_vy`: the fused position (m) and velocity over ground (m/s) in
@@ -17,7 +20,8 @@ use primm_core::track::TrackOutput;
 use std::io::Write;
 
 /// The header line.
-pub const TRACK_CSV_HEADER: &str = "frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct";
+pub const TRACK_CSV_HEADER: &str =
+    "frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,existence_probability";
 
 /// The columns a file with world-frame estimates adds to [`TRACK_CSV_HEADER`].
 pub const WORLD_COLUMNS: &str = "world_x,world_y,world_vx,world_vy";
@@ -41,6 +45,10 @@ pub struct TrackRow<'a> {
     pub ground_truth_id: Option<u64>,
     /// Mode probabilities, order PR, CV, CA, CT.
     pub mode_probabilities: [f64; 4],
+    /// Lifecycle status after the frame (`tentative`, `confirmed`, `coasting`).
+    pub status: &'a str,
+    /// Probability that the track's object exists.
+    pub existence_probability: f64,
     /// World-frame position (m) and velocity (m/s), `[x, y, vx, vy]`, when the frame was
     /// tracked in the world frame.
     pub world: Option<[f64; 4]>,
@@ -101,6 +109,8 @@ impl<W: Write> TrackCsvWriter<W> {
             prior_position_m: output.prior_position_m.map(|p| [p.x, p.y]),
             ground_truth_id: output.ground_truth_id,
             mode_probabilities: output.mode_probabilities,
+            status: output.status.name(),
+            existence_probability: output.existence_probability,
             world: output
                 .world_position_m
                 .zip(output.world_velocity_mps)
@@ -119,8 +129,8 @@ impl<W: Write> TrackCsvWriter<W> {
         let [x, y] = row.position_m;
         write!(
             self.out,
-            "{},{},{},{},{x},{y},{prior_x},{prior_y},{gt},{mu_pr},{mu_cv},{mu_ca},{mu_ct}",
-            row.frame, row.timestamp_s, row.track_id, row.class
+            "{},{},{},{},{x},{y},{prior_x},{prior_y},{gt},{mu_pr},{mu_cv},{mu_ca},{mu_ct},{},{}",
+            row.frame, row.timestamp_s, row.track_id, row.class, row.status, row.existence_probability
         )?;
         match (self.world_columns, row.world) {
             (false, _) => writeln!(self.out)?,
