@@ -227,7 +227,8 @@ fn frames_are_irregular_positive_steps_from_interleaved_sensors() {
 }
 
 /// Measurement position error in the sensor's polar frame: (along line of sight, across,
-/// range of the true position).
+/// range of the true position), for the measurements of real objects (false detections have
+/// no true position).
 fn polar_errors(cfg: &ScenarioConfig, frame: &RecordedFrame) -> Vec<(ObjectClass, u16, f64, f64, f64)> {
     let sensor_id = frame.sensor_id.expect("sensor id");
     let mount = mount_of(cfg, sensor_id);
@@ -235,6 +236,7 @@ fn polar_errors(cfg: &ScenarioConfig, frame: &RecordedFrame) -> Vec<(ObjectClass
     frame
         .measurements
         .iter()
+        .filter(|m| m.measurement.ground_truth_id.is_some())
         .map(|m| {
             let truth = m.true_position.expect("true position");
             let los = (truth - origin).normalize();

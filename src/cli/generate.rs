@@ -44,6 +44,12 @@ pub enum PresetChoice {
     Robustness,
     /// An ego vehicle that turns at most junctions (yaw rates up to about 0.5 rad/s).
     Turning,
+    /// The default scene with false detections: about 1.5 per scan, mostly static, some
+    /// moving-looking, a few multipath ghosts.
+    Clutter,
+    /// The turning scene with the clutter preset's false detections.
+    #[value(name = "clutter_turning", alias = "clutter-turning")]
+    ClutterTurning,
 }
 
 impl From<PresetChoice> for Preset {
@@ -52,6 +58,8 @@ impl From<PresetChoice> for Preset {
             PresetChoice::Default => Preset::Default,
             PresetChoice::Robustness => Preset::Robustness,
             PresetChoice::Turning => Preset::Turning,
+            PresetChoice::Clutter => Preset::Clutter,
+            PresetChoice::ClutterTurning => Preset::ClutterTurning,
         }
     }
 }
@@ -233,6 +241,17 @@ mod tests {
         let path = scratch_file("turning.toml", &toml::to_string(&turning).expect("serialise"));
         let args = parse(&["--output", "out", "--scenario", path.to_str().unwrap()]).expect("arguments");
         assert_eq!(base_config(&args).expect("configuration"), turning);
+    }
+
+    #[test]
+    fn every_preset_can_be_chosen_by_its_name() {
+        for preset in Preset::ALL {
+            let args = parse(&["--output", "out", "--preset", preset.name()]).expect("arguments");
+            assert_eq!(Preset::from(args.preset), preset);
+            assert_eq!(base_config(&args).expect("configuration"), preset.config());
+        }
+        let args = parse(&["--output", "out", "--preset", "clutter-turning"]).expect("arguments");
+        assert_eq!(Preset::from(args.preset), Preset::ClutterTurning);
     }
 
     #[test]

@@ -3,8 +3,8 @@
 //! Everything primm needs around the tracker but never on its real-time path:
 //!
 //! * [`scenario`]: a seeded generator of realistic automotive radar sequences (road layouts,
-//!   cars, pedestrians and two-wheelers, four interleaved radars with noise, clutter and
-//!   missed detections), with train / validation / evaluation splits and presets;
+//!   cars and pedestrians, four interleaved radars with noise and missed detections, optional
+//!   clutter and multipath ghosts), with train / validation / evaluation splits and presets;
 //! * [`io`]: the measurement CSV format (also written by `tools/radarscenes_to_csv.py` from
 //!   RadarScenes), the track CSV format and the association CSV format;
 //! * [`offline`]: running a tracker over a recorded sequence;

@@ -1,10 +1,12 @@
 //! Scenario configuration: every parameter of the generator, with its unit in its name.
 //!
-//! [`ScenarioConfig::default`] is the reference configuration; [`Preset`] names it and a second,
-//! harder configuration for robustness checks. All structs deserialize from TOML/JSON with
+//! [`ScenarioConfig::default`] is the reference configuration; [`Preset`] names it and its
+//! variants: a harder configuration for robustness checks, an often-turning ego vehicle, and
+//! both scenes with false detections (clutter). All structs deserialize from TOML/JSON with
 //! missing fields taken from the default, and [`ScenarioConfig::validate`] checks the physical
 //! and logical consistency of a configuration before it is used.
 
+use primm_core::measurement::MAX_MEASUREMENTS_PER_FRAME;
 use primm_core::readable_number::readable;
 use serde::{Deserialize, Serialize};
 
@@ -62,6 +64,8 @@ pub struct ScenarioConfig {
     pub car_reflection: ReflectionConfig,
     /// Reflection model of pedestrians.
     pub pedestrian_reflection: ReflectionConfig,
+    /// False detections: clutter and multipath ghosts (off by default).
+    pub clutter: ClutterConfig,
 }
 
 /// Sequence length and simulation stepping.
@@ -365,6 +369,47 @@ pub struct ReflectionConfig {
     pub micro_doppler_fraction: f64,
 }
 
+/// False detections added to the object list of every scan: clutter spread over the scanning
+/// sensor's field of view (guard rails, poles, kerbs, edges of parked cars that survive
+/// clustering and classification) and multipath ghosts behind real objects. False detections
+/// carry no ground-truth id and no true position. The default adds none.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClutterConfig {
+    /// Mean of the Poisson-distributed number of clutter detections per scan of one sensor
+    /// (0: no clutter), at most `MAX_MEASUREMENTS_PER_FRAME`.
+    pub mean_false_detections_per_scan: f64,
+    /// Clutter is spread uniformly over the area of the field-of-view sector between this
+    /// range and `max_range_m`, metres.
+    pub min_range_m: f64,
+    /// Farthest clutter range; the scanning sensor's `max_range_m` when that is smaller,
+    /// metres.
+    pub max_range_m: f64,
+    /// Share of clutter detections labelled `car`; the rest are labelled `pedestrian`.
+    pub car_fraction: f64,
+    /// Mean RCS of a clutter detection labelled `car`, dBsm.
+    pub car_rcs_mean_dbsm: f64,
+    /// Standard deviation of the RCS of a clutter detection labelled `car`, dB.
+    pub car_rcs_std_db: f64,
+    /// Mean RCS of a clutter detection labelled `pedestrian`, dBsm.
+    pub pedestrian_rcs_mean_dbsm: f64,
+    /// Standard deviation of the RCS of a clutter detection labelled `pedestrian`, dB.
+    pub pedestrian_rcs_std_db: f64,
+    /// Share of clutter detections that look moving: their radial velocity is drawn uniformly
+    /// in ±`moving_radial_velocity_max_mps`. The others are static: radial velocity zero plus
+    /// the sensor's Doppler noise and the scan's ego-motion compensation error.
+    pub moving_fraction: f64,
+    /// See `moving_fraction`, m/s.
+    pub moving_radial_velocity_max_mps: f64,
+    /// Probability that a real object measurement of a scan is accompanied by a multipath
+    /// ghost: same azimuth, farther away, same class, similar radial velocity, weaker.
+    pub ghost_probability: f64,
+    /// How much farther from the sensor a ghost lies than the object measurement, metres.
+    pub ghost_extra_range_m: Interval,
+    /// How much weaker a ghost's RCS is than the object measurement's, dB.
+    pub ghost_rcs_drop_db: f64,
+}
+
 // ------------------------------------------------------------------------------------------------
 // Defaults
 
@@ -381,6 +426,7 @@ impl Default for ScenarioConfig {
             radar: RadarConfig::default(),
             car_reflection: ReflectionConfig::car(),
             pedestrian_reflection: ReflectionConfig::pedestrian(),
+            clutter: ClutterConfig::default(),
         }
     }
 }
@@ -592,6 +638,41 @@ impl Default for ReflectionConfig {
     }
 }
 
+impl Default for ClutterConfig {
+    /// No false detections; the other values describe the clutter once it is switched on.
+    fn default() -> Self {
+        Self {
+            mean_false_detections_per_scan: 0.0,
+            min_range_m: 1.0,
+            max_range_m: 80.0,
+            car_fraction: 0.7,
+            car_rcs_mean_dbsm: 3.0,
+            car_rcs_std_db: 5.0,
+            pedestrian_rcs_mean_dbsm: -8.0,
+            pedestrian_rcs_std_db: 4.0,
+            moving_fraction: 0.15,
+            moving_radial_velocity_max_mps: 10.0,
+            ghost_probability: 0.0,
+            ghost_extra_range_m: [2.0, 8.0],
+            ghost_rcs_drop_db: 8.0,
+        }
+    }
+}
+
+impl ClutterConfig {
+    /// The clutter of the `clutter` and `clutter_turning` presets: 1.5 false detections per
+    /// scan, mostly static, 15 % moving-looking, and a ghost behind 3 % of the object
+    /// measurements.
+    pub fn urban() -> Self {
+        Self { mean_false_detections_per_scan: 1.5, ghost_probability: 0.03, ..Self::default() }
+    }
+
+    /// Whether this configuration adds any false detection.
+    pub fn is_enabled(&self) -> bool {
+        self.mean_false_detections_per_scan > 0.0 || self.ghost_probability > 0.0
+    }
+}
+
 // ------------------------------------------------------------------------------------------------
 // Presets
 
@@ -602,23 +683,32 @@ pub enum Preset {
     /// The reference configuration ([`ScenarioConfig::default`]).
     Default,
     /// A harder configuration for robustness checks: faster and more aggressive cars, more
-    /// erratic and faster pedestrians, denser traffic, noisier sensors with more misses.
+    /// erratic and faster pedestrians, denser traffic, noisier sensors with more misses, and
+    /// more false detections than [`Preset::Clutter`].
     Robustness,
     /// The default scene seen from an ego vehicle that turns at most junctions of a denser
     /// road grid, at town speeds: ego yaw rates up to about 0.5 rad/s.
     Turning,
+    /// The default scene with false detections ([`ClutterConfig::urban`]): about 1.5 per scan,
+    /// mostly static, some moving-looking, a few multipath ghosts.
+    Clutter,
+    /// The [`Preset::Turning`] scene with the false detections of [`Preset::Clutter`].
+    ClutterTurning,
 }
 
 impl Preset {
     /// All presets.
-    pub const ALL: [Preset; 3] = [Preset::Default, Preset::Robustness, Preset::Turning];
+    pub const ALL: [Preset; 5] =
+        [Preset::Default, Preset::Robustness, Preset::Turning, Preset::Clutter, Preset::ClutterTurning];
 
-    /// The preset's name (`default`, `robustness`).
+    /// The preset's name (`default`, `robustness`, `turning`, `clutter`, `clutter_turning`).
     pub fn name(self) -> &'static str {
         match self {
             Preset::Default => "default",
             Preset::Robustness => "robustness",
             Preset::Turning => "turning",
+            Preset::Clutter => "clutter",
+            Preset::ClutterTurning => "clutter_turning",
         }
     }
 
@@ -633,6 +723,8 @@ impl Preset {
             Preset::Default => ScenarioConfig::default(),
             Preset::Robustness => ScenarioConfig::robustness(),
             Preset::Turning => ScenarioConfig::turning(),
+            Preset::Clutter => ScenarioConfig::clutter(),
+            Preset::ClutterTurning => ScenarioConfig::clutter_turning(),
         }
     }
 }
@@ -646,8 +738,10 @@ impl std::fmt::Display for Preset {
 impl std::str::FromStr for Preset {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::from_name(s)
-            .ok_or_else(|| format!("unknown preset `{s}` (expected `default`, `robustness` or `turning`)"))
+        Self::from_name(s).ok_or_else(|| {
+            let names: Vec<String> = Self::ALL.iter().map(|p| format!("`{}`", p.name())).collect();
+            format!("unknown preset `{s}` (expected one of {})", names.join(", "))
+        })
     }
 }
 
@@ -661,6 +755,22 @@ impl ScenarioConfig {
         config.ego.start_distance_to_junction_m = [15.0, 40.0];
         config.ego.turn_left_probability = Some(0.45);
         config.ego.turn_right_probability = Some(0.45);
+        config
+    }
+
+    /// The clutter preset: see [`Preset::Clutter`].
+    pub fn clutter() -> Self {
+        let mut config = Self::default();
+        config.splits.seed_base = 0x434c_5554_5452;
+        config.clutter = ClutterConfig::urban();
+        config
+    }
+
+    /// The ego-turning clutter preset: see [`Preset::ClutterTurning`].
+    pub fn clutter_turning() -> Self {
+        let mut config = Self::turning();
+        config.splits.seed_base = 0x434c_5455_524e;
+        config.clutter = ClutterConfig::urban();
         config
     }
 
@@ -724,6 +834,12 @@ impl ScenarioConfig {
         config.car_reflection.rcs_fluctuation_db = 6.0;
         config.pedestrian_reflection.rcs_fluctuation_db = 5.0;
         config.pedestrian_reflection.micro_doppler_fraction = 0.5;
+        config.clutter = ClutterConfig {
+            mean_false_detections_per_scan: 2.0,
+            moving_fraction: 0.2,
+            ghost_probability: 0.05,
+            ..ClutterConfig::urban()
+        };
         config
     }
 
@@ -745,7 +861,8 @@ impl ScenarioConfig {
         self.validate_ego()?;
         self.validate_pedestrian()?;
         self.validate_radar()?;
-        self.validate_reflections()
+        self.validate_reflections()?;
+        self.validate_clutter()
     }
 
     /// `sequence.*`.
@@ -1014,6 +1131,45 @@ impl ScenarioConfig {
         Ok(())
     }
 
+    /// `clutter.*`, including a clutter range that every sensor can reach.
+    fn validate_clutter(&self) -> Result<(), ConfigError> {
+        let c = &self.clutter;
+        non_negative("clutter.mean_false_detections_per_scan", c.mean_false_detections_per_scan)?;
+        if c.mean_false_detections_per_scan > MAX_MEASUREMENTS_PER_FRAME as f64 {
+            return Err(ConfigError::new(
+                "clutter.mean_false_detections_per_scan",
+                format!("must not exceed the frame capacity of {MAX_MEASUREMENTS_PER_FRAME} measurements"),
+            ));
+        }
+        positive("clutter.min_range_m", c.min_range_m)?;
+        positive("clutter.max_range_m", c.max_range_m)?;
+        if c.max_range_m <= c.min_range_m {
+            return Err(ConfigError::new("clutter.max_range_m", "must exceed clutter.min_range_m"));
+        }
+        if let Some((i, sensor)) =
+            self.radar.sensors.iter().enumerate().find(|(_, sensor)| sensor.max_range_m <= c.min_range_m)
+        {
+            return Err(ConfigError::new(
+                "clutter.min_range_m",
+                format!(
+                    "must be below every sensor's range (radar.sensors[{i}].max_range_m is {} m)",
+                    readable(sensor.max_range_m)
+                ),
+            ));
+        }
+        probability("clutter.car_fraction", c.car_fraction)?;
+        finite("clutter.car_rcs_mean_dbsm", c.car_rcs_mean_dbsm)?;
+        non_negative("clutter.car_rcs_std_db", c.car_rcs_std_db)?;
+        finite("clutter.pedestrian_rcs_mean_dbsm", c.pedestrian_rcs_mean_dbsm)?;
+        non_negative("clutter.pedestrian_rcs_std_db", c.pedestrian_rcs_std_db)?;
+        probability("clutter.moving_fraction", c.moving_fraction)?;
+        non_negative("clutter.moving_radial_velocity_max_mps", c.moving_radial_velocity_max_mps)?;
+        probability("clutter.ghost_probability", c.ghost_probability)?;
+        interval("clutter.ghost_extra_range_m", c.ghost_extra_range_m, true)?;
+        non_negative("clutter.ghost_rcs_drop_db", c.ghost_rcs_drop_db)?;
+        Ok(())
+    }
+
     /// Width of one side of the carriageway (all lanes of one direction), metres.
     pub fn half_road_width_m(&self) -> f64 {
         self.road.lane_width_m * f64::from(self.road.lanes_per_direction)
@@ -1094,4 +1250,80 @@ fn interval(field: &str, value: Interval, strictly_positive: bool) -> Result<(),
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_preset_is_valid_and_found_by_its_name() {
+        for preset in Preset::ALL {
+            preset.config().validate().unwrap_or_else(|error| panic!("{preset}: {error}"));
+            assert_eq!(Preset::from_name(preset.name()), Some(preset));
+            assert_eq!(preset.name().parse::<Preset>(), Ok(preset));
+        }
+        let error = "clutter-free".parse::<Preset>().unwrap_err();
+        for preset in Preset::ALL {
+            assert!(error.contains(&format!("`{}`", preset.name())), "{error}");
+        }
+    }
+
+    #[test]
+    fn every_preset_has_its_own_seed_base() {
+        for (i, a) in Preset::ALL.into_iter().enumerate() {
+            for b in &Preset::ALL[..i] {
+                assert_ne!(a.config().splits.seed_base, b.config().splits.seed_base, "{a} and {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn only_the_clutter_and_robustness_presets_add_false_detections() {
+        for preset in Preset::ALL {
+            let clutter = preset.config().clutter;
+            let expected = matches!(preset, Preset::Clutter | Preset::ClutterTurning | Preset::Robustness);
+            assert_eq!(clutter.is_enabled(), expected, "{preset}");
+        }
+        assert_eq!(ScenarioConfig::default().clutter, ClutterConfig::default());
+        let robust = Preset::Robustness.config().clutter.mean_false_detections_per_scan;
+        assert!(robust > Preset::Clutter.config().clutter.mean_false_detections_per_scan);
+    }
+
+    #[test]
+    fn clutter_validation_names_the_offending_field() {
+        /// Makes one field of a valid clutter section invalid.
+        type Spoil = fn(&mut ClutterConfig);
+        let cases: [(&str, Spoil); 15] = [
+            ("clutter.mean_false_detections_per_scan", |c| c.mean_false_detections_per_scan = -1.0),
+            ("clutter.mean_false_detections_per_scan", |c| c.mean_false_detections_per_scan = 1000.0),
+            ("clutter.mean_false_detections_per_scan", |c| c.mean_false_detections_per_scan = f64::NAN),
+            ("clutter.min_range_m", |c| c.min_range_m = 0.0),
+            ("clutter.min_range_m", |c| {
+                c.min_range_m = 150.0;
+                c.max_range_m = 200.0;
+            }),
+            ("clutter.max_range_m", |c| c.max_range_m = 0.5),
+            ("clutter.car_fraction", |c| c.car_fraction = 1.2),
+            ("clutter.car_rcs_mean_dbsm", |c| c.car_rcs_mean_dbsm = f64::INFINITY),
+            ("clutter.car_rcs_std_db", |c| c.car_rcs_std_db = -1.0),
+            ("clutter.pedestrian_rcs_std_db", |c| c.pedestrian_rcs_std_db = f64::NAN),
+            ("clutter.moving_fraction", |c| c.moving_fraction = -0.1),
+            ("clutter.moving_radial_velocity_max_mps", |c| c.moving_radial_velocity_max_mps = -3.0),
+            ("clutter.ghost_probability", |c| c.ghost_probability = 2.0),
+            ("clutter.ghost_extra_range_m", |c| c.ghost_extra_range_m = [5.0, 1.0]),
+            ("clutter.ghost_rcs_drop_db", |c| c.ghost_rcs_drop_db = -6.0),
+        ];
+        for (field, spoil) in cases {
+            let mut config = ScenarioConfig::clutter();
+            spoil(&mut config.clutter);
+            assert_eq!(config.validate().unwrap_err().field, field);
+        }
+        let error = ScenarioConfig::from_toml_str("[clutter]\nghost_probability = 1.5\n").unwrap_err();
+        assert!(error.to_string().contains("clutter.ghost_probability"), "{error}");
+        let parsed = ScenarioConfig::from_toml_str("[clutter]\nmean_false_detections_per_scan = 2.5\n")
+            .expect("a partial clutter section");
+        assert_eq!(parsed.clutter.mean_false_detections_per_scan, 2.5);
+        assert_eq!(parsed.clutter.ghost_extra_range_m, ClutterConfig::default().ghost_extra_range_m);
+    }
 }

@@ -13,7 +13,9 @@
 //!   leave the fields of view, meet closely and cross each other's paths;
 //! * object-level measurements formed like the paper's (Section III-A, `eq:measurement_full`):
 //!   the average of reflection points drawn on the visible outline of the object, with
-//!   ego-motion compensated radial velocity and RCS, plus occlusion and random misses.
+//!   ego-motion compensated radial velocity and RCS, plus occlusion and random misses;
+//! * optionally, false detections: clutter over the field of view and multipath ghosts behind
+//!   objects (see [`ClutterConfig`]).
 //!
 //! Everything is deterministic given the configuration and a seed. See `docs/scenario.md` for
 //! the full model description, its limits, and every parameter.
@@ -28,6 +30,7 @@
 //! assert_eq!(generated.sequence.frames.len(), generated.truth.len());
 //! ```
 
+mod clutter;
 mod config;
 mod events;
 mod kinematics;
@@ -43,8 +46,8 @@ use rand_chacha::ChaCha12Rng;
 use serde::{Deserialize, Serialize};
 
 pub use config::{
-    CarConfig, ConfigError, EgoConfig, Interval, PedestrianConfig, Preset, RadarConfig, RadarMount,
-    ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig,
+    CarConfig, ClutterConfig, ConfigError, EgoConfig, Interval, PedestrianConfig, Preset, RadarConfig,
+    RadarMount, ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig,
     TrafficConfig,
 };
 pub use events::{
@@ -62,6 +65,9 @@ const STREAM_WORLD: u64 = 1;
 const STREAM_SCHEDULE: u64 = 2;
 /// Random stream of the measurement model.
 const STREAM_SENSOR: u64 = 3;
+/// Random stream of the false detections, so that clutter leaves every real measurement as it
+/// is without clutter.
+const STREAM_CLUTTER: u64 = 4;
 
 /// True state of one object at one frame (world frame).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -207,17 +213,26 @@ impl ScenarioGenerator {
         let mut world = world::World::new(cfg, rng_for(STREAM_WORLD));
         let scans = radar::schedule(&cfg.radar, cfg.sequence.duration_s, &mut rng_for(STREAM_SCHEDULE));
         let mut sensor_rng = rng_for(STREAM_SENSOR);
+        let mut clutter_rng = rng_for(STREAM_CLUTTER);
         let warmup = cfg.sequence.warmup_s;
         let mut sequence = Sequence::new(name);
         let mut truth = Vec::with_capacity(scans.len());
         for (index, scan) in scans.iter().enumerate() {
             world.advance_to(warmup + scan.t);
-            let measurements = radar::scan(&world, cfg, scan.sensor, &mut sensor_rng);
+            let mut scanned = radar::scan(&world, cfg, scan.sensor, &mut sensor_rng);
+            clutter::add_false_detections(
+                &cfg.clutter,
+                &cfg.radar,
+                scan.sensor,
+                scanned.doppler_bias_mps,
+                &mut scanned.measurements,
+                &mut clutter_rng,
+            );
             let ego_pose = world.ego_pose();
             let mut frame = RecordedFrame::new(index as u64, scan.t);
             frame.sensor_id = Some(cfg.radar.sensors[scan.sensor].id);
             frame.ego_pose = Some(ego_pose);
-            frame.measurements = measurements;
+            frame.measurements = scanned.measurements;
             sequence.frames.push(frame);
             let ego = world.ego();
             truth.push(TruthFrame {

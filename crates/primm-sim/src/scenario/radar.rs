@@ -132,13 +132,21 @@ struct Echo {
     count: u32,
 }
 
+/// The object measurements of one scan and the scan's ego-motion compensation error.
+pub(crate) struct ScanMeasurements {
+    /// One measurement per detected object, in random order.
+    pub measurements: Vec<RecordedMeasurement>,
+    /// Ego-motion compensation error of the radial velocities of this scan, m/s.
+    pub doppler_bias_mps: f64,
+}
+
 /// Produces the object measurements of one scan of sensor `sensor_index`.
 pub(crate) fn scan(
     world: &World<'_>,
     cfg: &ScenarioConfig,
     sensor_index: usize,
     rng: &mut ChaCha12Rng,
-) -> Vec<RecordedMeasurement> {
+) -> ScanMeasurements {
     let radar = &cfg.radar;
     let mount = &radar.sensors[sensor_index];
     let ego = world.ego_pose();
@@ -186,7 +194,7 @@ pub(crate) fn scan(
     }
     // Detection lists carry no meaningful order.
     out.shuffle(rng);
-    out
+    ScanMeasurements { measurements: out, doppler_bias_mps: scan_bias }
 }
 
 /// The range to `object`'s centre when some of its box may lie within `max_range` and the field
