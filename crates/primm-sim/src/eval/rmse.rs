@@ -32,10 +32,11 @@ impl RmseAccumulator {
     }
 
     /// Adds the row's prior error against its reference position (true position when known,
-    /// else the measurement). Rows without a prior are skipped; returns whether a sample was
-    /// added.
+    /// else the measurement). Rows without a prior, and rows of no ground-truth object (false
+    /// detections: there is no object whose motion the prior predicted), are skipped; returns
+    /// whether a sample was added.
     pub fn push_record(&mut self, record: &AssociationRecord) -> bool {
-        match record.prior {
+        match record.prior.filter(|_| record.ground_truth_id.is_some()) {
             Some(prior) => {
                 self.push(record.reference_position(), prior);
                 true
@@ -134,7 +135,7 @@ mod tests {
     }
 
     #[test]
-    fn records_use_truth_then_measurement_and_skip_rows_without_prior() {
+    fn records_use_truth_then_measurement_and_skip_rows_without_prior_or_object() {
         let mut with_truth = identity_row(0, Some(1), Some(1));
         with_truth.measured = DVec2::new(10.0, 0.0);
         with_truth.true_position = Some(DVec2::new(1.0, 0.0));
@@ -143,8 +144,10 @@ mod tests {
         measured_only.measured = DVec2::new(0.0, 3.0);
         measured_only.prior = Some(DVec2::ZERO); // error 3 in y
         let started = identity_row(2, Some(2), Some(2)); // no prior: new track
+        let mut clutter = identity_row(3, None, Some(1)); // a false detection a track took
+        clutter.prior = Some(DVec2::new(50.0, 50.0));
         let mut acc = RmseAccumulator::new();
-        acc.extend_records(&[with_truth, measured_only, started]);
+        acc.extend_records(&[with_truth, measured_only, started, clutter]);
         assert_eq!(acc.count(), 2);
         assert!(close(acc.rmse_x().unwrap(), (1.0f64 / 2.0).sqrt()));
         assert!(close(acc.rmse_y().unwrap(), (9.0f64 / 2.0).sqrt()));
