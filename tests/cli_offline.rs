@@ -76,7 +76,7 @@ fn eval_prints_the_tables_and_writes_json_and_figures() {
         plots.to_str().unwrap(),
     ]);
     let text = String::from_utf8(output.stdout).unwrap();
-    for table in ["Table II", "Table III", "Table IV", "Table V"] {
+    for table in ["Table II", "Table III", "Table IV", "Table V", "Confirmed tracks ("] {
         assert!(text.contains(table), "{table} missing:\n{text}");
     }
     let value: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
@@ -87,6 +87,24 @@ fn eval_prints_the_tables_and_writes_json_and_figures() {
         let idf1 = result["idf1"].as_f64().unwrap();
         assert!(idf1 > 0.5 && idf1 <= 1.0, "{method} idf1 {idf1}");
         assert!(result["idsw"].as_u64().is_some());
+        // Confirmed tracks only: fewer estimated frames and matches, the same ground truth.
+        let confirmed = &result["confirmed_tracks"];
+        let count =
+            |key: &str| confirmed[key].as_u64().unwrap_or_else(|| panic!("{method} {key}: {confirmed}"));
+        let paper = |key: &str| result["counts"][key].as_u64().unwrap();
+        assert_eq!(count("gt_object_frames"), paper("gt_object_frames"));
+        assert!(count("estimated_object_frames") < paper("estimated_object_frames"), "{confirmed}");
+        assert!(count("idtp") <= paper("idtp"), "{confirmed}");
+        assert_eq!(count("idtp") + count("idfp"), count("estimated_object_frames"));
+        assert!(count("tracks") > 0 && count("false_tracks") <= count("tracks"), "{confirmed}");
+        assert!(count("clutter_rows_in_confirmed_tracks") <= count("clutter_rows"));
+        assert_eq!(count("sequences"), 2);
+        let _ = count("fragmentations");
+        let _ = count("idsw");
+        assert!(confirmed["duration_s"].as_f64().unwrap() > 0.0);
+        assert!(confirmed["false_tracks_per_minute"].as_f64().unwrap() >= 0.0);
+        let idf1 = confirmed["idf1"].as_f64().unwrap();
+        assert!(idf1 > 0.5 && idf1 <= 1.0, "{method} confirmed idf1 {idf1}");
     }
     assert!(plots.join("trajectories.svg").exists());
 }
@@ -216,6 +234,25 @@ fn score_of_the_association_files_written_by_track_equals_the_eval_metrics() {
         let (a, b) = (score[scored].as_f64().unwrap(), eval[evaluated].as_f64().unwrap());
         assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "{scored}: score {a} vs eval {b}");
     }
+    assert!(score["confirmed_tracks"].is_object(), "{score}");
+    assert_eq!(score["confirmed_tracks"], eval["confirmed_tracks"]);
+
+    // The same files without the `confirmed` column: the paper's metrics as before, the metrics
+    // on confirmed tracks skipped with a message.
+    for file in primm_sim::io::dataset_files(&associations).unwrap() {
+        let text = std::fs::read_to_string(&file).unwrap();
+        let legacy: String =
+            text.lines().map(|line| format!("{}\n", &line[..line.rfind(',').unwrap()])).collect();
+        assert!(legacy.starts_with(primm_sim::io::association_csv::LEGACY_ASSOCIATION_CSV_HEADER));
+        std::fs::write(&file, legacy).unwrap();
+    }
+    let legacy =
+        primm(&["score", "--data", data.to_str().unwrap(), "--associations", associations.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&legacy.stderr);
+    assert!(stderr.contains("metrics on confirmed tracks skipped"), "{stderr}");
+    let legacy: serde_json::Value = serde_json::from_slice(&legacy.stdout).unwrap();
+    assert!(legacy["confirmed_tracks"].is_null(), "{legacy}");
+    assert_eq!((&legacy["idsw"], &legacy["idf1"]), (&score["idsw"], &score["idf1"]));
 }
 
 #[test]
@@ -226,7 +263,7 @@ fn score_refuses_an_association_file_that_names_a_missing_measurement() {
     let associations = dir.join("associations");
     std::fs::create_dir_all(&associations).unwrap();
     for file in primm_sim::io::dataset_files(&data).unwrap() {
-        let text = format!("{}\n0,9999,1,,\n", primm_sim::io::association_csv::ASSOCIATION_CSV_HEADER);
+        let text = format!("{}\n0,9999,1,,,1\n", primm_sim::io::association_csv::ASSOCIATION_CSV_HEADER);
         std::fs::write(associations.join(file.file_name().unwrap()), text).unwrap();
     }
     let output = Command::new(env!("CARGO_BIN_EXE_primm"))

@@ -39,6 +39,7 @@ fn load_sequences() -> BTreeMap<String, Vec<AssociationRecord>> {
     for row in reader.records() {
         let row = row.expect("CSV row");
         let frame: u64 = row[1].parse().expect("frame");
+        let track_id = parse_id(&row[3]);
         sequences.entry(row[0].to_string()).or_default().push(AssociationRecord {
             frame,
             timestamp_s: frame as f64 * 0.05,
@@ -46,9 +47,10 @@ fn load_sequences() -> BTreeMap<String, Vec<AssociationRecord>> {
             class: ObjectClass::Car,
             measured: DVec2::ZERO,
             true_position: None,
-            track_id: parse_id(&row[3]),
+            track_id,
             prior: None,
             mode_probabilities: None,
+            track_confirmed: Some(track_id.is_some()),
         });
     }
     sequences

@@ -59,6 +59,7 @@ fn scene(
                 track_id: Some(track),
                 prior: (k > 0).then_some(estimate),
                 mode_probabilities: Some([0.35, 0.2, 0.3, 0.15]),
+                track_confirmed: Some(true),
             });
             posterior.push(TrajectoryPoint { id: track, frame: k, position: estimate });
         }

@@ -1,4 +1,6 @@
-//! `primm eval`: every method on every sequence of a data set, printed as the paper's tables.
+//! `primm eval`: every method on every sequence of a data set, printed as the paper's tables and
+//! the metrics on confirmed tracks (each row records whether its track was confirmed after the
+//! frame, from the tracker output's status).
 
 use clap::{Args as ClapArgs, ValueEnum};
 use primm_core::config::{Config, TrackingFrame};
@@ -313,17 +315,7 @@ fn missed_detection_records<P: DisplacementPredictor>(
     for frame in &sequence.frames {
         for measurement in &frame.measurements {
             if mask.is_dropped(flat) {
-                records.push(AssociationRecord {
-                    frame: frame.index,
-                    timestamp_s: frame.timestamp_s,
-                    ground_truth_id: measurement.measurement.ground_truth_id,
-                    class: measurement.measurement.class,
-                    measured: measurement.measurement.position(),
-                    true_position: measurement.true_position,
-                    track_id: None,
-                    prior: None,
-                    mode_probabilities: None,
-                });
+                records.push(frame.unassigned_record(measurement));
             } else {
                 records.push(kept.next().ok_or(EvaluateError::MissedDetectionRows)?);
             }

@@ -5,10 +5,13 @@
 //! measurement and with which prior. The rows go through the same evaluator as `primm eval`
 //! (`MethodEvaluator`), so a tracker outside primm is scored exactly like primm's own methods:
 //! prior RMSE against the true object centre (Table II), ID switches and IDF1 (Table IV).
+//! When every association file has the `confirmed` column, the metrics on confirmed tracks
+//! (`primm_sim::eval::confirmed`) are added under `confirmed_tracks`; otherwise that key is
+//! `null` and a message on standard error names the first file without it.
 
 use clap::Args as ClapArgs;
 use primm_core::mode::Method;
-use primm_sim::eval::{MethodEvaluator, MethodResult};
+use primm_sim::eval::{confirmed_track_counts, ConfirmedTrackCounts, MethodEvaluator, MethodResult};
 use primm_sim::io::association_csv::{
     association_records_from_rows, read_association_rows, AssociationCsvError,
 };
@@ -33,7 +36,8 @@ pub struct Args {
     pub sequences: Option<usize>,
 }
 
-/// The scores as a JSON object.
+/// The scores as a JSON object; `confirmed_tracks` is `null` when the track status was not
+/// recorded.
 pub fn summary_json(name: &str, result: &MethodResult) -> serde_json::Value {
     serde_json::json!({
         "tracker": name,
@@ -45,6 +49,7 @@ pub fn summary_json(name: &str, result: &MethodResult) -> serde_json::Value {
         "idsw": result.identity.idsw,
         "idf1": result.identity.idf1(),
         "gt_object_frames": result.identity.gt_object_frames,
+        "confirmed_tracks": result.confirmed.as_ref().map(ConfirmedTrackCounts::to_json),
     })
 }
 
@@ -92,6 +97,7 @@ pub fn run(args: &Args) -> Result<(), ScoreError> {
     }
     // The method only labels the result; association rows carry no mode probabilities.
     let mut evaluator = MethodEvaluator::new(Method::Imm);
+    let mut without_status = None;
     for file in &files {
         let sequence = read_sequence_file(file)?;
         let name = file.file_name().ok_or(ScoreError::Unnamed)?;
@@ -101,7 +107,17 @@ pub fn run(args: &Args) -> Result<(), ScoreError> {
         let associations = |source| ScoreError::Associations { path: path.clone(), source };
         let rows = read_association_rows(std::io::BufReader::new(reader)).map_err(associations)?;
         let records = association_records_from_rows(&sequence, &rows).map_err(associations)?;
+        if without_status.is_none() {
+            without_status = confirmed_track_counts(&records).err().map(|error| (path.clone(), error));
+        }
         evaluator.add_sequence(&records);
+    }
+    if let Some((path, error)) = without_status {
+        eprintln!(
+            "metrics on confirmed tracks skipped: {}: {error} (the file has no `confirmed` column or an \
+             empty one)",
+            path.display()
+        );
     }
     println!("{}", summary_json(&args.name, evaluator.result()));
     Ok(())

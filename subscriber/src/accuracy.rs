@@ -132,6 +132,8 @@ impl AccuracyMonitor {
                 track_id: track.map(|t| t.id),
                 prior: track.and_then(|t| t.prior_m()).map(DVec2::from),
                 mode_probabilities: track.map(|t| t.mode_probabilities),
+                // Wire status 0 is tentative; every other status counts as confirmed.
+                track_confirmed: Some(track.is_some_and(|t| t.status != 0)),
             };
             self.prior.push_record(&record);
             if let (Some(track), Some(truth)) = (track, measurement.true_position) {

@@ -1,7 +1,7 @@
 //! Offline tracking of recorded sequences: the tracker run frame by frame over a
 //! [`Sequence`], with every measurement's fate turned into evaluation rows.
 
-use crate::eval::record::AssociationRecord;
+use crate::eval::record::{counts_as_confirmed, AssociationRecord};
 use crate::io::{RecordedFrame, Sequence, TooManyMeasurements};
 use primm_core::measurement::Frame;
 use primm_core::mode::Method;
@@ -63,7 +63,9 @@ pub fn track_sequence<P: DisplacementPredictor>(
 }
 
 /// One evaluation row per measurement of `recorded`, from the tracker's outputs for that frame.
-/// `method` decides whether mode probabilities are reported (IMM variants only).
+/// `method` decides whether mode probabilities are reported (IMM variants only). A row records
+/// whether its track was confirmed after the frame's update ([`counts_as_confirmed`] of the
+/// output's status).
 pub fn association_records(
     recorded: &RecordedFrame,
     outputs: &[TrackOutput],
@@ -78,6 +80,7 @@ pub fn association_records(
         if let Some(record) = records.get_mut(start + usize::from(index)) {
             record.track_id = Some(output.id);
             record.prior = output.prior_position_m;
+            record.track_confirmed = Some(counts_as_confirmed(output.status));
             if with_modes && output.prior_position_m.is_some() {
                 record.mode_probabilities = Some(output.mode_probabilities);
             }
@@ -96,4 +99,45 @@ pub fn evaluate_sequence<P: DisplacementPredictor>(
         association_records(recorded, outputs, method, &mut records)
     })?;
     Ok(records)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::RecordedMeasurement;
+    use primm_core::config::Config;
+    use primm_core::measurement::{Measurement, ObjectClass};
+
+    #[test]
+    fn rows_record_whether_their_track_was_confirmed_after_the_frame() {
+        // One car driving away at 5 m/s, seen every 0.1 s; the default tracker confirms a track
+        // with its third hit.
+        let mut sequence = Sequence::new("one car");
+        for index in 0..6u64 {
+            let mut frame = RecordedFrame::new(index, index as f64 * 0.1);
+            frame.measurements.push(RecordedMeasurement {
+                measurement: Measurement {
+                    x_m: 20.0 + 0.5 * index as f64,
+                    y_m: 0.0,
+                    radial_velocity_mps: 5.0,
+                    rcs_dbsm: 10.0,
+                    class: ObjectClass::Car,
+                    sensor_id: None,
+                    ground_truth_id: Some(1),
+                },
+                true_position: None,
+            });
+            sequence.frames.push(frame);
+        }
+        let config = Config::default().with_modes(Method::Imm.modes());
+        let hits = config.tracker.confirmation_hits as usize;
+        assert_eq!(hits, 3);
+        let mut tracker = Tracker::new(config).unwrap();
+        let records = evaluate_sequence(&mut tracker, &sequence, Method::Imm).unwrap();
+        let track = records[0].track_id;
+        assert!(track.is_some() && records.iter().all(|r| r.track_id == track), "{records:?}");
+        let confirmed: Vec<Option<bool>> = records.iter().map(|r| r.track_confirmed).collect();
+        let expected: Vec<Option<bool>> = (0..6).map(|k| Some(k + 1 >= hits)).collect();
+        assert_eq!(confirmed, expected);
+    }
 }

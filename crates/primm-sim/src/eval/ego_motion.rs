@@ -131,6 +131,7 @@ mod tests {
                 track_id: None,
                 prior: None,
                 mode_probabilities: None,
+                track_confirmed: Some(false),
             })
             .collect();
         assert_eq!(

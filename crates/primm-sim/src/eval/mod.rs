@@ -7,6 +7,8 @@
 //!
 //! * one-step prior RMSE ([`rmse`]),
 //! * identity metrics IDSW and IDF1 ([`identity`]),
+//! * identity, false-track and fragmentation counts on the rows of confirmed tracks only, with
+//!   clutter (rows without a ground-truth id) scored strictly ([`confirmed`]),
 //! * motion-scenario labels for the scenario-wise RMSE table ([`scenario`]),
 //! * the close-proximity and crossing-motion subsets of the scenario-wise tracking table
 //!   ([`interaction`]) and the seeded measurement removal for its missed-detection rows
@@ -20,6 +22,7 @@
 //!
 //! Nothing here is on the tracker's real-time path; clarity wins over speed.
 
+pub mod confirmed;
 pub mod dropout;
 pub mod ego_motion;
 pub mod identity;
@@ -31,6 +34,9 @@ pub mod report;
 pub mod rmse;
 pub mod scenario;
 
+pub use confirmed::{
+    confirmed_track_counts, tracks_born_of_clutter, ConfirmedTrackCounts, UnknownTrackStatus,
+};
 pub use dropout::{sequence_seed, DropoutMask};
 pub use identity::{
     id_switch_rows, id_switches, identity_counts, identity_counts_subset, max_total_overlap, IdentityCounts,
@@ -38,7 +44,7 @@ pub use identity::{
 pub use interaction::{interaction_flags, InteractionFlags, InteractionRules};
 pub use modes::{ModeProbabilityAccumulator, MODE_NAMES};
 pub use plots::{TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint};
-pub use record::{AssociationRecord, EvalError, Method};
+pub use record::{counts_as_confirmed, AssociationRecord, EvalError, Method};
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;
 pub use scenario::{classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules};

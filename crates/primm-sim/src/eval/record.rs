@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use primm_core::measurement::ObjectClass;
 use primm_core::readable_number::readable;
+use primm_core::track::TrackStatus;
 
 pub use primm_core::mode::Method;
 
@@ -38,6 +39,18 @@ pub struct AssociationRecord {
     /// (`eq:mode_update`); `None` for single-model methods and rows without an update. A mode the
     /// method does not have carries probability 0.
     pub mode_probabilities: Option<[f64; 4]>,
+    /// Whether the track that took this measurement was confirmed after this frame's update,
+    /// i.e. whether a user of the published (confirmed) tracks saw this update. `Some(false)`
+    /// when a tentative track or no track took it; `None` when the source does not say (an
+    /// association file without the `confirmed` column). See [`counts_as_confirmed`].
+    #[serde(default)]
+    pub track_confirmed: Option<bool>,
+}
+
+/// Whether a track of this status is published as confirmed: every status except
+/// [`TrackStatus::Tentative`] (a confirmed track stays confirmed while it coasts).
+pub fn counts_as_confirmed(status: TrackStatus) -> bool {
+    !matches!(status, TrackStatus::Tentative)
 }
 
 impl AssociationRecord {
@@ -55,6 +68,12 @@ impl AssociationRecord {
     /// Whether this row is an estimated object frame (a track consumed the measurement).
     pub fn is_estimated_frame(&self) -> bool {
         self.track_id.is_some()
+    }
+
+    /// Whether a confirmed track took this measurement: a track id and `track_confirmed ==
+    /// Some(true)`.
+    pub fn is_confirmed_track_frame(&self) -> bool {
+        self.track_id.is_some() && self.track_confirmed == Some(true)
     }
 }
 
@@ -109,6 +128,7 @@ pub(crate) mod test_support {
             track_id: track,
             prior: None,
             mode_probabilities: None,
+            track_confirmed: Some(track.is_some()),
         }
     }
 
@@ -124,6 +144,7 @@ pub(crate) mod test_support {
             track_id: Some(gt),
             prior: None,
             mode_probabilities: None,
+            track_confirmed: Some(true),
         }
     }
 }
@@ -142,6 +163,23 @@ mod tests {
         }
         assert_eq!(Method::parse("pr-imm"), Some(Method::PrImm));
         assert_eq!(Method::parse("kalman"), None);
+    }
+
+    #[test]
+    fn every_status_but_tentative_counts_as_confirmed() {
+        assert!(!counts_as_confirmed(TrackStatus::Tentative));
+        assert!(counts_as_confirmed(TrackStatus::Confirmed));
+    }
+
+    #[test]
+    fn a_row_is_a_confirmed_track_frame_only_with_a_track_known_to_be_confirmed() {
+        let mut row = test_support::identity_row(0, Some(1), Some(1));
+        assert!(row.is_confirmed_track_frame());
+        row.track_confirmed = None;
+        assert!(!row.is_confirmed_track_frame());
+        row.track_confirmed = Some(true);
+        row.track_id = None;
+        assert!(!row.is_confirmed_track_frame());
     }
 
     #[test]

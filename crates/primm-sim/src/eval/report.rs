@@ -10,6 +10,8 @@
 //! * Table V (`tab:scenario_mot`): IDSW and IDF1 per interaction/missed-detection scenario
 //!   (rows) and method (columns),
 //! * the mean PR-IMM mode probabilities (`fig:mode_probability`),
+//! * beside the paper's tables, identity, false tracks and fragmentations on confirmed tracks
+//!   only ([`super::confirmed`]),
 //!
 //! as aligned plain text, marking the best value of each comparison with `*`, and writes the same
 //! numbers as JSON. A method without results is printed as `n/a`, never estimated.
@@ -22,6 +24,7 @@ use primm_core::measurement::ObjectClass;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
 
+use super::confirmed::{confirmed_track_counts, ConfirmedTrackCounts};
 use super::ego_motion::EgoMotion;
 use super::identity::{identity_counts, identity_counts_subset, IdentityCounts};
 use super::interaction::{interaction_flags, InteractionRules};
@@ -68,6 +71,10 @@ pub struct MethodResult {
     /// Identity counts per ego motion (sequences with ego poses only).
     #[serde(default)]
     pub ego_identity: BTreeMap<EgoMotion, IdentityCounts>,
+    /// Counts on confirmed tracks of the nominal sequences; `None` once a sequence's rows did
+    /// not say whether their tracks were confirmed (then the counts of the others would mislead).
+    #[serde(default)]
+    pub confirmed: Option<ConfirmedTrackCounts>,
 }
 
 impl MethodResult {
@@ -88,6 +95,7 @@ impl MethodResult {
             class_modes: BTreeMap::new(),
             ego_rmse: BTreeMap::new(),
             ego_identity: BTreeMap::new(),
+            confirmed: Some(ConfirmedTrackCounts::default()),
         }
     }
 
@@ -123,6 +131,10 @@ impl MethodResult {
         }
         for (motion, counts) in &other.ego_identity {
             self.ego_identity.entry(*motion).or_default().merge(counts);
+        }
+        match (&mut self.confirmed, &other.confirmed) {
+            (Some(mine), Some(theirs)) => mine.merge(theirs),
+            _ => self.confirmed = None,
         }
     }
 
@@ -188,6 +200,10 @@ impl MethodEvaluator {
         result.close_proximity.merge(&identity_counts_subset(records, &close));
         let crossing: Vec<bool> = flags.iter().map(|flag| flag.crossing).collect();
         result.crossing.merge(&identity_counts_subset(records, &crossing));
+        match (&mut result.confirmed, confirmed_track_counts(records)) {
+            (Some(total), Ok(counts)) => total.merge(&counts),
+            _ => result.confirmed = None,
+        }
         result.sequences += 1;
     }
 
@@ -431,6 +447,77 @@ impl EvaluationReport {
         text
     }
 
+    /// Identity, false tracks and fragmentations on confirmed tracks only, per method (rows):
+    /// IDF1, IDSW, IDFP, false tracks, false tracks per minute, fragmentations, confirmed tracks
+    /// and the clutter rows they took ([`super::confirmed`]).
+    pub fn table_confirmed_tracks(&self) -> String {
+        let counts: Vec<Option<ConfirmedTrackCounts>> =
+            Method::ALL.iter().map(|m| self.result(*m).and_then(|r| r.confirmed)).collect();
+        let column = |value: fn(&ConfirmedTrackCounts) -> Option<f64>, better: Better, digits: usize| {
+            let values: Vec<Option<f64>> = counts.iter().map(|c| c.as_ref().and_then(value)).collect();
+            mark_best(&values, better, digits)
+        };
+        let columns = [
+            column(ConfirmedTrackCounts::idf1, Better::Higher, 4),
+            column(|c| Some(c.identity.idsw as f64), Better::Lower, 0),
+            column(|c| Some(c.identity.idfp as f64), Better::Lower, 0),
+            column(|c| Some(c.false_tracks as f64), Better::Lower, 0),
+            column(ConfirmedTrackCounts::false_tracks_per_minute, Better::Lower, 2),
+            column(|c| Some(c.fragmentations as f64), Better::Lower, 0),
+            column(|c| Some(c.clutter_rows_in_confirmed_tracks as f64), Better::Lower, 0),
+        ];
+        let header: Vec<String> = [
+            "Model",
+            "IDF1",
+            "IDSW",
+            "IDFP",
+            "False tracks",
+            "False tracks/min",
+            "Frag",
+            "Clutter taken",
+            "Tracks",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let rows = Method::ALL
+            .iter()
+            .enumerate()
+            .map(|(row, method)| {
+                let mut line = vec![method.row_label().to_string()];
+                line.extend(columns.iter().map(|column| column[row].to_string()));
+                line.push(counts[row].map_or_else(|| "n/a".into(), |c| group_thousands(c.confirmed_tracks)));
+                line
+            })
+            .collect::<Vec<_>>();
+        let present: Vec<&ConfirmedTrackCounts> = counts.iter().flatten().collect();
+        let gt_frames = count_text(&present.iter().map(|c| c.identity.gt_object_frames).collect::<Vec<_>>());
+        let clutter = count_text(&present.iter().map(|c| c.clutter_rows).collect::<Vec<_>>());
+        let minutes = match present.first() {
+            Some(first) => format!("{:.1} min", first.duration_s / 60.0),
+            None => "n/a".into(),
+        };
+        let title = format!(
+            "Confirmed tracks (GT object frames = {gt_frames}, clutter rows = {clutter}, duration = {minutes})"
+        );
+        let mut text = render_table(&title, &header, &rows);
+        self.append_notes(
+            &mut text,
+            "* highest IDF1 / lowest other value in its column; estimated object frames are rows of \
+             confirmed tracks only",
+        );
+        for method in Method::ALL {
+            if self.result(method).is_some_and(|r| r.confirmed.is_none()) {
+                let _ = writeln!(
+                    text,
+                    "n/a {}: the rows do not say whether their track was confirmed",
+                    method.label()
+                );
+            }
+        }
+        text
+    }
+
     /// Mean posterior mode probabilities of PR-IMM (`fig:mode_probability`) as a small table.
     pub fn mode_probability_table(&self) -> String {
         let modes = self.result(Method::PrImm).map(|r| r.modes);
@@ -537,6 +624,7 @@ impl EvaluationReport {
             self.table_overall_mot(),
             self.table_scenario_mot(),
             self.table_ego_motion(),
+            self.table_confirmed_tracks(),
             self.mode_probability_table(),
         ]
         .into_iter()
@@ -556,6 +644,8 @@ impl EvaluationReport {
     /// empty `scenarios`. `mode_probabilities` holds PR-IMM's mean probabilities per mode and the
     /// number of updates (`null` values without updates), and `by_class` the same per object
     /// class that has updates (`{"car": {"samples", "pr", "cv", "ca", "ct"}, …}`).
+    /// `confirmed_tracks` holds the counts on confirmed tracks
+    /// ([`ConfirmedTrackCounts::to_json`]), `null` when unavailable or unknown.
     pub fn to_json(&self) -> Value {
         let mut methods = Map::new();
         for method in Method::ALL {
@@ -568,6 +658,7 @@ impl EvaluationReport {
                     "idsw": null, "idf1": null,
                     "counts": null,
                     "scenarios": {},
+                    "confirmed_tracks": null,
                 }),
             };
             methods.insert(method.key().to_string(), value);
@@ -650,6 +741,7 @@ impl EvaluationReport {
                 "mode_probability_samples": result.modes.count(),
             },
             "scenarios": scenarios,
+            "confirmed_tracks": result.confirmed.as_ref().map(ConfirmedTrackCounts::to_json),
         })
     }
 
@@ -957,6 +1049,8 @@ mod tests {
         assert!((merged.rmse.rmse_xy().unwrap() - joint.rmse.rmse_xy().unwrap()).abs() < 1e-12);
         assert_eq!(merged.modes, joint.modes);
         assert_eq!(merged.class_modes, joint.class_modes);
+        assert_eq!(merged.confirmed, joint.confirmed);
+        assert_eq!(merged.confirmed.unwrap().sequences, 2);
         assert_eq!(merged.sequences, 2);
         assert_eq!(merged.identity.idsw, 2);
         // RMSE over both: sqrt((21·1 + 21·4) / 42) = sqrt(2.5).
@@ -1088,6 +1182,61 @@ mod tests {
         for title in ["Table II", "Table III", "Table IV", "Table V", "Mean mode probability"] {
             assert!(text.contains(title));
         }
+    }
+
+    #[test]
+    fn the_confirmed_tracks_table_and_json_count_only_rows_of_confirmed_tracks() {
+        // Track 3 takes over object 2 in frame 6 and is confirmed from frame 8 on: object 2 is
+        // uncovered in frames 6 and 7 (one fragmentation), and its switch happens in frame 8.
+        let mut records = sequence(0.5);
+        for record in records.iter_mut().filter(|r| r.track_id == Some(3) && r.frame < 8) {
+            record.track_confirmed = Some(false);
+        }
+        let mut evaluator = MethodEvaluator::new(Method::Imm);
+        evaluator.add_sequence(&records);
+        let imm = evaluator.finish();
+        // The paper's counts are untouched by the status.
+        assert_eq!(imm.identity, evaluate(Method::Imm, 0.5).identity);
+        let confirmed = imm.confirmed.unwrap();
+        // 24 GT frames, 22 confirmed rows; overlap (1,1)=12, (2,2)=6, (2,3)=4 → IDTP 18.
+        assert_eq!(confirmed.identity.estimated_object_frames, 22);
+        assert_eq!((confirmed.identity.idtp, confirmed.identity.idfp, confirmed.identity.idfn), (18, 4, 6));
+        assert_eq!((confirmed.identity.idsw, confirmed.fragmentations), (1, 1));
+        assert_eq!((confirmed.confirmed_tracks, confirmed.false_tracks), (3, 0));
+        assert!((confirmed.duration_s - 1.1).abs() < 1e-9);
+
+        // Rows that do not say whether their track was confirmed (an old association file).
+        let mut unknown = sequence(0.5);
+        unknown.iter_mut().for_each(|record| record.track_confirmed = None);
+        let mut evaluator = MethodEvaluator::new(Method::ConstantVelocity);
+        evaluator.add_sequence(&sequence(0.5));
+        evaluator.add_sequence(&unknown);
+        let cv = evaluator.finish();
+        assert_eq!(cv.confirmed, None);
+        assert_eq!(cv.identity.idsw, 2, "the paper's metrics still count every sequence");
+
+        let mut report = EvaluationReport::new();
+        report.insert(imm);
+        report.insert(cv);
+        report.insert(evaluate(Method::PrImm, 0.5));
+        let table = report.table_confirmed_tracks();
+        assert!(table.starts_with("Confirmed tracks (GT object frames = 24, clutter rows = 0"), "{table}");
+        assert_eq!(row(&table, "IMM (CV+CA+CT)"), vec!["0.7826*", "1*", "4*", "0*", "0.00*", "1", "0*", "3"]);
+        assert_eq!(row(&table, "PR-IMM"), vec!["0.7500", "1*", "6", "0*", "0.00*", "0*", "0*", "3"]);
+        assert_eq!(row(&table, "CV "), vec!["n/a"; 8]);
+        assert!(table.contains("n/a CV: the rows do not say whether their track was confirmed"), "{table}");
+        assert!(table.contains("n/a PR: not evaluated"), "{table}");
+        assert!(report.to_text().contains("Confirmed tracks"));
+
+        let json = report.to_json();
+        let imm = &json["methods"]["imm"]["confirmed_tracks"];
+        assert_eq!(imm["idfp"], json!(4));
+        assert_eq!(imm["fragmentations"], json!(1));
+        assert_eq!(imm["tracks"], json!(3));
+        assert_eq!(imm["false_tracks_per_minute"], json!(0.0));
+        assert!((imm["idf1"].as_f64().unwrap() - 36.0 / 46.0).abs() < 1e-12);
+        assert!(json["methods"]["cv"]["confirmed_tracks"].is_null());
+        assert!(json["methods"]["pr"]["confirmed_tracks"].is_null());
     }
 
     #[test]

@@ -48,6 +48,7 @@ impl RecordedFrame {
             track_id: None,
             prior: None,
             mode_probabilities: None,
+            track_confirmed: Some(false),
         }
     }
 }
