@@ -79,6 +79,26 @@ overrides where present, else from ``[imm]``:
     python3 tools/tune_physics.py --data out/tune/default/validation out/tune/robust/validation \\
         --parameters imm-class --rounds 1 --out out/tune/imm_class.toml
 
+``--parameters tracks`` tunes how tracks are kept (scored with ``--method imm`` by default) on
+what a user of the published tracks sees: the identity of confirmed tracks and how many of them
+are false. Its knobs are the existence model's per-class detection probabilities and clutter
+densities, the initial, confirmation and deletion existence probabilities, the persistence time
+and the per-class gates (with ``association.cost = "likelihood"``: the chi-square gate and the
+radial-velocity residual spreads instead of the gates). Probabilities move through their odds.
+The objective is, averaged over the directories,
+
+    (1 - confirmed IDF1) + false_track_weight * false tracks per minute
+        + max(0, IDF1_start - IDF1)
+
+(confirmed-track metrics of ``primm eval``, docs/evaluation-metrics.md; the last term keeps the
+paper's per-measurement IDF1 from falling). The discrete choices (``association.cost``,
+``association.stages``, ``tracker.lifecycle``) are the starting configuration's: tune each
+combination from its own file and compare the objectives.
+
+    python3 tools/tune_physics.py --data out/tune/clutter_turning/validation \
+        out/tune/clutter/validation out/tune/default/validation out/tune/robust/validation \
+        --parameters tracks --rounds 2 --out out/tune/tracks.toml
+
 Needs only the Python standard library (3.11+) and a release build of primm.
 """
 
@@ -134,8 +154,32 @@ PR_NOISE_PARAMETERS = [
 CLASS_IMM_KNOBS = ("pr_leave", "into_pr", "initial_pr")
 CLASS_IMM_PARAMETERS = [(f"classes.{cls}.imm", key) for cls in ("car", "pedestrian") for key in CLASS_IMM_KNOBS]
 
+# How tracks are kept: the existence model and the gates (paper cost), scored on confirmed tracks.
+TRACK_PARAMETERS = [
+    ("classes.car.existence", "detection_probability"),
+    ("classes.pedestrian.existence", "detection_probability"),
+    ("classes.car.existence", "clutter_density_per_m2"),
+    ("classes.pedestrian.existence", "clutter_density_per_m2"),
+    ("tracker", "initial_existence_probability"),
+    ("tracker", "confirmation_existence_probability"),
+    ("tracker", "deletion_existence_probability"),
+    ("tracker", "existence_persistence_time_s"),
+    ("classes.car", "gate_m"),
+    ("classes.pedestrian", "gate_m"),
+]
+# The likelihood cost's gate and spreads, which replace the paper cost's gates in the set.
+LIKELIHOOD_PARAMETERS = [
+    ("association", "likelihood_gate_chi2"),
+    ("classes.car", "radial_velocity_residual_std_mps"),
+    ("classes.pedestrian", "radial_velocity_residual_std_mps"),
+]
+# Keys whose values are probabilities: they move through their odds, so they stay in (0, 1).
+PROBABILITY_KEYS = ("detection_probability", "initial_existence_probability",
+                    "confirmation_existence_probability", "deletion_existence_probability")
+
 PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS, "imm": IMM_PARAMETERS,
-                  "pr-noise": PR_NOISE_PARAMETERS, "imm-class": CLASS_IMM_PARAMETERS}
+                  "pr-noise": PR_NOISE_PARAMETERS, "imm-class": CLASS_IMM_PARAMETERS,
+                  "tracks": TRACK_PARAMETERS}
 # Sets tuned with the wide factors and scored with pr-imm by default.
 WIDE_SETS = ("imm", "pr-noise", "imm-class")
 
@@ -404,6 +448,8 @@ def parse_args(argv=None):
                              "pr-noise)")
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--idf1-weight", type=float, default=20.0, help="metres of RMSE per unit of IDF1 lost")
+    parser.add_argument("--false-track-weight", type=float, default=0.001,
+                        help="--parameters tracks: objective per false confirmed track per minute")
     parser.add_argument("--tracking-frame", choices=["world", "vehicle"], default="world")
     parser.add_argument("--displacement-oracle", action="store_true",
                         help="score with `primm eval --displacement-oracle`: PR gets the true displacement "
@@ -505,8 +551,36 @@ def pr_noise_text(text: str, matrices: dict, scales: dict) -> str:
     return text
 
 
+def track_parameters(config: dict) -> list:
+    """The knobs of the ``tracks`` set for a configuration: the likelihood cost's gate and spreads
+    replace the paper cost's gates when the configuration uses it."""
+    if config.get("association", {}).get("cost") == "likelihood":
+        return [parameter for parameter in TRACK_PARAMETERS if parameter[1] != "gate_m"] + LIKELIHOOD_PARAMETERS
+    return list(TRACK_PARAMETERS)
+
+
+def scaled_value(key: str, base: float, factor: float) -> float:
+    """``base`` times ``factor``, through its odds for a probability (which stays in (0, 1)); 4
+    significant digits."""
+    if key in PROBABILITY_KEYS:
+        odds = factor * base / (1.0 - base)
+        return float(f"{odds / (1.0 + odds):.4g}")
+    return float(f"{base * factor:.4g}")
+
+
+def track_objective(args, result: dict, start: dict) -> float:
+    """The ``tracks`` objective (module docstring), averaged over the directories."""
+    terms = [
+        (1.0 - confirmed) + args.false_track_weight * false_rate + max(0.0, idf1_start - idf1)
+        for confirmed, false_rate, idf1, idf1_start in zip(
+            result["confirmed_idf1"], result["false_tracks_per_minute"], result["idf1"], start["idf1"])
+    ]
+    return sum(terms) / len(terms)
+
+
 def score(args, text: str) -> dict:
-    """The method's RMSE_xy and IDF1 on every data directory for the configuration ``text``."""
+    """The method's RMSE_xy and IDF1 on every data directory for the configuration ``text`` (and
+    the confirmed-track IDF1 and false-track rate)."""
     with tempfile.TemporaryDirectory() as tmp:
         config = os.path.join(tmp, "config.toml")
         with open(config, "w") as handle:
@@ -524,6 +598,9 @@ def score(args, text: str) -> dict:
                 scored = json.load(handle)["methods"][args.method.replace("-", "_")]
             result["rmse_xy"].append(scored["rmse_xy"])
             result["idf1"].append(scored["idf1"])
+            confirmed = scored.get("confirmed_tracks") or {}
+            result.setdefault("confirmed_idf1", []).append(confirmed.get("idf1") or 0.0)
+            result.setdefault("false_tracks_per_minute", []).append(confirmed.get("false_tracks_per_minute") or 0.0)
             pr_probability = scored_pr_probability(report, args.method)
             if pr_probability is not None:
                 result.setdefault("pr_probability", []).append(pr_probability)
@@ -548,6 +625,8 @@ def scored_pr_probability(report: str, method: str):
 
 
 def objective(args, result: dict, start: dict) -> float:
+    if args.parameters == "tracks":
+        return track_objective(args, result, start)
     terms = [
         rmse + args.idf1_weight * max(0.0, idf1_start - idf1)
         for rmse, idf1, idf1_start in zip(result["rmse_xy"], result["idf1"], start["idf1"])
@@ -573,13 +652,19 @@ def main(argv=None) -> int:
     best = objective(args, start, start)
     log = [{"parameter": None, "value": None, "result": start, "objective": best}]
     print(f"start: objective {best:.4f}  {start}", flush=True)
+    parameters = track_parameters(config) if args.parameters == "tracks" else PARAMETER_SETS[args.parameters]
     for round_index in range(args.rounds):
-        for section, key in PARAMETER_SETS[args.parameters]:
+        for section, key in parameters:
             base = get_value(config, section, key)
             for factor in args.factors:
-                value = float(f"{base * factor:.4g}")
+                value = scaled_value(key, base, factor)
                 candidate = substitute(text, section, key, value)
-                result = score(args, candidate)
+                try:
+                    result = score(args, candidate)
+                except subprocess.CalledProcessError:
+                    # primm refused the candidate (e.g. a deletion threshold above confirmation).
+                    log.append({"parameter": f"{section}.{key}", "value": value, "result": None})
+                    continue
                 value_objective = objective(args, result, start)
                 log.append({"parameter": f"{section}.{key}", "value": value, "result": result,
                             "objective": value_objective})
