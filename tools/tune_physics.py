@@ -88,16 +88,17 @@ radial-velocity residual spreads instead of the gates). Probabilities move throu
 The objective is, averaged over the directories,
 
     (1 - confirmed IDF1) + false_track_weight * false tracks per minute
-        + max(0, IDF1_start - IDF1)
+        + idf1_guard_weight * max(0, IDF1_guard - IDF1)
 
 (confirmed-track metrics of ``primm eval``, docs/evaluation-metrics.md; the last term keeps the
-paper's per-measurement IDF1 from falling). The discrete choices (``association.cost``,
+paper's per-measurement IDF1 from falling below that of ``--guard-config``, by default the
+starting configuration). The discrete choices (``association.cost``,
 ``association.stages``, ``tracker.lifecycle``) are the starting configuration's: tune each
 combination from its own file and compare the objectives.
 
     python3 tools/tune_physics.py --data out/tune/clutter_turning/validation \
         out/tune/clutter/validation out/tune/default/validation out/tune/robust/validation \
-        --parameters tracks --rounds 2 --out out/tune/tracks.toml
+        --parameters tracks --rounds 2 --guard-config config/primm.toml --out out/tune/tracks.toml
 
 Needs only the Python standard library (3.11+) and a release build of primm.
 """
@@ -450,6 +451,11 @@ def parse_args(argv=None):
     parser.add_argument("--idf1-weight", type=float, default=20.0, help="metres of RMSE per unit of IDF1 lost")
     parser.add_argument("--false-track-weight", type=float, default=0.001,
                         help="--parameters tracks: objective per false confirmed track per minute")
+    parser.add_argument("--guard-config", default=None,
+                        help="--parameters tracks: the configuration whose per-measurement IDF1 the candidates must "
+                             "not fall below (default: the starting one)")
+    parser.add_argument("--idf1-guard-weight", type=float, default=5.0,
+                        help="--parameters tracks: objective per unit of per-measurement IDF1 lost")
     parser.add_argument("--tracking-frame", choices=["world", "vehicle"], default="world")
     parser.add_argument("--displacement-oracle", action="store_true",
                         help="score with `primm eval --displacement-oracle`: PR gets the true displacement "
@@ -571,7 +577,8 @@ def scaled_value(key: str, base: float, factor: float) -> float:
 def track_objective(args, result: dict, start: dict) -> float:
     """The ``tracks`` objective (module docstring), averaged over the directories."""
     terms = [
-        (1.0 - confirmed) + args.false_track_weight * false_rate + max(0.0, idf1_start - idf1)
+        (1.0 - confirmed) + args.false_track_weight * false_rate
+        + args.idf1_guard_weight * max(0.0, idf1_start - idf1)
         for confirmed, false_rate, idf1, idf1_start in zip(
             result["confirmed_idf1"], result["false_tracks_per_minute"], result["idf1"], start["idf1"])
     ]
@@ -649,6 +656,9 @@ def main(argv=None) -> int:
         return tune_class_imm(args, text)
     config = tomllib.loads(text)
     start = score(args, text)
+    if args.parameters == "tracks" and args.guard_config is not None:
+        with open(args.guard_config) as handle:
+            start["idf1"] = score(args, handle.read())["idf1"]
     best = objective(args, start, start)
     log = [{"parameter": None, "value": None, "result": start, "objective": best}]
     print(f"start: objective {best:.4f}  {start}", flush=True)

@@ -263,6 +263,11 @@ pub struct TrackerConfig {
     /// `exp(−Δt / T)` every frame (absent: 10 s).
     #[cfg_attr(feature = "serde", serde(default = "default_persistence_time_s"))]
     pub existence_persistence_time_s: f64,
+    /// Consecutive updates of either of two overlapping tracks of one class, without an update
+    /// of the other in the same frame, after which the younger is merged into the older
+    /// (`crate::duplicates`); 0 turns the check off (absent: 0).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub duplicate_updates: u32,
 }
 
 #[cfg(feature = "serde")]
@@ -346,6 +351,14 @@ pub struct ClassConfig {
     /// (absent: 0.9 and 1e-4 /m²).
     #[cfg_attr(feature = "serde", serde(default))]
     pub existence: ExistenceConfig,
+    /// Largest distance between the fused positions of two tracks of one object of this class,
+    /// for the duplicate check, m (absent: 2 m).
+    #[cfg_attr(feature = "serde", serde(default = "default_duplicate_distance_m"))]
+    pub duplicate_distance_m: f64,
+    /// Largest difference between the fused velocities of two tracks of one object of this
+    /// class, for the duplicate check, m/s (absent: 2 m/s).
+    #[cfg_attr(feature = "serde", serde(default = "default_duplicate_speed_difference_mps"))]
+    pub duplicate_speed_difference_mps: f64,
     /// Constant-velocity mode.
     pub constant_velocity: ConstantVelocityConfig,
     /// Constant-acceleration mode.
@@ -398,6 +411,16 @@ impl ImmConfig {
 #[cfg(feature = "serde")]
 fn default_radial_velocity_residual_std_mps() -> f64 {
     1.0
+}
+
+#[cfg(feature = "serde")]
+fn default_duplicate_distance_m() -> f64 {
+    2.0
+}
+
+#[cfg(feature = "serde")]
+fn default_duplicate_speed_difference_mps() -> f64 {
+    2.0
 }
 
 /// Constant-velocity noise.
@@ -493,9 +516,10 @@ impl Default for Config {
             association: AssociationConfig {
                 velocity_weight_s: 0.1,
                 velocity_cap_mps: 5.0,
-                cost: AssociationCost::Paper,
-                stages: AssociationStages::Joint,
-                likelihood_gate_chi2: DEFAULT_LIKELIHOOD_GATE_CHI2,
+                // Chosen on validation data (`config/primm.toml` says how).
+                cost: AssociationCost::Likelihood,
+                stages: AssociationStages::ConfirmedFirst,
+                likelihood_gate_chi2: 112.0,
             },
             tracker: TrackerConfig {
                 max_frame_interval_s: 1.0,
@@ -504,11 +528,12 @@ impl Default for Config {
                 tentative_max_coast_s: 0.3,
                 confirmed_max_misses: 100,
                 max_coast_s: 1.0,
-                lifecycle: Lifecycle::Counts,
-                initial_existence_probability: 0.5,
-                confirmation_existence_probability: 0.9,
-                deletion_existence_probability: 0.05,
-                existence_persistence_time_s: 10.0,
+                lifecycle: Lifecycle::Existence,
+                initial_existence_probability: 0.2,
+                confirmation_existence_probability: 0.973,
+                deletion_existence_probability: 0.01299,
+                existence_persistence_time_s: 40.0,
+                duplicate_updates: 4,
             },
             classes: ClassTable {
                 car: ClassConfig {
@@ -516,8 +541,10 @@ impl Default for Config {
                     measurement_noise_covariance_m2: diagonal(0.36, 0.36),
                     radial_velocity_std_mps: 0.5,
                     initial_tangential_speed_std_mps: 2.0,
-                    radial_velocity_residual_std_mps: 1.0,
-                    existence: ExistenceConfig { detection_probability: 0.8, clutter_density_per_m2: 1e-4 },
+                    radial_velocity_residual_std_mps: 0.5,
+                    existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
+                    duplicate_distance_m: 3.0,
+                    duplicate_speed_difference_mps: 2.0,
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 5.0,
@@ -549,8 +576,13 @@ impl Default for Config {
                     measurement_noise_covariance_m2: diagonal(0.09, 0.09),
                     radial_velocity_std_mps: 0.3,
                     initial_tangential_speed_std_mps: 0.525,
-                    radial_velocity_residual_std_mps: 0.5,
-                    existence: ExistenceConfig { detection_probability: 0.7, clutter_density_per_m2: 1e-4 },
+                    radial_velocity_residual_std_mps: 0.7,
+                    existence: ExistenceConfig {
+                        detection_probability: 0.15,
+                        clutter_density_per_m2: 0.0004,
+                    },
+                    duplicate_distance_m: 1.0,
+                    duplicate_speed_difference_mps: 1.0,
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 1.75,
@@ -583,7 +615,9 @@ impl Default for Config {
                     radial_velocity_std_mps: 0.4,
                     initial_tangential_speed_std_mps: 5.0,
                     radial_velocity_residual_std_mps: 1.0,
-                    existence: ExistenceConfig { detection_probability: 0.8, clutter_density_per_m2: 1e-4 },
+                    existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
+                    duplicate_distance_m: 1.5,
+                    duplicate_speed_difference_mps: 2.0,
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 3.0 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 15.0,
@@ -832,6 +866,8 @@ fn validate_class(class: ObjectClass, section: &ClassConfig) -> Result<(), Confi
     positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
     positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
     positive(&key("radial_velocity_residual_std_mps"), section.radial_velocity_residual_std_mps)?;
+    positive(&key("duplicate_distance_m"), section.duplicate_distance_m)?;
+    positive(&key("duplicate_speed_difference_mps"), section.duplicate_speed_difference_mps)?;
     open_probability(&key("existence.detection_probability"), section.existence.detection_probability)?;
     let clutter = section.existence.clutter_density_per_m2;
     if !(clutter.is_finite() && clutter >= 0.0) {

@@ -54,6 +54,7 @@ extern crate alloc;
 pub mod association;
 pub mod config;
 pub mod displacement_check;
+pub mod duplicates;
 pub mod existence;
 pub mod gaussian;
 pub mod imm;

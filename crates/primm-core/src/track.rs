@@ -82,6 +82,12 @@ pub struct Track {
     pub existence_probability: f64,
     /// Ground-truth id of the last associated measurement (evaluation only).
     pub ground_truth_id: Option<u64>,
+    /// The older track of the same class this one has overlapped with (see
+    /// [`crate::duplicates`]), and for how many consecutive updates of either of the two
+    /// without one of the other in the same frame.
+    pub duplicate_of: Option<u64>,
+    /// See [`duplicate_of`](Self::duplicate_of).
+    pub exclusive_updates: u32,
 }
 
 impl Track {
@@ -107,6 +113,8 @@ impl Track {
             misses: 0,
             existence_probability,
             ground_truth_id: measurement.ground_truth_id,
+            duplicate_of: None,
+            exclusive_updates: 0,
         };
         track.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
         track

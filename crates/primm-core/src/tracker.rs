@@ -12,6 +12,7 @@ use crate::association::assignment::AssignmentError;
 use crate::association::associator::{AssociationStats, Associator};
 use crate::config::{Config, ConfigError, LearnedProcessNoise};
 use crate::displacement_check::{check_answer, DisplacementRejection};
+use crate::duplicates::{self, DuplicateView};
 use crate::existence::{self, Evidence, FieldOfView, Lifecycle};
 use crate::gaussian::UpdateError;
 use crate::imm::ImmPrior;
@@ -113,6 +114,8 @@ pub struct TrackerStats {
     /// Frames with a measurement whose sensor has no configured mount (or no sensor id): every
     /// track counted as in view of that sensor, so misses counted against existence.
     pub frames_with_unknown_sensor: u64,
+    /// Tracks merged into an older track of the same object (`crate::duplicates`).
+    pub duplicate_tracks_merged: u64,
 }
 
 /// What one step did: the per-frame counterpart of [`TrackerStats`]. Returned by
@@ -163,6 +166,8 @@ pub struct StepSummary {
     /// Whether a measurement of the frame named no configured sensor (see
     /// [`TrackerStats::frames_with_unknown_sensor`]).
     pub unknown_sensor: bool,
+    /// Tracks merged into an older track of the same object.
+    pub duplicates_merged: usize,
 }
 
 impl TrackerStats {
@@ -185,6 +190,7 @@ impl TrackerStats {
         self.initiations_from_unknown_sensor += count(step.initiations_from_unknown_sensor);
         self.tracking_frame_changes += u64::from(step.tracking_frame_changed);
         self.frames_with_unknown_sensor += u64::from(step.unknown_sensor);
+        self.duplicate_tracks_merged += count(step.duplicates_merged);
     }
 }
 
@@ -257,6 +263,10 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// The fields of view of the sensors that scanned in the current frame, with their
     /// detection-probability and clutter-density factors.
     scanning_sensors: Box<ArrayVec<ScanningSensor, MAX_SENSORS>>,
+    /// Each live track's fused state for the duplicate check, aligned with the table.
+    duplicate_views: Box<[DuplicateView; MAX_TRACKS]>,
+    /// Tracks merged into an older one in the current frame, aligned with the table.
+    merged: Box<[bool; MAX_TRACKS]>,
     /// The current frame as read once during validation; every later stage reads this copy.
     validated: Box<ValidatedFrame>,
     outputs: Box<ArrayVec<TrackOutput, MAX_TRACKS>>,
@@ -297,6 +307,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
             accepted: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
             scanning_sensors: Box::new(ArrayVec::new()),
+            duplicate_views: Box::new([DuplicateView::default(); MAX_TRACKS]),
+            merged: Box::new([false; MAX_TRACKS]),
             validated: Box::new(ValidatedFrame::new()),
             outputs: Box::new(ArrayVec::new()),
         })
@@ -384,6 +396,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.coast();
         self.initiate(t);
         self.delete(t);
+        self.merge_duplicates();
         observer.stage_finished(Stage::Update);
         self.last_timestamp_s = Some(t);
         self.stats.frames_tracked += 1;
@@ -788,6 +801,115 @@ impl<P: DisplacementPredictor> Tracker<P> {
             keep
         });
         self.last_step.deleted = deleted;
+    }
+
+    /// Merges each track that has shadowed an older track of its class for
+    /// `tracker.duplicate_updates` exclusive updates into that track (`crate::duplicates`).
+    fn merge_duplicates(&mut self) {
+        if !duplicates::enabled(&self.config) {
+            return;
+        }
+        let count = self.table.len();
+        for (i, track) in self.table.tracks().iter().enumerate() {
+            let imm = &self.imms[track.class.index()];
+            let available = self.rows[i].available;
+            self.duplicate_views[i] = DuplicateView {
+                position_m: imm.fuse_posterior(&track.estimate, available).mean,
+                velocity_mps: imm.fuse_velocity(&track.estimate, available),
+                updated: self.rows[i].measurement_index.is_some(),
+            };
+        }
+        self.merged[..count].fill(false);
+        let needed = self.config.tracker.duplicate_updates;
+        for younger in 0..count {
+            let partner = self.older_overlapping_track(younger);
+            let views = &self.duplicate_views;
+            let track = &mut self.table.tracks_mut()[younger];
+            let Some(older) = partner else {
+                track.duplicate_of = None;
+                track.exclusive_updates = 0;
+                continue;
+            };
+            let older_id = self.table.tracks()[older].id;
+            let track = &mut self.table.tracks_mut()[younger];
+            if track.duplicate_of != Some(older_id) {
+                track.duplicate_of = Some(older_id);
+                track.exclusive_updates = 0;
+            }
+            track.exclusive_updates = duplicates::next_exclusive_updates(
+                track.exclusive_updates,
+                views[younger].updated,
+                views[older].updated,
+            );
+            if track.exclusive_updates >= needed && !self.merged[older] {
+                self.merge_into(younger, older);
+            }
+        }
+        let merged = &self.merged;
+        let rows = &mut self.rows;
+        let (mut read, mut write) = (0, 0);
+        let removed = self.table.retain(|_| {
+            let keep = !merged[read];
+            if keep {
+                rows[write] = rows[read];
+                write += 1;
+            }
+            read += 1;
+            keep
+        });
+        self.last_step.duplicates_merged = removed;
+    }
+
+    /// The nearest older track (more frames, or as many and a smaller id) of `index`'s class that
+    /// overlaps it, not already merged away.
+    fn older_overlapping_track(&self, index: usize) -> Option<usize> {
+        let tracks = self.table.tracks();
+        let track = &tracks[index];
+        let section = self.config.classes.get(track.class);
+        let view = &self.duplicate_views[index];
+        let older = |other: &crate::track::Track| {
+            (other.age_frames, core::cmp::Reverse(other.id))
+                > (track.age_frames, core::cmp::Reverse(track.id))
+        };
+        (0..tracks.len())
+            .filter(|&j| j != index && !self.merged[j] && tracks[j].class == track.class && older(&tracks[j]))
+            .filter(|&j| {
+                duplicates::overlap(
+                    view,
+                    &self.duplicate_views[j],
+                    section.duplicate_distance_m,
+                    section.duplicate_speed_difference_mps,
+                )
+            })
+            .min_by(|&a, &b| {
+                let distance =
+                    |j: usize| view.position_m.distance_squared(self.duplicate_views[j].position_m);
+                distance(a).total_cmp(&distance(b))
+            })
+    }
+
+    /// Merges track `younger` into `older`: the older keeps its id, age, hits and status (the
+    /// better of the two), and takes the younger's state if that was updated more recently.
+    fn merge_into(&mut self, younger: usize, older: usize) {
+        let source = self.table.tracks()[younger].clone();
+        let target = &mut self.table.tracks_mut()[older];
+        if source.last_update_s > target.last_update_s {
+            target.estimate = source.estimate;
+            target.history = source.history;
+            target.last_radial_velocity_mps = source.last_radial_velocity_mps;
+            target.last_update_s = source.last_update_s;
+            target.misses = source.misses;
+            target.ground_truth_id = source.ground_truth_id;
+            if target.status == TrackStatus::Coasting {
+                target.status = TrackStatus::Confirmed;
+            }
+            self.rows[older] = self.rows[younger];
+        }
+        target.existence_probability = target.existence_probability.max(source.existence_probability);
+        if source.status.is_confirmed() && !target.status.is_confirmed() {
+            target.status = source.status;
+        }
+        self.merged[younger] = true;
     }
 
     /// Where the radar that measured `measurement` is, in the tracking frame: the world

@@ -412,6 +412,8 @@ pub struct PrimmStats {
     /// Frames with a measurement whose sensor has no configured mount (or no sensor id): every
     /// track counted as in view of that sensor.
     pub frames_with_unknown_sensor: u64,
+    /// Tracks merged into an older track of the same object.
+    pub duplicate_tracks_merged: u64,
 }
 
 impl From<&TrackerStats> for PrimmStats {
@@ -444,6 +446,7 @@ impl From<&TrackerStats> for PrimmStats {
             update_failures,
             resets,
             frames_with_unknown_sensor,
+            duplicate_tracks_merged,
         } = *stats;
         PrimmStats {
             frames_tracked,
@@ -472,6 +475,7 @@ impl From<&TrackerStats> for PrimmStats {
             update_failures,
             resets,
             frames_with_unknown_sensor,
+            duplicate_tracks_merged,
         }
     }
 }
