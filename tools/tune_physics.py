@@ -605,9 +605,11 @@ def score(args, text: str) -> dict:
                 scored = json.load(handle)["methods"][args.method.replace("-", "_")]
             result["rmse_xy"].append(scored["rmse_xy"])
             result["idf1"].append(scored["idf1"])
-            confirmed = scored.get("confirmed_tracks") or {}
-            result.setdefault("confirmed_idf1", []).append(confirmed.get("idf1") or 0.0)
-            result.setdefault("false_tracks_per_minute", []).append(confirmed.get("false_tracks_per_minute") or 0.0)
+            if args.parameters == "tracks":
+                confirmed = scored.get("confirmed_tracks") or {}
+                result.setdefault("confirmed_idf1", []).append(confirmed.get("idf1") or 0.0)
+                result.setdefault("false_tracks_per_minute", []).append(
+                    confirmed.get("false_tracks_per_minute") or 0.0)
             pr_probability = scored_pr_probability(report, args.method)
             if pr_probability is not None:
                 result.setdefault("pr_probability", []).append(pr_probability)

@@ -419,3 +419,31 @@ def test_the_oracle_flag_reaches_every_primm_eval_call(tmp_path, monkeypatch):
         assert all(("--displacement-oracle" in command) == expected for command in commands)
         noise = "0.1" in flag
         assert all((command[-2:] == ["--displacement-oracle-noise-m", "0.1"]) == noise for command in commands)
+
+
+def test_the_tracks_set_moves_probabilities_through_their_odds_and_other_knobs_by_factor():
+    assert tune_physics.scaled_value("detection_probability", 0.5, 3.0) == 0.75
+    assert 0.0 < tune_physics.scaled_value("deletion_existence_probability", 0.9, 100.0) < 1.0
+    assert tune_physics.scaled_value("gate_m", 4.0, 0.5) == 2.0
+    config = tomllib.loads(shipped_text())
+    for section, key in tune_physics.TRACK_PARAMETERS + tune_physics.LIKELIHOOD_PARAMETERS:
+        tune_physics.get_value(config, section, key)  # every knob exists in the shipped file
+    config["association"]["cost"] = "likelihood"
+    likelihood = tune_physics.track_parameters(config)
+    assert ("association", "likelihood_gate_chi2") in likelihood
+    assert all(key != "gate_m" for _, key in likelihood)
+    config["association"]["cost"] = "paper"
+    assert ("classes.car", "gate_m") in tune_physics.track_parameters(config)
+
+
+def test_the_tracks_objective_rewards_confirmed_identity_and_punishes_false_tracks_and_idf1_lost(tmp_path):
+    args = tune_physics.parse_args(["--data", "a/validation", "--out", str(tmp_path / "o.toml"),
+                                    "--parameters", "tracks"])
+    start = {"idf1": [0.95], "confirmed_idf1": [0.9], "false_tracks_per_minute": [100.0]}
+    base = tune_physics.objective(args, start, start)
+    assert abs(base - (0.1 + 0.1)) < 1e-12
+    fewer_false = dict(start, false_tracks_per_minute=[10.0])
+    assert tune_physics.objective(args, fewer_false, start) < base
+    # A confirmed-IDF1 gain bought with per-measurement IDF1 costs five times that loss.
+    traded = dict(start, confirmed_idf1=[0.92], idf1=[0.94])
+    assert tune_physics.objective(args, traded, start) > base
