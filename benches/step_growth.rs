@@ -15,7 +15,7 @@
 //!
 //! Prints a table and writes `benches/results/step_growth.{md,json,svg}`. Nothing is asserted.
 //!
-//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64] [-- --inference-threads N] [-- --engine native|tract]`
+//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64] [-- --inference-threads N] [-- --engine native|tract] [-- --config FILE] [-- --no-write]`
 
 use hdrhistogram::Histogram;
 use plotters::prelude::*;
@@ -105,8 +105,14 @@ fn us(nanoseconds: u64) -> f64 {
     nanoseconds as f64 / 1000.0
 }
 
-fn run<P: DisplacementPredictor>(method: Method, predictor: P, count: usize, frames: usize) -> Row {
-    let config = Config::default().with_modes(method.modes());
+fn run<P: DisplacementPredictor>(
+    base: &Config,
+    method: Method,
+    predictor: P,
+    count: usize,
+    frames: usize,
+) -> Row {
+    let config = base.clone().with_modes(method.modes());
     let mut tracker = Tracker::with_predictor(config, predictor).unwrap();
     let scene = scene(count, WARM_UP_FRAMES + frames, 7 + count as u64);
     let mut step = histogram();
@@ -248,6 +254,11 @@ fn main() {
         .unwrap_or(Config::default().predictor.inference_threads);
     let engine: InferenceEngine = argument("--engine")
         .map_or(Config::default().predictor.engine, |name| name.parse().expect("--engine native|tract"));
+    // `--config FILE`: another tracker configuration (e.g. the previous lifecycle and association
+    // settings, to measure what existence and staged association cost).
+    let base = argument("--config").map_or_else(Config::default, |path| {
+        primm_config::from_file(Path::new(&path)).expect("--config names a valid configuration")
+    });
     let mut rows = Vec::new();
     for &method in &methods {
         for &count in &counts {
@@ -256,9 +267,9 @@ fn main() {
                 assert_eq!(onnx.set_engine(engine), engine);
                 let threaded =
                     on_inference_threads(onnx, inference_threads, Duration::from_millis(50)).unwrap();
-                run(method, threaded, count, frames)
+                run(&base, method, threaded, count, frames)
             } else {
-                run(method, NoPredictor, count, frames)
+                run(&base, method, NoPredictor, count, frames)
             };
             eprintln!(
                 "{} {:>3} objects: step p50 {:.1} µs, p99 {:.1} µs",

@@ -197,6 +197,8 @@ typedef struct PrimmTrack {
   uint32_t hits;
   // Consecutive frames without measurement (0 when updated in this step).
   uint32_t misses;
+  // Probability that the track's object exists, in (0, 1).
+  double existence_probability;
   // Index, in this step's measurement array, of the measurement that updated or started the
   // track, or `PRIMM_NO_MEASUREMENT_INDEX` when the track coasted.
   int32_t measurement_index;
@@ -278,6 +280,11 @@ typedef struct PrimmStats {
   uint64_t update_failures;
   // Calls to `primm_tracker_reset`.
   uint64_t resets;
+  // Frames with a measurement whose sensor has no configured mount (or no sensor id): every
+  // track counted as in view of that sensor.
+  uint64_t frames_with_unknown_sensor;
+  // Tracks merged into an older track of the same object.
+  uint64_t duplicate_tracks_merged;
 } PrimmStats;
 
 // The modes the configuration names (`imm.modes`; PR, CV, CA and CT in the defaults).
@@ -313,8 +320,12 @@ typedef struct PrimmStats {
 // Started by an unassigned measurement, not yet confirmed.
 #define PRIMM_TRACK_STATUS_TENTATIVE 0
 
-// Confirmed by `tracker.confirmation_hits` hits.
+// Confirmed (by hits or by its existence probability) and detected the last time a sensor had
+// it in view.
 #define PRIMM_TRACK_STATUS_CONFIRMED 1
+
+// Confirmed, but missed the last time a sensor had it in view (its state is a prediction since).
+#define PRIMM_TRACK_STATUS_COASTING 2
 
 #ifdef __cplusplus
 extern "C" {

@@ -130,7 +130,10 @@ fn dense_optimum(scene: &Scene, config: &Config, class: ObjectClass) -> (usize, 
 
 #[test]
 fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
-    let config = Config::default();
+    // The paper's cost in one stage (tests/staged_association.rs covers the other settings).
+    let mut config = Config::default();
+    config.association.cost = primm_core::config::AssociationCost::Paper;
+    config.association.stages = primm_core::config::AssociationStages::Joint;
     let mut rng = ChaCha8Rng::seed_from_u64(2024);
     let mut associator = Associator::new();
     let mut solved_clusters = 0;

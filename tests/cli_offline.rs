@@ -49,8 +49,11 @@ fn track_writes_one_row_per_measurement_with_consistent_columns() {
     // Every measurement updated or started exactly one track.
     assert_eq!(rows.len(), sequence.measurement_count());
     for row in &rows {
-        assert_eq!(row.len(), 17);
-        let world: Vec<f64> = row[13..17].iter().map(|v| v.parse::<f64>().unwrap()).collect();
+        assert_eq!(row.len(), 19);
+        assert!(["tentative", "confirmed", "coasting"].contains(&row[13]), "status {}", row[13]);
+        let existence: f64 = row[14].parse().unwrap();
+        assert!(existence > 0.0 && existence < 1.0, "existence {existence}");
+        let world: Vec<f64> = row[15..19].iter().map(|v| v.parse::<f64>().unwrap()).collect();
         assert!(world.iter().all(|v| v.is_finite()), "world columns {world:?}");
         let mu: f64 = row[9..13].iter().map(|v| v.parse::<f64>().unwrap()).sum();
         assert!((mu - 1.0).abs() < 1e-9, "mode probabilities sum to {mu}");

@@ -10,6 +10,7 @@ use primm_core::tracker::Tracker;
 fn config(duplicate_updates: u32) -> Config {
     let mut config = Config::default().with_modes(Method::Imm.modes());
     config.tracker.duplicate_updates = duplicate_updates;
+    config.association.cost = primm_core::config::AssociationCost::Paper;
     // A gate tighter than the two reflection points' distance, so that the second starts a track.
     config.classes.car.gate_m = 1.0;
     config.classes.pedestrian.gate_m = 0.5;

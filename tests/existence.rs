@@ -17,6 +17,12 @@ const RIGHT: [f64; 2] = [20.0, -20.0];
 fn config(lifecycle: Lifecycle) -> Config {
     let mut config = Config::default().with_modes(Method::Imm.modes());
     config.tracker.lifecycle = lifecycle;
+    // A sensor that seldom misses and confirmation and deletion thresholds of round values, so
+    // that a few scans decide (the shipped values are chosen on validation data).
+    config.classes.car.existence.detection_probability = 0.9;
+    config.tracker.initial_existence_probability = 0.5;
+    config.tracker.confirmation_existence_probability = 0.9;
+    config.tracker.deletion_existence_probability = 0.05;
     config
 }
 

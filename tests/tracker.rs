@@ -168,6 +168,7 @@ fn a_pedestrian_measurement_never_updates_a_car_track() {
 #[test]
 fn tracks_are_confirmed_after_the_configured_hits_and_deleted_after_misses() {
     let mut config = imm_config();
+    config.tracker.lifecycle = primm_core::config::Lifecycle::Counts;
     config.tracker.confirmation_hits = 4;
     config.tracker.confirmed_max_misses = 5;
     config.tracker.max_coast_s = 10.0;
