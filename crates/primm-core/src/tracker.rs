@@ -778,9 +778,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// `tentative_max_misses` misses and confirmed ones after `confirmed_max_misses`.
     fn delete(&mut self, t: f64) {
         let lifecycle = &self.config.tracker;
-        let rows = &mut self.rows;
-        let (mut read, mut write) = (0, 0);
-        let deleted = self.table.retain(|track| {
+        let deleted = retain_with_rows(&mut self.table, &mut self.rows[..], |_, track| {
             let (max_misses, max_coast_s) = if track.status.is_confirmed() {
                 (lifecycle.confirmed_max_misses, lifecycle.max_coast_s)
             } else {
@@ -792,13 +790,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     track.existence_probability >= lifecycle.deletion_existence_probability
                 }
             };
-            let keep = alive && t - track.last_update_s <= max_coast_s;
-            if keep {
-                rows[write] = rows[read];
-                write += 1;
-            }
-            read += 1;
-            keep
+            alive && t - track.last_update_s <= max_coast_s
         });
         self.last_step.deleted = deleted;
     }
@@ -846,17 +838,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         let merged = &self.merged;
-        let rows = &mut self.rows;
-        let (mut read, mut write) = (0, 0);
-        let removed = self.table.retain(|_| {
-            let keep = !merged[read];
-            if keep {
-                rows[write] = rows[read];
-                write += 1;
-            }
-            read += 1;
-            keep
-        });
+        let removed = retain_with_rows(&mut self.table, &mut self.rows[..], |index, _| !merged[index]);
         self.last_step.duplicates_merged = removed;
     }
 
@@ -974,6 +956,25 @@ impl<P: DisplacementPredictor> Tracker<P> {
     pub fn predictor_mut(&mut self) -> &mut P {
         &mut self.predictor
     }
+}
+
+/// Keeps the tracks for which `keep(index, track)` holds and moves their frame records along,
+/// so that `rows` stays aligned with the table; returns how many were removed.
+fn retain_with_rows(
+    table: &mut TrackTable,
+    rows: &mut [RowRecord],
+    mut keep: impl FnMut(usize, &Track) -> bool,
+) -> usize {
+    let (mut read, mut write) = (0, 0);
+    table.retain(|track| {
+        let kept = keep(read, track);
+        if kept {
+            rows[write] = rows[read];
+            write += 1;
+        }
+        read += 1;
+        kept
+    })
 }
 
 /// Whether a tentative `track` has earned confirmation under the configured lifecycle.
