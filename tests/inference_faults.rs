@@ -520,6 +520,7 @@ fn the_service_answers_every_frame_while_its_inference_thread_hangs_and_reports_
             wait: WaitMode::Event,
             latency_report_interval_frames: 0,
             poll_timeout: Duration::from_millis(20),
+            ..TrackingOptions::default()
         };
         let mut service = TrackingService::new(tracker, options).unwrap();
         ready.send(()).unwrap();

@@ -54,6 +54,7 @@ fn run(wait: WaitMode, method: Method) {
             wait,
             latency_report_interval_frames: 100,
             poll_timeout: Duration::from_millis(20),
+            ..TrackingOptions::default()
         };
         let mut service = TrackingService::new(tracker, options).unwrap();
         ready_tx.send(()).unwrap();

@@ -13,7 +13,7 @@ use crate::common;
 use common::service::{unique_prefix, ChildGuard, PrivateService, TestClient};
 use primm_core::measurement::Frame;
 use primm_service::ServiceNames;
-use primm_wire::{FrameStatus, TRACK_FLAG_TRACKER_RESET};
+use primm_wire::{FrameStatus, TRACK_FLAG_LATE_FRAME, TRACK_FLAG_PREDICTED, TRACK_FLAG_TRACKER_RESET};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -63,9 +63,9 @@ fn malformed_frames_are_rejected_and_counted_and_the_next_good_frame_is_tracked(
         frame.count = 100_000;
     });
     assert_eq!(answer(client).1, Some(FrameStatus::RejectedTooManyMeasurements));
-    // Time going backwards.
+    // Time going backwards beyond the late-frame window.
     client.send(&frames[5], 22, 0);
-    assert_eq!(answer(client).1, Some(FrameStatus::RejectedTimestampNotIncreasing));
+    assert_eq!(answer(client).1, Some(FrameStatus::RejectedTooLate));
     // A NaN timestamp.
     client.send_raw(|frame| {
         frame.sequence = 23;
@@ -259,4 +259,60 @@ fn the_tracker_restarts_after_sigkill() {
     }
     second.signal(libc::SIGINT);
     assert!(second.wait(Duration::from_secs(10)).0.success());
+}
+
+#[test]
+fn a_late_frame_within_the_window_is_tracked_in_its_place_and_flagged() {
+    let prefix = unique_prefix("late");
+    let service = PrivateService::new("faults_late", &ServiceNames::new(&prefix));
+    let client = service.client();
+    let _serve = service.serve(&prefix, &[]);
+    client.wait_for_tracker(Duration::from_secs(20));
+    let frames = lane_frames(12);
+    // Frame 9 arrives after frame 10 (50 ms late, inside the 150 ms window).
+    let order = [0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 9, 11];
+    let mut late_answer = None;
+    for (sequence, &index) in order.iter().enumerate() {
+        client.send(&frames[index], sequence as u64, 0);
+        let got = client
+            .next_answer(Duration::from_secs(10), |a| {
+                (a.frame_status(), a.flags, a.sensor_timestamp_s, a.tracks_timestamp_s, a.count)
+            })
+            .expect("the tracker answers");
+        assert_eq!(got.0, Some(FrameStatus::Tracked), "frame {index}");
+        if index == 9 {
+            late_answer = Some(got);
+        } else {
+            assert_eq!(got.1 & TRACK_FLAG_LATE_FRAME, 0);
+            assert_eq!(got.3, frames[index].timestamp_s);
+        }
+    }
+    let (_, flags, sensor_s, tracks_s, count) = late_answer.unwrap();
+    assert_ne!(flags & TRACK_FLAG_LATE_FRAME, 0);
+    assert_eq!(sensor_s, frames[9].timestamp_s);
+    assert_eq!(tracks_s, frames[10].timestamp_s, "the tracks are those at the newest frame");
+    assert!(count >= 6, "{count} tracks");
+}
+
+#[test]
+fn with_publish_time_now_the_tracks_are_predicted_to_the_publish_time() {
+    let prefix = unique_prefix("publish_now");
+    let service = PrivateService::new("faults_publish_now", &ServiceNames::new(&prefix));
+    let client = service.client();
+    let _serve = service.serve(&prefix, &["--publish-time", "now"]);
+    client.wait_for_tracker(Duration::from_secs(20));
+    let frames = lane_frames(15);
+    for (sequence, frame) in frames.iter().enumerate() {
+        client.send(frame, sequence as u64, 0);
+        let (status, flags, sensor_s, tracks_s, indexed) = client
+            .next_answer(Duration::from_secs(10), |a| {
+                let indexed = a.valid_tracks().iter().filter(|t| t.measurement_index().is_some()).count();
+                (a.frame_status(), a.flags, a.sensor_timestamp_s, a.tracks_timestamp_s, indexed)
+            })
+            .expect("the tracker answers");
+        assert_eq!(status, Some(FrameStatus::Tracked));
+        assert_ne!(flags & TRACK_FLAG_PREDICTED, 0);
+        assert!(tracks_s >= sensor_s && tracks_s <= sensor_s + 1.0, "{sensor_s} -> {tracks_s}");
+        assert_eq!(indexed, 0, "predicted tracks carry no measurement");
+    }
 }

@@ -239,19 +239,24 @@ fn a_frame_with_a_non_finite_timestamp_is_rejected_and_changes_nothing() {
 }
 
 #[test]
-fn a_frame_going_back_in_time_or_repeating_is_rejected() {
+fn a_frame_repeating_a_time_or_older_than_the_late_frame_window_is_rejected() {
     let (mut tracker, frames) = warmed_up_tracker();
     let before = snapshot(&tracker);
-    for bad_time in [frames[19].timestamp_s, frames[10].timestamp_s] {
-        let mut bad = frames[20].clone();
-        bad.timestamp_s = bad_time;
-        assert!(matches!(
-            tracker.step(&bad),
-            Err(StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. }))
-        ));
-    }
+    let window_s = tracker.config().tracker.max_frame_delay_s;
+    let newest = frames[19].timestamp_s;
+    let mut repeated = frames[20].clone();
+    repeated.timestamp_s = newest;
+    assert!(matches!(
+        tracker.step(&repeated),
+        Err(StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. }))
+    ));
+    let old = frames.iter().rev().find(|frame| newest - frame.timestamp_s > window_s).unwrap();
+    let mut too_late = frames[20].clone();
+    too_late.timestamp_s = old.timestamp_s;
+    assert!(matches!(tracker.step(&too_late), Err(StepError::InvalidFrame(FrameError::TooLate { .. }))));
     assert_eq!(snapshot(&tracker), before);
-    assert_eq!(tracker.stats().frames_rejected_timestamp_not_increasing, 2);
+    assert_eq!(tracker.stats().frames_rejected_timestamp_not_increasing, 1);
+    assert_eq!(tracker.stats().frames_rejected_too_late, 1);
     assert!(tracker.step(&frames[20]).is_ok());
 }
 

@@ -138,3 +138,26 @@ fn dense_crossing_clusters_reach_the_assignment_solver_and_allocate_nothing_with
     assert_eq!(allocations, 0);
     assert_the_solver_ran_on_every_cluster(&work);
 }
+
+#[test]
+fn late_frames_tracked_in_their_place_allocate_nothing() {
+    let mut tracker = Tracker::new(Config::default().with_modes(Method::Imm.modes())).unwrap();
+    let frames = common::scene_frames(&common::lanes(64), 600, 0.04, 0.2, 23);
+    // Every third frame arrives two frames late: it is tracked in its place and the two newer
+    // frames are tracked again.
+    let mut order = Vec::with_capacity(frames.len());
+    for block in frames.chunks(3) {
+        order.extend(block.iter().skip(1));
+        order.push(&block[0]);
+    }
+    let mut late = 0u64;
+    let allocations = count_allocations(|| {
+        for frame in &order {
+            tracker.step(*frame).expect("within the late-frame window");
+            late += u64::from(tracker.last_step().late);
+        }
+    });
+    assert_eq!(allocations, 0);
+    assert_eq!(late, 200);
+    assert_eq!(tracker.stats().frames_replayed, 400);
+}

@@ -228,17 +228,42 @@ static const char *track_status_name(PrimmTrackStatus status) {
     }
 }
 
+/* Writes the upper triangle of a row-major 4x4 covariance, each value after a comma. */
+static void print_upper_triangle(FILE *out, const double covariance[16]) {
+    for (size_t row = 0; row < 4; row++) {
+        for (size_t column = row; column < 4; column++) {
+            fputc(',', out);
+            print_double(out, covariance[4 * row + column]);
+        }
+    }
+}
+
 /* Tracks one frame (with its ego pose, or NULL) and writes the rows of the tracks a measurement
- * updated; with `world_columns`, each row ends with the world-frame estimate (empty without). */
+ * updated; with `world_columns`, each row ends with the world-frame estimate (empty without).
+ * Frames come in file order, which is arrival order: a late frame is tracked in its place and
+ * writes no rows (its tracks are those of the newest frame); one older than the late-frame
+ * window is skipped, as `primm track` does. */
 static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double timestamp_s,
                         const PrimmEgoPose *pose, const PrimmMeasurement *measurements, size_t count,
                         PrimmTrack *tracks, int world_columns) {
-    PrimmStatus status = primm_tracker_step_with_pose(tracker, timestamp_s, pose, measurements, count, NULL);
+    PrimmStats before;
+    check(primm_tracker_stats(tracker, &before), "reading the counters");
+    PrimmStepSummary summary;
+    PrimmStatus status = primm_tracker_step_with_pose(tracker, timestamp_s, pose, measurements, count, &summary);
     if (status != PRIMM_STATUS_OK) {
         char message[1024];
         primm_tracker_last_error(tracker, message, sizeof message);
+        PrimmStats after;
+        check(primm_tracker_stats(tracker, &after), "reading the counters");
+        if (after.frames_rejected_too_late > before.frames_rejected_too_late) {
+            fprintf(stderr, "frame %" PRIu64 ": older than the late-frame window reaches; skipped\n", frame);
+            return;
+        }
         fprintf(stderr, "track_csv: frame %" PRIu64 ": %s\n", frame, message);
         exit(EXIT_FAILURE);
+    }
+    if (summary.late_frame) {
+        return;
     }
     size_t track_count = 0;
     check(primm_tracker_tracks(tracker, tracks, PRIMM_MAX_TRACKS, &track_count), "copying tracks");
@@ -268,6 +293,12 @@ static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double
         }
         fprintf(out, ",%s,", track_status_name(track->status));
         print_double(out, track->existence_probability);
+        const double velocity_and_age[3] = {track->velocity_x_mps, track->velocity_y_mps, track->age_s};
+        for (size_t i = 0; i < 3; i++) {
+            fputc(',', out);
+            print_double(out, velocity_and_age[i]);
+        }
+        print_upper_triangle(out, track->state_covariance);
         if (world_columns && track->has_world_estimate) {
             const double world[4] = {track->world_x_m, track->world_y_m, track->world_velocity_x_mps,
                                      track->world_velocity_y_mps};
@@ -275,8 +306,9 @@ static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double
                 fputc(',', out);
                 print_double(out, world[i]);
             }
+            print_upper_triangle(out, track->world_state_covariance);
         } else if (world_columns) {
-            fputs(",,,,", out);
+            fputs(",,,,,,,,,,,,,,", out);
         }
         fputc('\n', out);
     }
@@ -322,8 +354,13 @@ int main(int argc, char **argv) {
     if (!world_columns) {
         in.columns[COL_EGO_X] = -1; /* an incomplete pose group is ignored */
     }
-    fputs("frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,existence_probability", out);
-    fputs(world_columns ? ",world_x,world_y,world_vx,world_vy\n" : "\n", out);
+    fputs("frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,existence_probability,"
+          "vx,vy,age_s,cov_xx,cov_xy,cov_xvx,cov_xvy,cov_yy,cov_yvx,cov_yvy,cov_vxvx,cov_vxvy,cov_vyvy",
+          out);
+    fputs(world_columns ? ",world_x,world_y,world_vx,world_vy,world_cov_xx,world_cov_xy,world_cov_xvx,world_cov_xvy,"
+                          "world_cov_yy,world_cov_yvx,world_cov_yvy,world_cov_vxvx,world_cov_vxvy,world_cov_vyvy\n"
+                        : "\n",
+          out);
 
     static PrimmMeasurement measurements[PRIMM_MAX_MEASUREMENTS_PER_FRAME];
     static PrimmTrack tracks[PRIMM_MAX_TRACKS];
@@ -338,9 +375,6 @@ int main(int argc, char **argv) {
         double row_t = parse_double(&in, COL_T);
         if (!open || row_frame != frame) {
             if (open) {
-                if (row_frame < frame) {
-                    fail("frame index `%s` decreases", in.path, in.line_number, field(&in, COL_FRAME));
-                }
                 track_frame(tracker, out, frame, timestamp_s, has_pose ? &pose : NULL, measurements, count, tracks,
                             world_columns);
             }

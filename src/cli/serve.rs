@@ -11,7 +11,8 @@ use primm_predictor::split::{on_inference_threads, InferenceThreadsError, SplitP
 use primm_predictor::threaded::ThreadedPredictor;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
 use primm_service::{
-    ConnectError, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService, WaitMode,
+    ConnectError, PublishTime, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService,
+    WaitMode,
 };
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -51,6 +52,21 @@ pub struct Args {
     /// `tract`; overrides the configuration's `predictor.engine`.
     #[arg(long, value_name = "ENGINE")]
     pub engine: Option<InferenceEngine>,
+    /// The time the published tracks describe: `frame` (the newest frame's time, as the step
+    /// left them) or `now` (predicted from the newest frame to the publish time, so that a
+    /// consumer gets them at the time they describe; costs one prediction per track after the
+    /// step, and the learned mode sits the prediction out). See docs/integrating.md.
+    #[arg(long, value_enum, default_value = "frame", value_name = "WHEN")]
+    pub publish_time: PublishTimeArg,
+}
+
+/// `--publish-time`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PublishTimeArg {
+    /// The newest tracked frame's time.
+    Frame,
+    /// The publish time.
+    Now,
 }
 
 /// Why `primm serve` failed.
@@ -147,6 +163,10 @@ fn serve<P: DisplacementPredictor>(tracker: Tracker<P>, args: &Args) -> Result<(
         wait: if args.busy_poll { WaitMode::BusyPoll } else { WaitMode::Event },
         latency_report_interval_frames: args.latency_every,
         poll_timeout: Duration::from_millis(50),
+        publish_time: match args.publish_time {
+            PublishTimeArg::Frame => PublishTime::Frame,
+            PublishTimeArg::Now => PublishTime::Now,
+        },
     };
     let names = options.names.clone();
     let mut service = TrackingService::new(tracker, options)?;

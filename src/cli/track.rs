@@ -4,6 +4,7 @@ use clap::Args as ClapArgs;
 use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_core::tracker::{StepError, Tracker};
+use primm_core::validation::FrameError;
 use primm_predictor::onnx::ModelError;
 use primm_predictor::predictor_for;
 use primm_sim::io::association_csv::AssociationCsvWriter;
@@ -124,11 +125,24 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
     let frames = sequence.to_frames()?;
     let mut step_ns: Vec<u64> = Vec::with_capacity(frames.len());
     tracker.reset();
+    // Frames in file order, which is arrival order: a late frame (within
+    // `tracker.max_frame_delay_s`) is tracked in its place and writes no rows of its own; one
+    // older than that is rejected, counted and skipped.
     for (recorded, frame) in sequence.frames.iter().zip(&frames) {
         let start = std::time::Instant::now();
-        let outputs =
-            tracker.step(frame).map_err(|source| TrackError::Step { frame: recorded.index, source })?;
+        match tracker.step(frame) {
+            Ok(_) => {}
+            Err(StepError::InvalidFrame(FrameError::TooLate { .. })) => {
+                eprintln!("frame {}: older than the late-frame window reaches; skipped", recorded.index);
+                continue;
+            }
+            Err(source) => return Err(TrackError::Step { frame: recorded.index, source }),
+        };
         step_ns.push(start.elapsed().as_nanos() as u64);
+        if tracker.last_step().late {
+            continue;
+        }
+        let outputs = tracker.last_outputs();
         writer.write_frame(recorded.index, recorded.timestamp_s, outputs)?;
         if let Some(associations) = associations.as_mut() {
             associations.write_frame(recorded.index, recorded.measurements.len(), outputs)?;

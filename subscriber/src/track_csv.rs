@@ -4,13 +4,16 @@
 use primm_core::measurement::ObjectClass;
 use primm_core::track::TrackStatus;
 use primm_sim::io::track_csv::{TrackCsvWriter, TrackRow};
-use primm_wire::{FrameStatus, TrackFrame};
+use primm_wire::{FrameStatus, TrackFrame, TRACK_FLAG_LATE_FRAME, TRACK_FLAG_PREDICTED};
 use std::io::Write;
 
 /// Writes the rows of one received track frame to `csv`: one per track updated by a measurement,
-/// none for a rejected frame.
+/// none for a rejected frame, a late frame (its tracks are those of a newer frame) or tracks
+/// predicted to the publish time (they carry no measurement).
 pub fn write_track_frame<W: Write>(csv: &mut TrackCsvWriter<W>, frame: &TrackFrame) -> std::io::Result<()> {
-    if frame.frame_status() != Some(FrameStatus::Tracked) {
+    if frame.frame_status() != Some(FrameStatus::Tracked)
+        || frame.flags & (TRACK_FLAG_LATE_FRAME | TRACK_FLAG_PREDICTED) != 0
+    {
         return Ok(());
     }
     for track in frame.valid_tracks().iter().filter(|track| track.measurement_index().is_some()) {
@@ -35,7 +38,10 @@ pub fn write_track_frame<W: Write>(csv: &mut TrackCsvWriter<W>, frame: &TrackFra
             mode_probabilities: track.mode_probabilities,
             status,
             existence_probability: track.existence_probability,
-            world: track.world(),
+            velocity_mps: [track.vx_mps, track.vy_mps],
+            age_s: track.age_s,
+            state_covariance: track.state_covariance,
+            world: track.world().map(|world| (world, track.world_state_covariance)),
         })?;
     }
     Ok(())
@@ -55,6 +61,7 @@ mod tests {
             input_sequence: frame,
             source_frame: frame,
             sensor_timestamp_s: timestamp_s,
+            tracks_timestamp_s: timestamp_s,
             input_publish_time_ns: 0,
             receive_time_ns: 0,
             publish_time_ns: 0,

@@ -268,6 +268,35 @@ pub struct TrackerConfig {
     /// (`crate::duplicates`); 0 turns the check off (absent: 0).
     #[cfg_attr(feature = "serde", serde(default))]
     pub duplicate_updates: u32,
+    /// A frame up to this much older than the newest tracked frame is tracked in its place
+    /// (`crate::replay`), s; an older one is rejected and counted. 0 turns late-frame tracking
+    /// off (absent: 0).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub max_frame_delay_s: f64,
+    /// How many of the most recent frames are kept for tracking a late frame in its place, from
+    /// 0 (off) to 64; the window is the shorter of this and `max_frame_delay_s`. Each costs one
+    /// frame copy and room for every track, allocated when the tracker is built (absent: 0).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub replay_frames: u32,
+    /// Fastest plausible ego motion between two frames, m/s: an ego pose further from the
+    /// previous one than this speed allows (plus 1 m) is an odometry reset, across which the
+    /// tracks keep their place around the vehicle (absent: 100 m/s).
+    #[cfg_attr(feature = "serde", serde(default = "default_max_ego_speed_mps"))]
+    pub max_ego_speed_mps: f64,
+    /// Fastest plausible ego turn between two frames, rad/s (yaw compared modulo 2π): a faster
+    /// one is an odometry reset as above (absent: 3 rad/s).
+    #[cfg_attr(feature = "serde", serde(default = "default_max_ego_yaw_rate_radps"))]
+    pub max_ego_yaw_rate_radps: f64,
+}
+
+#[cfg(feature = "serde")]
+fn default_max_ego_speed_mps() -> f64 {
+    100.0
+}
+
+#[cfg(feature = "serde")]
+fn default_max_ego_yaw_rate_radps() -> f64 {
+    3.0
 }
 
 #[cfg(feature = "serde")]
@@ -534,6 +563,10 @@ impl Default for Config {
                 deletion_existence_probability: 0.01299,
                 existence_persistence_time_s: 40.0,
                 duplicate_updates: 4,
+                max_frame_delay_s: 0.15,
+                replay_frames: 16,
+                max_ego_speed_mps: 100.0,
+                max_ego_yaw_rate_radps: 3.0,
             },
             classes: ClassTable {
                 car: ClassConfig {
@@ -855,6 +888,20 @@ fn validate_tracker_and_predictor(
         ));
     }
     positive("tracker.existence_persistence_time_s", tracker.existence_persistence_time_s)?;
+    if !(tracker.max_frame_delay_s >= 0.0 && tracker.max_frame_delay_s <= tracker.max_frame_interval_s) {
+        return Err(invalid(
+            "tracker.max_frame_delay_s",
+            format!(
+                "must be in [0, tracker.max_frame_interval_s], got {}",
+                readable(tracker.max_frame_delay_s)
+            ),
+        ));
+    }
+    if tracker.replay_frames as usize > crate::limits::MAX_REPLAY_FRAMES {
+        return Err(invalid("tracker.replay_frames", "must be at most 64"));
+    }
+    positive("tracker.max_ego_speed_mps", tracker.max_ego_speed_mps)?;
+    positive("tracker.max_ego_yaw_rate_radps", tracker.max_ego_yaw_rate_radps)?;
     Ok(())
 }
 

@@ -34,7 +34,7 @@ use crate::motion::{
 };
 use crate::pose::RigidTransform;
 use crate::predictor::Displacement;
-use glam::{DMat2, DVec2};
+use glam::{DMat2, DMat4, DVec2, DVec4};
 
 /// Mode probabilities in primm's mode order (PR, CV, CA, CT); inactive modes hold 0.
 pub type ModeProbabilities = [f64; MODE_COUNT];
@@ -619,6 +619,55 @@ impl Imm {
         modes.iter().map(|mode| weights[mode.index()] * state.velocity(mode)).sum()
     }
 
+    /// The fused position and velocity `[x, y, vx, vy]` of a posterior over `modes` and their
+    /// 4×4 covariance (with the spread of the mode means), weights `μ` renormalised over them:
+    /// `eq:posterior_fusion` extended from the position to the position and velocity. Each
+    /// physics mode contributes the `[x, y, vx, vy]` marginal of its state. The PR mode has a
+    /// position covariance but no velocity covariance: it contributes its position, its
+    /// velocity (last displacement over the step), its position covariance, no
+    /// position–velocity covariance, and as velocity covariance the physics modes' fused one
+    /// (zero when PR is the only mode). The position block equals
+    /// [`fuse_posterior`](Self::fuse_posterior)'s covariance.
+    pub fn fuse_position_velocity(&self, state: &ImmState, modes: ModeSet) -> PositionVelocityEstimate {
+        let weights = renormalised(&state.probabilities, modes);
+        let physics = modes.without(Mode::Learned);
+        let mut marginals = [PositionVelocityEstimate::default(); MODE_COUNT];
+        for mode in physics.iter() {
+            marginals[mode.index()] = match mode {
+                Mode::ConstantVelocity => marginal4(&state.constant_velocity),
+                Mode::ConstantAcceleration => marginal4(&state.constant_acceleration),
+                Mode::CoordinatedTurn => marginal4(&state.coordinated_turn),
+                Mode::Learned => unreachable!("left out of the physics modes"),
+            };
+        }
+        if modes.contains(Mode::Learned) {
+            let physics_weights = renormalised(&state.probabilities, physics);
+            let velocity_covariance: DMat2 = physics
+                .iter()
+                .map(|mode| {
+                    let covariance = marginals[mode.index()].covariance;
+                    physics_weights[mode.index()] * lower_right(&covariance)
+                })
+                .fold(DMat2::ZERO, |sum, term| sum + term);
+            let position = state.learned.position();
+            let velocity = state.learned_velocity_mps;
+            marginals[Mode::Learned.index()] = PositionVelocityEstimate {
+                mean: DVec4::new(position.mean.x, position.mean.y, velocity.x, velocity.y),
+                covariance: block_diagonal(position.covariance, velocity_covariance),
+            };
+        }
+        let mean: DVec4 = modes.iter().map(|mode| weights[mode.index()] * marginals[mode.index()].mean).sum();
+        let covariance = modes
+            .iter()
+            .map(|mode| {
+                let marginal = &marginals[mode.index()];
+                let spread = marginal.mean - mean;
+                weights[mode.index()] * (marginal.covariance + outer4(spread, spread))
+            })
+            .fold(DMat4::ZERO, |sum, term| sum + term);
+        PositionVelocityEstimate { mean, covariance }
+    }
+
     /// Raises every active mode's probability to at least the floor and renormalises, keeping
     /// the floored modes at exactly the floor.
     #[inline]
@@ -647,6 +696,52 @@ impl Imm {
         }
         mu
     }
+}
+
+/// A position and velocity `[x, y, vx, vy]` (m, m/s) and its covariance (m², m²/s, m²/s²).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PositionVelocityEstimate {
+    /// `[x, y, vx, vy]`.
+    pub mean: DVec4,
+    /// Covariance of `[x, y, vx, vy]`, symmetric.
+    pub covariance: DMat4,
+}
+
+/// The `[x, y, vx, vy]` marginal of a state whose first four elements are those.
+fn marginal4<const N: usize>(gaussian: &Gaussian<N>) -> PositionVelocityEstimate {
+    let mean = DVec4::new(gaussian.mean[0], gaussian.mean[1], gaussian.mean[2], gaussian.mean[3]);
+    let column = |c: usize| {
+        DVec4::new(
+            gaussian.covariance[(0, c)],
+            gaussian.covariance[(1, c)],
+            gaussian.covariance[(2, c)],
+            gaussian.covariance[(3, c)],
+        )
+    };
+    PositionVelocityEstimate { mean, covariance: DMat4::from_cols(column(0), column(1), column(2), column(3)) }
+}
+
+/// The lower-right 2×2 block of a 4×4 matrix (the velocity block).
+fn lower_right(matrix: &DMat4) -> DMat2 {
+    DMat2::from_cols(
+        DVec2::new(matrix.z_axis.z, matrix.z_axis.w),
+        DVec2::new(matrix.w_axis.z, matrix.w_axis.w),
+    )
+}
+
+/// The 4×4 block-diagonal matrix `diag(upper_left, lower_right)`.
+fn block_diagonal(upper_left: DMat2, lower_right: DMat2) -> DMat4 {
+    DMat4::from_cols(
+        DVec4::new(upper_left.x_axis.x, upper_left.x_axis.y, 0.0, 0.0),
+        DVec4::new(upper_left.y_axis.x, upper_left.y_axis.y, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, lower_right.x_axis.x, lower_right.x_axis.y),
+        DVec4::new(0.0, 0.0, lower_right.y_axis.x, lower_right.y_axis.y),
+    )
+}
+
+/// `a bᵀ`.
+fn outer4(a: DVec4, b: DVec4) -> DMat4 {
+    DMat4::from_cols(a * b.x, a * b.y, a * b.z, a * b.w)
 }
 
 /// `weights` restricted to `modes` and renormalised to sum to 1 (uniform if they sum to 0).

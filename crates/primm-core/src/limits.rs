@@ -22,3 +22,7 @@ pub const MAX_ASSOCIATION_PAIRS: usize = MAX_TRACKS * MAX_MEASUREMENTS_PER_FRAME
 
 /// Largest number of radar sensors whose mounting poses a configuration can hold.
 pub const MAX_SENSORS: usize = 16;
+
+/// Largest number of recent frames the tracker keeps for tracking a late frame in its place
+/// (`tracker.replay_frames`; see `crate::replay`).
+pub const MAX_REPLAY_FRAMES: usize = 64;

@@ -37,6 +37,22 @@ pub fn sqrt(x: f64) -> f64 {
     return libm::sqrt(x);
 }
 
+/// Arc tangent of `y / x` in the quadrant of `(x, y)`, radians in [−π, π].
+#[inline(always)]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    #[cfg(feature = "std")]
+    return y.atan2(x);
+    #[cfg(not(feature = "std"))]
+    return libm::atan2(y, x);
+}
+
+/// `angle` wrapped into [−π, π], radians.
+#[inline]
+pub fn wrap_angle(angle: f64) -> f64 {
+    let (sin, cos) = sin_cos(angle);
+    atan2(sin, cos)
+}
+
 /// `x²`.
 #[inline(always)]
 pub fn square(x: f64) -> f64 {
@@ -46,6 +62,16 @@ pub fn square(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn wrapped_angles_lie_within_plus_minus_pi_and_keep_their_direction() {
+        for angle in [0.0, 3.0, -3.0, 3.2, -3.2, 7.0, -13.0, 100.0] {
+            let wrapped = wrap_angle(angle);
+            assert!(wrapped.abs() <= core::f64::consts::PI + 1e-12, "{angle} -> {wrapped}");
+            assert!((wrapped.sin() - angle.sin()).abs() < 1e-9 && (wrapped.cos() - angle.cos()).abs() < 1e-9);
+        }
+        assert!((wrap_angle(2.0 * core::f64::consts::PI - 0.1) + 0.1).abs() < 1e-12);
+    }
 
     #[test]
     fn the_functions_agree_with_libm_to_the_last_bits() {

@@ -122,6 +122,19 @@ impl RigidTransform {
     pub fn apply_covariance(&self, covariance: DMat2) -> DMat2 {
         self.rotation * covariance * self.rotation.transpose()
     }
+
+    /// Maps the covariance of a position and velocity `[x, y, vx, vy]`: both halves rotate
+    /// with `R` (the translation leaves a covariance alone).
+    pub fn apply_state_covariance(&self, covariance: glam::DMat4) -> glam::DMat4 {
+        let r = self.rotation;
+        let rotation = glam::DMat4::from_cols(
+            glam::DVec4::new(r.x_axis.x, r.x_axis.y, 0.0, 0.0),
+            glam::DVec4::new(r.y_axis.x, r.y_axis.y, 0.0, 0.0),
+            glam::DVec4::new(0.0, 0.0, r.x_axis.x, r.x_axis.y),
+            glam::DVec4::new(0.0, 0.0, r.y_axis.x, r.y_axis.y),
+        );
+        rotation * covariance * rotation.transpose()
+    }
 }
 
 /// Where a radar is mounted on the vehicle, in the vehicle frame.

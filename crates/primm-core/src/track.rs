@@ -5,7 +5,7 @@ use crate::imm::{ImmState, ModeProbabilities};
 use crate::measurement::{Measurement, ObjectClass};
 use crate::pose::RigidTransform;
 use crate::predictor::{HistoryEntry, MAX_HISTORY};
-use glam::{DMat2, DVec2};
+use glam::{DMat2, DMat4, DVec2};
 use heapless::HistoryBuf;
 
 /// Lifecycle status of a track.
@@ -72,6 +72,8 @@ pub struct Track {
     pub last_radial_velocity_mps: f64,
     /// Time of the last associated measurement, s.
     pub last_update_s: f64,
+    /// Time of the measurement that started the track, s.
+    pub started_s: f64,
     /// Frames since the track started (0 in its first frame).
     pub age_frames: u32,
     /// Associated measurements, including the initiating one.
@@ -108,6 +110,7 @@ impl Track {
             history: HistoryBuf::new(),
             last_radial_velocity_mps: measurement.radial_velocity_mps,
             last_update_s: timestamp_s,
+            started_s: timestamp_s,
             age_frames: 0,
             hits: 1,
             misses: 0,
@@ -170,7 +173,8 @@ impl HistoryEntry {
     }
 }
 
-/// What the tracker reports for every live track after a frame.
+/// What the tracker reports for every live track after a frame. The default is an empty
+/// record (id 0, zeros), for buffers filled by [`Tracker::predict_to`](crate::tracker::Tracker::predict_to).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct TrackOutput {
@@ -182,10 +186,15 @@ pub struct TrackOutput {
     pub status: TrackStatus,
     /// Fused posterior position (`eq:posterior_fusion`), m.
     pub position_m: DVec2,
-    /// Covariance of the fused position (with the spread of the mode means), m².
+    /// Covariance of the fused position (with the spread of the mode means), m²: the upper-left
+    /// block of [`state_covariance`](Self::state_covariance).
     pub position_covariance_m2: DMat2,
     /// Fused velocity estimate, m/s.
     pub velocity_mps: DVec2,
+    /// Covariance of the fused position and velocity `[x, y, vx, vy]` (m², m²/s, m²/s²), in the
+    /// frame of `position_m` and `velocity_mps`, with the spread of the mode means (see
+    /// [`Imm::fuse_position_velocity`](crate::imm::Imm::fuse_position_velocity)).
+    pub state_covariance: DMat4,
     /// Fused one-step prior used for association (`eq:prior_fusion`), m; `None` for a track
     /// started in this frame.
     pub prior_position_m: Option<DVec2>,
@@ -196,10 +205,16 @@ pub struct TrackOutput {
     /// Fused velocity over ground in the world frame, m/s, when the frame was tracked in the
     /// world frame.
     pub world_velocity_mps: Option<DVec2>,
+    /// Covariance of `[x, y, vx, vy]` in the world frame, when the frame was tracked in the
+    /// world frame.
+    pub world_state_covariance: Option<DMat4>,
     /// Posterior mode probabilities, order PR, CV, CA, CT (inactive modes 0).
     pub mode_probabilities: ModeProbabilities,
     /// Frames since the track started.
     pub age_frames: u32,
+    /// Time since the track's first measurement, s (at the time of the outputs: the newest
+    /// tracked frame's, or the requested time of a prediction).
+    pub age_s: f64,
     /// Associated measurements so far.
     pub hits: u32,
     /// Consecutive frames without measurement (0 when updated in this frame).
@@ -211,4 +226,30 @@ pub struct TrackOutput {
     /// Index in this frame of the measurement that updated or started the track; `None` when
     /// the track coasted.
     pub measurement_index: Option<u16>,
+}
+
+impl Default for TrackOutput {
+    fn default() -> Self {
+        TrackOutput {
+            id: 0,
+            class: ObjectClass::Car,
+            status: TrackStatus::Tentative,
+            position_m: DVec2::ZERO,
+            position_covariance_m2: DMat2::ZERO,
+            velocity_mps: DVec2::ZERO,
+            state_covariance: DMat4::ZERO,
+            prior_position_m: None,
+            world_position_m: None,
+            world_velocity_mps: None,
+            world_state_covariance: None,
+            mode_probabilities: [0.0; crate::mode::MODE_COUNT],
+            age_frames: 0,
+            age_s: 0.0,
+            hits: 0,
+            misses: 0,
+            existence_probability: 0.0,
+            ground_truth_id: None,
+            measurement_index: None,
+        }
+    }
 }

@@ -83,4 +83,21 @@ impl TrackTable {
     pub fn clear(&mut self) {
         self.tracks.clear();
     }
+
+    /// Copies the live tracks into `tracks` (which must have room for [`MAX_TRACKS`], so that
+    /// nothing is allocated) and returns the next id: what [`restore`](Self::restore) needs.
+    pub(crate) fn save(&self, tracks: &mut alloc::vec::Vec<Track>) -> u64 {
+        tracks.clear();
+        tracks.extend_from_slice(&self.tracks);
+        self.next_id
+    }
+
+    /// Puts the table back as [`save`](Self::save) found it.
+    pub(crate) fn restore(&mut self, tracks: &[Track], next_id: u64) {
+        self.tracks.clear();
+        for track in tracks.iter().take(MAX_TRACKS) {
+            self.tracks.push(track.clone());
+        }
+        self.next_id = next_id;
+    }
 }

@@ -21,7 +21,10 @@ use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_P
 use crate::mode::{Mode, ModeSet};
 use crate::motion::ModeModels;
 use crate::pose::{EgoPose, RigidTransform};
+use crate::prediction::PredictError;
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
+use crate::recorded_frame::RecordedFrame;
+use crate::replay::{Placement, ReplayRing};
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput, TrackStatus};
 use crate::track_loops::{self, ClassImms};
@@ -116,6 +119,19 @@ pub struct TrackerStats {
     pub frames_with_unknown_sensor: u64,
     /// Tracks merged into an older track of the same object (`crate::duplicates`).
     pub duplicate_tracks_merged: u64,
+    /// Late frames tracked in their place (`crate::replay`): older than the newest tracked
+    /// frame, within `tracker.max_frame_delay_s` and the recorded frames.
+    pub late_frames_tracked: u64,
+    /// Newer frames tracked again after a late frame (each late frame replays the frames it
+    /// went before).
+    pub frames_replayed: u64,
+    /// Frames rejected because they were older than the newest tracked frame by more than the
+    /// late-frame window (`tracker.max_frame_delay_s`, `tracker.replay_frames`) reaches.
+    pub frames_rejected_too_late: u64,
+    /// Ego poses that jumped further or turned faster than `tracker.max_ego_speed_mps` and
+    /// `tracker.max_ego_yaw_rate_radps` allow since the previous frame: odometry resets, across
+    /// which the tracks kept their place around the vehicle.
+    pub odometry_resets: u64,
 }
 
 /// What one step did: the per-frame counterpart of [`TrackerStats`]. Returned by
@@ -168,6 +184,15 @@ pub struct StepSummary {
     pub unknown_sensor: bool,
     /// Tracks merged into an older track of the same object.
     pub duplicates_merged: usize,
+    /// Whether the frame was late (older than the newest tracked frame) and tracked in its
+    /// place. The outputs are then the tracks at the newest frame's time, after the newer
+    /// frames were tracked again ([`Tracker::newest_timestamp_s`]); this summary's counts are
+    /// the late frame's own, except `live_tracks` and `confirmed_tracks`.
+    pub late: bool,
+    /// Newer frames tracked again after this late frame.
+    pub replayed_frames: usize,
+    /// Whether the frame's ego pose jumped from the previous one (an odometry reset).
+    pub odometry_reset: bool,
 }
 
 impl TrackerStats {
@@ -191,6 +216,27 @@ impl TrackerStats {
         self.tracking_frame_changes += u64::from(step.tracking_frame_changed);
         self.frames_with_unknown_sensor += u64::from(step.unknown_sensor);
         self.duplicate_tracks_merged += count(step.duplicates_merged);
+        self.odometry_resets += u64::from(step.odometry_reset);
+    }
+
+    /// Goes back to `before` for everything a tracked frame changes, keeping what happened
+    /// since to frames that were never tracked (frame rejections), resets and the late-frame
+    /// counters: used when a late frame sends the tracker back to the state before newer frames
+    /// that are then tracked again (and counted again).
+    fn restore_tracked_counts(&mut self, before: &TrackerStats) {
+        let now = *self;
+        *self = TrackerStats {
+            frames_rejected_non_finite_timestamp: now.frames_rejected_non_finite_timestamp,
+            frames_rejected_timestamp_not_increasing: now.frames_rejected_timestamp_not_increasing,
+            frames_rejected_interval_too_long: now.frames_rejected_interval_too_long,
+            frames_rejected_too_many_measurements: now.frames_rejected_too_many_measurements,
+            frames_rejected_invalid_ego_pose: now.frames_rejected_invalid_ego_pose,
+            frames_rejected_too_late: now.frames_rejected_too_late,
+            late_frames_tracked: now.late_frames_tracked,
+            frames_replayed: now.frames_replayed,
+            resets: now.resets,
+            ..*before
+        };
     }
 }
 
@@ -267,8 +313,12 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     duplicate_views: Box<[DuplicateView; MAX_TRACKS]>,
     /// Tracks merged into an older one in the current frame, aligned with the table.
     merged: Box<[bool; MAX_TRACKS]>,
-    /// The current frame as read once during validation; every later stage reads this copy.
+    /// The current frame as read once from the caller; validation reads only this copy.
+    recorded: Box<RecordedFrame>,
+    /// The current frame as validated; every later stage reads this copy.
     validated: Box<ValidatedFrame>,
+    /// The recent frames and the state before each, for late frames.
+    ring: ReplayRing,
     outputs: Box<ArrayVec<TrackOutput, MAX_TRACKS>>,
 }
 
@@ -283,6 +333,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// A tracker using `predictor` for the PR mode. Validates `config`.
     pub fn with_predictor(config: Config, predictor: P) -> Result<Self, ConfigError> {
         config.validate()?;
+        let ring = ReplayRing::new(config.tracker.replay_frames as usize, config.tracker.max_frame_delay_s);
         Ok(Self {
             imms: track_loops::class_imms(&config),
             models: ObjectClass::ALL.map(|class| ModeModels::from_config(config.classes.get(class))),
@@ -309,7 +360,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
             scanning_sensors: Box::new(ArrayVec::new()),
             duplicate_views: Box::new([DuplicateView::default(); MAX_TRACKS]),
             merged: Box::new([false; MAX_TRACKS]),
+            recorded: Box::new(RecordedFrame::new()),
             validated: Box::new(ValidatedFrame::new()),
+            ring,
             outputs: Box::new(ArrayVec::new()),
         })
     }
@@ -322,7 +375,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.outputs.clear();
         let outputs = &mut self.outputs;
         let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
-        report(&self.table, &self.rows[..], &self.imms, to_vehicle, |output| outputs.push(*output));
+        let t = self.last_timestamp_s.unwrap_or(0.0);
+        report(&self.table, &self.rows[..], &self.imms, to_vehicle, t, |output| outputs.push(*output));
         Ok(&self.outputs)
     }
 
@@ -348,38 +402,153 @@ impl<P: DisplacementPredictor> Tracker<P> {
     ) -> Result<StepSummary, StepError> {
         self.advance(frame, observer)?;
         let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
-        report(&self.table, &self.rows[..], &self.imms, to_vehicle, sink);
+        let t = self.last_timestamp_s.unwrap_or(0.0);
+        report(&self.table, &self.rows[..], &self.imms, to_vehicle, t, sink);
         observer.stage_finished(Stage::Report);
         Ok(self.last_step)
     }
 
     /// Everything but the report; counts what the step did into
-    /// [`last_step`](Self::last_step) and the statistics, also when it fails.
+    /// [`last_step`](Self::last_step) and the statistics, also when it fails. Reads `frame`
+    /// once, into the tracker's own copy; a late frame is tracked in its place
+    /// (`crate::replay`).
     fn advance<F: FrameView + ?Sized, O: StageObserver>(
         &mut self,
         frame: &F,
         observer: &mut O,
     ) -> Result<(), StepError> {
+        self.recorded.read_from(frame);
+        match self.ring.place(self.recorded.timestamp_s(), self.last_timestamp_s) {
+            Placement::InOrder | Placement::Duplicate => self.track_in_order(observer),
+            Placement::Before(position) => self.track_late(position, observer),
+            Placement::TooLate => {
+                self.last_step = StepSummary::default();
+                self.count_live_tracks();
+                self.stats.frames_rejected_too_late += 1;
+                Err(StepError::InvalidFrame(FrameError::TooLate {
+                    timestamp_s: self.recorded.timestamp_s(),
+                    newest_s: self.last_timestamp_s.unwrap_or(f64::NAN),
+                }))
+            }
+        }
+    }
+
+    /// Tracks the recorded frame after the newest one, first saving the state before it in the
+    /// ring (and recording the frame there once tracked).
+    fn track_in_order<O: StageObserver>(&mut self, observer: &mut O) -> Result<(), StepError> {
+        if !self.ring.is_enabled() {
+            return self.track_recorded(observer);
+        }
+        let slot = self.ring.spare();
+        self.save_state(slot);
+        let result = self.track_recorded(observer);
+        if result.is_ok() {
+            core::mem::swap(&mut self.recorded, &mut self.ring.slot_mut(slot).frame);
+            self.ring.insert(slot, self.ring.len());
+            self.ring.trim(self.recorded_newest_s());
+        }
+        result
+    }
+
+    /// Tracks a late recorded frame in its place, before the recorded frame at `position`:
+    /// back to the state before that frame, the late frame, then every newer recorded frame
+    /// again. The frame is checked against its place first, so that a frame refused there
+    /// changes nothing.
+    fn track_late<O: StageObserver>(&mut self, position: usize, observer: &mut O) -> Result<(), StepError> {
+        let newer = self.ring.slot_at(position);
+        let newest_s = self.last_timestamp_s;
         self.last_step = StepSummary::default();
-        let result = self.run_stages(frame, observer);
-        self.last_step.live_tracks = self.table.len();
-        self.last_step.confirmed_tracks =
-            self.table.tracks().iter().filter(|track| track.status.is_confirmed()).count();
+        self.last_timestamp_s = self.ring.slot(newer).before.last_timestamp_s;
+        let check = self.validate();
+        self.last_timestamp_s = newest_s;
+        if let Err(error) = check {
+            self.count_live_tracks();
+            return Err(error);
+        }
+        self.restore_state(newer);
+        let late = self.ring.spare();
+        self.ring.copy_snapshot(newer, late);
+        let result = self.track_recorded(observer);
+        let mut summary = self.last_step;
+        let mut next = position;
+        if result.is_ok() {
+            core::mem::swap(&mut self.recorded, &mut self.ring.slot_mut(late).frame);
+            self.ring.insert(late, position);
+            self.stats.late_frames_tracked += 1;
+            next += 1;
+        }
+        while next < self.ring.len() {
+            let slot = self.ring.slot_at(next);
+            self.save_state(slot);
+            core::mem::swap(&mut self.recorded, &mut self.ring.slot_mut(slot).frame);
+            let replayed = self.track_recorded(observer);
+            core::mem::swap(&mut self.recorded, &mut self.ring.slot_mut(slot).frame);
+            if replayed.is_ok() {
+                summary.replayed_frames += 1;
+                next += 1;
+            } else {
+                // Cannot happen for a frame tracked before (its interval only shrank); it is
+                // dropped from the ring rather than tracked half.
+                self.ring.remove(next);
+            }
+        }
+        self.ring.trim(self.recorded_newest_s());
+        self.stats.frames_replayed += summary.replayed_frames as u64;
+        summary.late = true;
+        self.last_step = summary;
+        self.count_live_tracks();
+        result
+    }
+
+    /// The newest tracked frame's time, s (0 before the first).
+    fn recorded_newest_s(&self) -> f64 {
+        self.last_timestamp_s.unwrap_or(0.0)
+    }
+
+    /// Saves the state before the next frame into ring slot `slot`.
+    fn save_state(&mut self, slot: usize) {
+        let before = &mut self.ring.slot_mut(slot).before;
+        before.next_id = self.table.save(&mut before.tracks);
+        before.last_timestamp_s = self.last_timestamp_s;
+        before.tracks_frame = self.tracks_frame;
+        before.last_pose = self.last_pose;
+        before.stats = self.stats;
+    }
+
+    /// Puts the tracker back into the state saved in ring slot `slot`.
+    fn restore_state(&mut self, slot: usize) {
+        let before = &self.ring.slot(slot).before;
+        self.table.restore(&before.tracks, before.next_id);
+        self.last_timestamp_s = before.last_timestamp_s;
+        self.tracks_frame = before.tracks_frame;
+        self.last_pose = before.last_pose;
+        self.stats.restore_tracked_counts(&before.stats);
+    }
+
+    /// Tracks the recorded frame; counts what it did into [`last_step`](Self::last_step) and
+    /// the statistics, also when it fails.
+    fn track_recorded<O: StageObserver>(&mut self, observer: &mut O) -> Result<(), StepError> {
+        self.last_step = StepSummary::default();
+        let result = self.run_stages(observer);
+        self.count_live_tracks();
         self.stats.add_step(&self.last_step);
         result
     }
 
-    /// The stages of a step up to the report.
-    fn run_stages<F: FrameView + ?Sized, O: StageObserver>(
-        &mut self,
-        frame: &F,
-        observer: &mut O,
-    ) -> Result<(), StepError> {
-        let dt_s = self.validate(frame)?;
+    /// The live and confirmed tracks into [`last_step`](Self::last_step).
+    fn count_live_tracks(&mut self) {
+        self.last_step.live_tracks = self.table.len();
+        self.last_step.confirmed_tracks =
+            self.table.tracks().iter().filter(|track| track.status.is_confirmed()).count();
+    }
+
+    /// The stages of a step up to the report, on the recorded frame.
+    fn run_stages<O: StageObserver>(&mut self, observer: &mut O) -> Result<(), StepError> {
+        let dt_s = self.validate()?;
         observer.stage_finished(Stage::Validate);
-        // From here on only the validated copy is read, never `frame` again.
+        // From here on only the validated copy is read.
         let t = self.validated.timestamp_s();
-        self.enter_tracking_frame(self.validated.ego_pose());
+        self.enter_tracking_frame(self.validated.ego_pose(), dt_s);
         if let Some(vehicle_to_world) = self.step_pose.map(|pose| pose.vehicle_to_world()) {
             self.validated.move_positions(&vehicle_to_world);
         }
@@ -407,9 +576,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// moves the live tracks into it if they are in the other one: into the world frame with
     /// this frame's pose (the tracks' vehicle frame is taken as this frame's, which is off by
     /// the ego motion since the last frame), back into the vehicle frame of the last pose.
-    fn enter_tracking_frame(&mut self, pose: Option<EgoPose>) {
+    fn enter_tracking_frame(&mut self, pose: Option<EgoPose>, dt_s: f64) {
         let world = self.config.frame.tracking_frame == TrackingFrame::World;
         self.step_pose = pose.filter(|_| world);
+        self.follow_odometry_reset(dt_s);
         let step_frame = if self.step_pose.is_some() { TrackingFrame::World } else { TrackingFrame::Vehicle };
         self.last_step.tracking_frame = step_frame;
         if world && pose.is_none() {
@@ -435,9 +605,36 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Frame checks, then per-measurement checks; counts every rejection. Reads each field of
-    /// `frame` once, into [`ValidatedFrame`], and checks that copy.
-    fn validate<F: FrameView + ?Sized>(&mut self, frame: &F) -> Result<f64, StepError> {
+    /// Moves the live world-frame tracks across an odometry reset: when this frame's pose is
+    /// further from the last one, or turned further, than `tracker.max_ego_speed_mps` and
+    /// `tracker.max_ego_yaw_rate_radps` allow over `dt_s` (plus 1 m and 0.1 rad), the vehicle
+    /// cannot have moved so; the world frame did. The tracks keep their place around the
+    /// vehicle: into its frame with the last pose, back out with this one.
+    fn follow_odometry_reset(&mut self, dt_s: f64) {
+        let (Some(pose), Some(last)) = (self.step_pose, self.last_pose) else { return };
+        if self.tracks_frame != TrackingFrame::World {
+            return;
+        }
+        let tracker = &self.config.tracker;
+        let moved_m = pose.position().distance(last.position());
+        let turned_rad = crate::math::wrap_angle(pose.yaw_rad - last.yaw_rad).abs();
+        let jumped = moved_m > tracker.max_ego_speed_mps * dt_s + 1.0
+            || turned_rad > tracker.max_ego_yaw_rate_radps * dt_s + 0.1;
+        if !jumped {
+            return;
+        }
+        self.last_step.odometry_reset = true;
+        let (to_vehicle, to_world) = (last.world_to_vehicle(), pose.vehicle_to_world());
+        for track in self.table.tracks_mut() {
+            track.transform(&to_vehicle);
+            track.transform(&to_world);
+        }
+    }
+
+    /// Frame checks, then per-measurement checks; counts every rejection. Reads the recorded
+    /// copy of the frame into [`ValidatedFrame`] and checks that.
+    fn validate(&mut self) -> Result<f64, StepError> {
+        let frame = &*self.recorded;
         self.validated.read_header(frame);
         if self.config.frame.tracking_frame == TrackingFrame::World {
             if let Some(pose) = self.validated.ego_pose().filter(|pose| !pose.is_valid()) {
@@ -463,11 +660,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
                         &mut self.stats.frames_rejected_too_many_measurements
                     }
                     FrameError::InvalidEgoPose { .. } => &mut self.stats.frames_rejected_invalid_ego_pose,
+                    FrameError::TooLate { .. } => &mut self.stats.frames_rejected_too_late,
                 };
                 *counter += 1;
             })?;
         for index in 0..self.validated.len() {
-            let verdict = validate_measurement(frame, index);
+            let verdict = validate_measurement(&*self.recorded, index);
             self.validated.set(index, verdict.ok());
             self.accepted[index] = verdict.is_ok();
             self.fates[index] =
@@ -913,6 +1111,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// [`last_step`](Self::last_step) is cleared.
     pub fn reset(&mut self) {
         self.table.clear();
+        self.ring.clear();
         self.last_timestamp_s = None;
         self.last_pose = None;
         self.step_pose = None;
@@ -924,6 +1123,102 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// directly, clusters handed to the optimal solver and the largest and smallest of those.
     pub fn association_stats(&self) -> &AssociationStats {
         self.associator.stats()
+    }
+
+    /// Writes every live track's fused prediction to time `timestamp_s` into `out`, in table
+    /// order, without changing any state (see [`crate::prediction`]); returns how many were
+    /// written (the live tracks, at most `out.len()`). Positions and velocities are given in
+    /// the vehicle frame of the newest frame's ego pose (world-frame tracking; the ego motion
+    /// since is not known to the tracker) with the world-frame values beside; use
+    /// [`predict_to_with_pose`](Self::predict_to_with_pose) with the ego pose at
+    /// `timestamp_s` to have them in the vehicle frame of that time.
+    pub fn predict_to(&self, timestamp_s: f64, out: &mut [TrackOutput]) -> Result<usize, PredictError> {
+        self.predict_to_with_pose(timestamp_s, None, out)
+    }
+
+    /// [`predict_to`](Self::predict_to) with the ego pose at `timestamp_s`, if known: the
+    /// vehicle-frame outputs of world-frame tracks are then in the vehicle frame of that pose.
+    pub fn predict_to_with_pose(
+        &self,
+        timestamp_s: f64,
+        ego_pose: Option<EgoPose>,
+        out: &mut [TrackOutput],
+    ) -> Result<usize, PredictError> {
+        if !timestamp_s.is_finite() {
+            return Err(PredictError::NonFiniteTime { timestamp_s });
+        }
+        let Some(newest_s) = self.last_timestamp_s else { return Ok(0) };
+        let dt_s = timestamp_s - newest_s;
+        if dt_s < 0.0 {
+            return Err(PredictError::BeforeNewestFrame { timestamp_s, newest_s });
+        }
+        let max_s = self.config.tracker.max_frame_interval_s;
+        if dt_s > max_s {
+            return Err(PredictError::TooFarAhead { timestamp_s, ahead_s: dt_s, max_s });
+        }
+        let world = self.tracks_frame == TrackingFrame::World;
+        let to_vehicle = if world {
+            ego_pose.filter(|pose| pose.is_valid()).or(self.last_pose).map(|pose| pose.world_to_vehicle())
+        } else {
+            None
+        };
+        let survival = existence::survival_probability(dt_s, &self.config.tracker);
+        let mut written = 0;
+        for (track, slot) in self.table.tracks().iter().zip(out.iter_mut()) {
+            let class = track.class.index();
+            let (imm, models) = (&self.imms[class], &self.models[class]);
+            let mut prior = ImmPrior::default();
+            imm.predict_physics_into(models, &track.estimate, dt_s, &mut prior);
+            imm.complete_prior_in_place(models, &mut prior, dt_s, None);
+            let estimate = imm.fuse_position_velocity(&prior.state, prior.available);
+            let position = DVec2::new(estimate.mean.x, estimate.mean.y);
+            let velocity = DVec2::new(estimate.mean.z, estimate.mean.w);
+            let position_covariance = prior.fused.covariance;
+            let (position_m, position_covariance_m2, velocity_mps, state_covariance) = match to_vehicle {
+                Some(to_vehicle) => (
+                    to_vehicle.apply_point(position),
+                    to_vehicle.apply_covariance(position_covariance),
+                    to_vehicle.apply_vector(velocity),
+                    to_vehicle.apply_state_covariance(estimate.covariance),
+                ),
+                None => (position, position_covariance, velocity, estimate.covariance),
+            };
+            *slot = TrackOutput {
+                id: track.id,
+                class: track.class,
+                status: track.status,
+                position_m,
+                position_covariance_m2,
+                velocity_mps,
+                state_covariance,
+                prior_position_m: None,
+                world_position_m: to_vehicle.map(|_| position),
+                world_velocity_mps: to_vehicle.map(|_| velocity),
+                world_state_covariance: to_vehicle.map(|_| estimate.covariance),
+                mode_probabilities: prior.state.probabilities,
+                age_frames: track.age_frames,
+                age_s: timestamp_s - track.started_s,
+                hits: track.hits,
+                misses: track.misses,
+                existence_probability: track.existence_probability * survival,
+                ground_truth_id: None,
+                measurement_index: None,
+            };
+            written += 1;
+        }
+        Ok(written)
+    }
+
+    /// The outputs of the last successful [`step`](Self::step) (not of
+    /// [`step_into`](Self::step_into), which hands them to its sink instead).
+    pub fn last_outputs(&self) -> &[TrackOutput] {
+        &self.outputs
+    }
+
+    /// The newest tracked frame's time, s: the time of the latest outputs (after a late frame
+    /// too); `None` before the first frame and after a [`reset`](Self::reset).
+    pub fn newest_timestamp_s(&self) -> Option<f64> {
+        self.last_timestamp_s
     }
 
     /// The counters.
@@ -999,21 +1294,25 @@ fn report(
     rows: &[RowRecord],
     imms: &ClassImms,
     world_to_vehicle: Option<RigidTransform>,
+    timestamp_s: f64,
     mut sink: impl FnMut(&TrackOutput),
 ) {
     for (track, row) in table.tracks().iter().zip(rows.iter()) {
         let imm = &imms[track.class.index()];
         let fused = imm.fuse_posterior(&track.estimate, row.available);
         let velocity = imm.fuse_velocity(&track.estimate, row.available);
-        let (position_m, position_covariance_m2, velocity_mps, prior_position_m) = match world_to_vehicle {
-            Some(to_vehicle) => (
-                to_vehicle.apply_point(fused.mean),
-                to_vehicle.apply_covariance(fused.covariance),
-                to_vehicle.apply_vector(velocity),
-                row.prior_position_m.map(|prior| to_vehicle.apply_point(prior)),
-            ),
-            None => (fused.mean, fused.covariance, velocity, row.prior_position_m),
-        };
+        let state_covariance = imm.fuse_position_velocity(&track.estimate, row.available).covariance;
+        let (position_m, position_covariance_m2, velocity_mps, prior_position_m, vehicle_state_covariance) =
+            match world_to_vehicle {
+                Some(to_vehicle) => (
+                    to_vehicle.apply_point(fused.mean),
+                    to_vehicle.apply_covariance(fused.covariance),
+                    to_vehicle.apply_vector(velocity),
+                    row.prior_position_m.map(|prior| to_vehicle.apply_point(prior)),
+                    to_vehicle.apply_state_covariance(state_covariance),
+                ),
+                None => (fused.mean, fused.covariance, velocity, row.prior_position_m, state_covariance),
+            };
         sink(&TrackOutput {
             id: track.id,
             class: track.class,
@@ -1024,8 +1323,11 @@ fn report(
             prior_position_m,
             world_position_m: world_to_vehicle.map(|_| fused.mean),
             world_velocity_mps: world_to_vehicle.map(|_| velocity),
+            state_covariance: vehicle_state_covariance,
+            world_state_covariance: world_to_vehicle.map(|_| state_covariance),
             mode_probabilities: track.estimate.probabilities,
             age_frames: track.age_frames,
+            age_s: timestamp_s - track.started_s,
             hits: track.hits,
             misses: track.misses,
             existence_probability: track.existence_probability,

@@ -62,6 +62,19 @@ pub enum FrameError {
         /// Yaw of the pose, rad.
         yaw_rad: f64,
     },
+    /// The frame is older than the newest tracked frame by more than the late-frame window
+    /// reaches (`tracker.max_frame_delay_s`, or the `tracker.replay_frames` recorded frames).
+    #[error(
+        "frame timestamp {} s is older than the newest frame at {} s by more than the late-frame window (tracker.max_frame_delay_s, tracker.replay_frames) reaches",
+        readable(.timestamp_s),
+        readable(.newest_s)
+    )]
+    TooLate {
+        /// The timestamp, s.
+        timestamp_s: f64,
+        /// The newest tracked frame's timestamp, s.
+        newest_s: f64,
+    },
     /// The frame claims more measurements than a frame may carry.
     #[error("frame carries {count} measurements, more than the maximum of {MAX_MEASUREMENTS_PER_FRAME}")]
     TooManyMeasurements {

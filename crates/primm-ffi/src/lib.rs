@@ -116,8 +116,8 @@ pub use helpers::{
 };
 pub use status::PrimmStatus;
 pub use tracker::{
-    primm_tracker_create, primm_tracker_destroy, primm_tracker_last_error, primm_tracker_options_default,
-    primm_tracker_reset, primm_tracker_stats, primm_tracker_step, primm_tracker_step_with_pose,
-    primm_tracker_tracks, PrimmTracker,
+    primm_tracker_create, primm_tracker_destroy, primm_tracker_last_error, primm_tracker_newest_timestamp,
+    primm_tracker_options_default, primm_tracker_predict_to, primm_tracker_reset, primm_tracker_stats,
+    primm_tracker_step, primm_tracker_step_with_pose, primm_tracker_tracks, PrimmTracker,
 };
 pub use types::*;

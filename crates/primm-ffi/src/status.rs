@@ -110,6 +110,8 @@ pub(crate) enum Failure {
     Step(StepError),
     /// The caller's buffer holds `capacity` entries, `needed` are required.
     BufferTooSmall { needed: usize, capacity: usize },
+    /// The tracker refused to predict to the requested time.
+    Predict(primm_core::prediction::PredictError),
 }
 
 impl Failure {
@@ -126,6 +128,7 @@ impl Failure {
             Failure::Step(StepError::InvalidFrame(_)) => PrimmStatus::InvalidFrame,
             Failure::Step(StepError::Association(_)) => PrimmStatus::AssociationError,
             Failure::BufferTooSmall { .. } => PrimmStatus::BufferTooSmall,
+            Failure::Predict(_) => PrimmStatus::InvalidArgument,
         }
     }
 }
@@ -150,6 +153,7 @@ impl fmt::Display for Failure {
             Failure::BufferTooSmall { needed, capacity } => {
                 write!(f, "the buffer holds {capacity} entries, {needed} are needed")
             }
+            Failure::Predict(error) => write!(f, "{error}"),
         }
     }
 }

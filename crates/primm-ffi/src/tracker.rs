@@ -13,6 +13,7 @@ use primm_core::measurement::{FrameView, Measurement, UnknownClass};
 use primm_core::mode::Mode;
 use primm_core::pose::EgoPose;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
+use primm_core::track::TrackOutput;
 use primm_core::tracker::Tracker;
 use primm_predictor::onnx::{ModelSource, OnnxPredictor, PrModel};
 use primm_predictor::split::on_inference_threads;
@@ -30,6 +31,8 @@ pub struct PrimmTracker {
     /// [`PRIMM_MAX_TRACKS`] entries; the first `track_count` are the last step's tracks.
     tracks: Box<[PrimmTrack]>,
     track_count: usize,
+    /// Room for every track predicted by `primm_tracker_predict_to`, allocated once.
+    predicted: Box<[TrackOutput]>,
     last_error: ErrorText,
     /// Set when a call panicked: the tracker's state may be inconsistent.
     poisoned: bool,
@@ -104,6 +107,7 @@ impl PrimmTracker {
             tracker,
             tracks: vec![PrimmTrack::EMPTY; PRIMM_MAX_TRACKS].into_boxed_slice(),
             track_count: 0,
+            predicted: vec![TrackOutput::default(); PRIMM_MAX_TRACKS].into_boxed_slice(),
             last_error: ErrorText::new(),
             poisoned: false,
         }))
@@ -277,7 +281,9 @@ pub unsafe extern "C" fn primm_tracker_step(
 }
 
 /// Tracks one frame: `count` measurements at `measurements` (NULL allowed when `count` is 0),
-/// taken at `timestamp_s` (seconds, strictly increasing from frame to frame), with the ego
+/// taken at `timestamp_s` (seconds; a frame older than the newest tracked one by at most
+/// `tracker.max_frame_delay_s` is tracked in its place, see `late_frame` of the summary; an older
+/// one is rejected), with the ego
 /// vehicle's pose `*ego_pose` at that time, or NULL when unknown. With a pose (and the
 /// configuration's `frame.tracking_frame` "world", the default) the tracker keeps its tracks in
 /// the world frame and reports them in the vehicle frame of this step with their world estimate
@@ -406,6 +412,86 @@ pub unsafe extern "C" fn primm_tracker_reset(tracker: *mut PrimmTracker) -> Prim
     let body = |handle: &mut PrimmTracker| {
         handle.tracker.reset();
         handle.track_count = 0;
+        Ok(())
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { with_tracker(tracker, body) }
+}
+
+/// Writes every live track's fused prediction to time `timestamp_s` (seconds, on the clock of
+/// the frames; not before the newest tracked frame, at most `tracker.max_frame_interval_s`
+/// after it) into `out`, which holds `capacity` entries, and their number to `*out_count`,
+/// without changing any state: for a consumer that runs at its own cycle. The learned mode
+/// sits the prediction out (it would need a model inference); the existence probability decays
+/// over the interval. With `ego_pose` (the vehicle's pose at `timestamp_s`, NULL when unknown)
+/// the vehicle-frame values of world-frame tracks are given in the vehicle frame of that pose;
+/// without, in that of the newest frame's pose. Buffer rules as `primm_tracker_tracks`; a time
+/// out of range is `PRIMM_STATUS_INVALID_ARGUMENT` with the reason in the last error. Before the
+/// first frame, and after a reset, there is no track: `*out_count` is 0. Allocates nothing.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread; `ego_pose` is NULL or readable;
+/// `out` is NULL or points to `capacity` writable `PrimmTrack`s; `out_count` is NULL or
+/// writable.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_predict_to(
+    tracker: *mut PrimmTracker,
+    timestamp_s: f64,
+    ego_pose: *const PrimmEgoPose,
+    out: *mut PrimmTrack,
+    capacity: usize,
+    out_count: *mut usize,
+) -> PrimmStatus {
+    let body = |handle: &mut PrimmTracker| {
+        if out_count.is_null() {
+            return Err(Failure::NullArgument("out_count"));
+        }
+        if out.is_null() && capacity > 0 {
+            return Err(Failure::NullArgument("out"));
+        }
+        let needed = handle.tracker.tracks().len();
+        // SAFETY: writable (caller contract).
+        unsafe { out_count.write(needed) };
+        if needed > capacity {
+            return Err(Failure::BufferTooSmall { needed, capacity });
+        }
+        // SAFETY: NULL or readable (caller contract).
+        let ego_pose = unsafe { ego_pose.as_ref() }.map(|pose| EgoPose {
+            x_m: pose.x_m,
+            y_m: pose.y_m,
+            yaw_rad: pose.yaw_rad,
+        });
+        let predicted = &mut handle.predicted[..];
+        let count =
+            handle.tracker.predict_to_with_pose(timestamp_s, ego_pose, predicted).map_err(Failure::Predict)?;
+        for (index, output) in predicted[..count].iter().enumerate() {
+            // SAFETY: `out` holds `capacity >= needed >= count` entries (caller contract).
+            unsafe { out.add(index).write(PrimmTrack::from(output)) };
+        }
+        Ok(())
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { with_tracker(tracker, body) }
+}
+
+/// Writes the time of the newest tracked frame (the time of the tracks `primm_tracker_tracks`
+/// copies, also after a late frame) to `*out_timestamp_s`, or NaN before the first frame and
+/// after a reset.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread; `out_timestamp_s` is NULL or
+/// writable.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_newest_timestamp(
+    tracker: *mut PrimmTracker,
+    out_timestamp_s: *mut f64,
+) -> PrimmStatus {
+    let body = |handle: &mut PrimmTracker| {
+        if out_timestamp_s.is_null() {
+            return Err(Failure::NullArgument("out_timestamp_s"));
+        }
+        // SAFETY: writable (caller contract).
+        unsafe { out_timestamp_s.write(handle.tracker.newest_timestamp_s().unwrap_or(f64::NAN)) };
         Ok(())
     };
     // SAFETY: forwarded caller contract.

@@ -217,6 +217,15 @@ pub struct PrimmTrack {
     pub world_velocity_x_mps: f64,
     /// Fused velocity over ground in the world frame, y, m/s.
     pub world_velocity_y_mps: f64,
+    /// Covariance of the fused `[x, y, vx, vy]`, row-major 4×4 (m², m²/s, m²/s²), in the frame
+    /// of `x_m`, `y_m` and the velocity; its upper-left 2×2 block is the position covariance.
+    pub state_covariance: [f64; 16],
+    /// Covariance of the world-frame `[x, y, vx, vy]`, row-major 4×4; NaN unless
+    /// `has_world_estimate`.
+    pub world_state_covariance: [f64; 16],
+    /// Time since the track's first measurement, s (at the step's newest frame, or at the
+    /// requested time of `primm_tracker_predict_to`).
+    pub age_s: f64,
 }
 
 /// The ego vehicle's pose in the world (odometry) frame at a frame's time: the reference point
@@ -260,6 +269,9 @@ impl PrimmTrack {
         world_y_m: f64::NAN,
         world_velocity_x_mps: f64::NAN,
         world_velocity_y_mps: f64::NAN,
+        state_covariance: [0.0; 16],
+        world_state_covariance: [f64::NAN; 16],
+        age_s: 0.0,
     };
 }
 
@@ -294,6 +306,12 @@ impl From<&TrackOutput> for PrimmTrack {
             world_y_m: world.map_or(f64::NAN, |(p, _)| p.y),
             world_velocity_x_mps: world.map_or(f64::NAN, |(_, v)| v.x),
             world_velocity_y_mps: world.map_or(f64::NAN, |(_, v)| v.y),
+            state_covariance: row_major(&output.state_covariance),
+            world_state_covariance: match (world, output.world_state_covariance) {
+                (Some(_), Some(covariance)) => row_major(&covariance),
+                _ => [f64::NAN; 16],
+            },
+            age_s: output.age_s,
         }
     }
 }
@@ -325,6 +343,16 @@ pub struct PrimmStepSummary {
     pub largest_solved_cluster_tracks: usize,
     /// Measurements of the largest cluster solved in this step (0 if none was).
     pub largest_solved_cluster_measurements: usize,
+    /// Newer frames tracked again because this frame was late (0 for a frame in order).
+    pub replayed_frames: usize,
+    /// Whether the frame was late (older than the newest frame tracked before it, within
+    /// `tracker.max_frame_delay_s`) and was tracked in its place. The tracks are then those at
+    /// the newest frame's time (`primm_tracker_newest_timestamp`), and their
+    /// `measurement_index` refers to the newest frame's measurements.
+    pub late_frame: bool,
+    /// Whether the frame's ego pose jumped from the previous one (an odometry reset; the tracks
+    /// kept their place around the vehicle).
+    pub odometry_reset: bool,
 }
 
 impl PrimmStepSummary {
@@ -346,6 +374,9 @@ impl PrimmStepSummary {
             smallest_solved_cluster_measurements: association.smallest_solved_cluster.1,
             largest_solved_cluster_tracks: association.largest_cluster.0,
             largest_solved_cluster_measurements: association.largest_cluster.1,
+            replayed_frames: summary.replayed_frames,
+            late_frame: summary.late,
+            odometry_reset: summary.odometry_reset,
         }
     }
 }
@@ -414,6 +445,14 @@ pub struct PrimmStats {
     pub frames_with_unknown_sensor: u64,
     /// Tracks merged into an older track of the same object.
     pub duplicate_tracks_merged: u64,
+    /// Late frames tracked in their place.
+    pub late_frames_tracked: u64,
+    /// Newer frames tracked again after a late frame.
+    pub frames_replayed: u64,
+    /// Frames rejected for being older than the late-frame window reaches.
+    pub frames_rejected_too_late: u64,
+    /// Ego poses that jumped (odometry resets).
+    pub odometry_resets: u64,
 }
 
 impl From<&TrackerStats> for PrimmStats {
@@ -447,6 +486,10 @@ impl From<&TrackerStats> for PrimmStats {
             resets,
             frames_with_unknown_sensor,
             duplicate_tracks_merged,
+            late_frames_tracked,
+            frames_replayed,
+            frames_rejected_too_late,
+            odometry_resets,
         } = *stats;
         PrimmStats {
             frames_tracked,
@@ -476,6 +519,15 @@ impl From<&TrackerStats> for PrimmStats {
             resets,
             frames_with_unknown_sensor,
             duplicate_tracks_merged,
+            late_frames_tracked,
+            frames_replayed,
+            frames_rejected_too_late,
+            odometry_resets,
         }
     }
+}
+
+/// A 4×4 matrix as 16 values, row-major.
+fn row_major(matrix: &glam::DMat4) -> [f64; 16] {
+    matrix.transpose().to_cols_array()
 }

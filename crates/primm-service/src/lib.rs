@@ -47,4 +47,6 @@ pub mod tracking;
 
 pub use catalog::{ConnectError, ServiceNames};
 pub use shutdown::ShutdownFlag;
-pub use tracking::{ServiceCounters, TrackingLoopError, TrackingOptions, TrackingService, WaitMode};
+pub use tracking::{
+    PublishTime, ServiceCounters, TrackingLoopError, TrackingOptions, TrackingService, WaitMode,
+};

@@ -35,11 +35,12 @@ use iceoryx2::sample_mut::SampleMut;
 use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::stage_timing::Stage;
+use primm_core::track::TrackOutput;
 use primm_core::tracker::{StepError, StepSummary, Tracker};
 use primm_wire::{
     FrameStatus, LatencyReport, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
-    TrackFrameWriter, FRAME_FLAG_STREAM_END, STAGE_CAPACITY, TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END,
-    TRACK_FLAG_TRACKER_RESET,
+    TrackFrameWriter, FRAME_FLAG_STREAM_END, STAGE_CAPACITY, TRACK_FLAG_LATE_FRAME, TRACK_FLAG_PREDICTED,
+    TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
 };
 use std::mem::MaybeUninit;
 use std::time::{Duration, Instant};
@@ -55,6 +56,23 @@ pub enum WaitMode {
     BusyPoll,
 }
 
+/// The time the published tracks describe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PublishTime {
+    /// The newest tracked frame's time (the input frame's, unless it was late): the tracks as
+    /// the step left them, written straight into the loaned sample (default).
+    #[default]
+    Frame,
+    /// The publish time: the tracks predicted from the newest frame over the time since the
+    /// input frame was published ([`Tracker::predict_to`]), so that a consumer receives them at
+    /// the time they describe. Costs one prediction per track and a copy, after the step; the
+    /// learned mode sits the prediction out. The publish time on the sensor clock is taken as
+    /// the input frame's sensor time plus the time since its publisher sent it (monotonic
+    /// clock of this host), clamped to `[0, tracker.max_frame_interval_s]` ahead of the newest
+    /// frame.
+    Now,
+}
+
 /// Settings of the tracking loop.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TrackingOptions {
@@ -67,6 +85,8 @@ pub struct TrackingOptions {
     pub latency_report_interval_frames: u64,
     /// Longest single wait, after which the loop checks for shutdown.
     pub poll_timeout: Duration,
+    /// The time the published tracks describe.
+    pub publish_time: PublishTime,
 }
 
 impl Default for TrackingOptions {
@@ -76,6 +96,7 @@ impl Default for TrackingOptions {
             wait: WaitMode::Event,
             latency_report_interval_frames: 100,
             poll_timeout: Duration::from_millis(50),
+            publish_time: PublishTime::Frame,
         }
     }
 }
@@ -161,6 +182,9 @@ pub struct TrackingService<P: DisplacementPredictor> {
     latency_notifier: Notifier<Ipc>,
     tracker: Tracker<P>,
     histograms: LatencyHistograms,
+    /// Room for every track predicted to the publish time ([`PublishTime::Now`]), allocated
+    /// once.
+    predicted: Box<[TrackOutput]>,
     counters: ServiceCounters,
     stream: StreamState,
     logs: LogLimits,
@@ -189,6 +213,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             latency_notifier: latency.notifier()?,
             tracker,
             histograms: LatencyHistograms::new(),
+            predicted: vec![TrackOutput::default(); primm_core::track_table::MAX_TRACKS].into_boxed_slice(),
             counters: ServiceCounters::default(),
             stream: StreamState::default(),
             logs: LogLimits::default(),
@@ -253,7 +278,18 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         if frame.flags & FRAME_FLAG_STREAM_END != 0 {
             flags |= TRACK_FLAG_STREAM_END;
         }
+        if step.late {
+            flags |= TRACK_FLAG_LATE_FRAME;
+        }
+        let mut tracks_timestamp_s = self.tracker.newest_timestamp_s().unwrap_or(frame.sensor_timestamp_s);
+        if result.is_ok() && self.options.publish_time == PublishTime::Now {
+            if let Some(predicted_s) = self.write_predicted(frame, tracks_timestamp_s, &mut writer) {
+                tracks_timestamp_s = predicted_s;
+                flags |= TRACK_FLAG_PREDICTED;
+            }
+        }
         let mut header = track_frame_header(frame, receive_ns, status, flags, &step);
+        header.tracks_timestamp_s = tracks_timestamp_s;
         // The input sample goes back to its publisher before the answer is sent.
         drop(sample);
 
@@ -290,8 +326,30 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         }
     }
 
-    /// Tracks `frame`, its tracks written by `writer` and its stages timed from `receive_ns`. A
-    /// frame after too long a gap is tracked again after a reset, which `flags` then records.
+    /// With [`PublishTime::Now`]: writes the tracks predicted from the newest frame
+    /// (`newest_s`) to the publish time; returns that time, or `None` (nothing written) when
+    /// the prediction was refused.
+    fn write_predicted(
+        &mut self,
+        frame: &MeasurementFrame,
+        newest_s: f64,
+        writer: &mut Option<TrackFrameWriter<'_>>,
+    ) -> Option<f64> {
+        let since_publish_s = monotonic_ns().saturating_sub(frame.publish_time_ns) as f64 * 1e-9;
+        let max_ahead_s = self.tracker.config().tracker.max_frame_interval_s;
+        let ahead_s = (frame.sensor_timestamp_s + since_publish_s - newest_s).clamp(0.0, max_ahead_s);
+        let predicted_s = newest_s + ahead_s;
+        let count = self.tracker.predict_to(predicted_s, &mut self.predicted[..]).ok()?;
+        if let Some(writer) = writer.as_mut() {
+            writer.clear();
+            self.predicted[..count].iter().for_each(|output| writer.push(output));
+        }
+        Some(predicted_s)
+    }
+
+    /// Tracks `frame`, its tracks written by `writer` (unless they are published predicted) and
+    /// its stages timed from `receive_ns`. A frame after too long a gap is tracked again after a
+    /// reset, which `flags` then records.
     fn track(
         &mut self,
         frame: &MeasurementFrame,
@@ -300,6 +358,8 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         flags: &mut u8,
     ) -> Result<StepSummary, StepError> {
         let mut timer = StageTimer::new(&mut self.histograms, receive_ns);
+        let mut no_writer = None;
+        let writer = if self.options.publish_time == PublishTime::Now { &mut no_writer } else { writer };
         let stepped = step_received_frame(&mut self.tracker, frame, &mut timer, writer);
         if stepped.reset_for_interval {
             self.counters.resets_interval_too_long += 1;
@@ -548,6 +608,7 @@ fn track_frame_header(
         input_sequence: frame.sequence,
         source_frame: frame.source_frame,
         sensor_timestamp_s: frame.sensor_timestamp_s,
+        tracks_timestamp_s: frame.sensor_timestamp_s,
         input_publish_time_ns: frame.publish_time_ns,
         receive_time_ns: receive_ns,
         publish_time_ns: 0,

@@ -15,7 +15,7 @@
 
 #include <stdint.h>
 
-#define PRIMM_WIRE_VERSION 3 /* layout version; primm_track_frame.wire_version carries the writer's */
+#define PRIMM_WIRE_VERSION 4 /* layout version; primm_track_frame.wire_version carries the writer's */
 #define PRIMM_MEASUREMENT_CAPACITY 256
 #define PRIMM_TRACK_CAPACITY 512
 #define PRIMM_STAGE_CAPACITY 12
@@ -34,6 +34,8 @@
 #define PRIMM_TRACK_FLAG_TRACKER_RESET (1u << 0)
 #define PRIMM_TRACK_FLAG_SEQUENCE_GAP (1u << 1)
 #define PRIMM_TRACK_FLAG_STREAM_END (1u << 2)
+#define PRIMM_TRACK_FLAG_LATE_FRAME (1u << 3) /* late input tracked in its place; tracks at tracks_timestamp_s */
+#define PRIMM_TRACK_FLAG_PREDICTED (1u << 4)  /* tracks predicted to tracks_timestamp_s (publish time) */
 
 /* TrackFrame.status */
 #define PRIMM_STATUS_TRACKED 0
@@ -43,6 +45,7 @@
 #define PRIMM_STATUS_REJECTED_TOO_MANY_MEASUREMENTS 4
 #define PRIMM_STATUS_ASSOCIATION_FAILED 5
 #define PRIMM_STATUS_REJECTED_INVALID_EGO_POSE 6
+#define PRIMM_STATUS_REJECTED_TOO_LATE 7
 
 /* Object class codes */
 #define PRIMM_CLASS_CAR 0
@@ -78,16 +81,16 @@ typedef struct primm_measurement_frame {
     primm_wire_measurement measurements[PRIMM_MEASUREMENT_CAPACITY];
 } primm_measurement_frame;
 
-/* One track: 192 bytes. With world_valid == 1 the frame was tracked in the world frame: x, y,
- * covariance, prior and velocity are in the vehicle frame of the input frame (velocity over
+/* One track: 424 bytes. With world_valid == 1 the frame was tracked in the world frame: x, y,
+ * velocity, covariance and prior are in the vehicle frame of the input frame (velocity over
  * ground in the vehicle's axes), world_* in the world frame. */
 typedef struct primm_wire_track {
     uint64_t id;
     double x_m;
     double y_m;
-    double covariance_m2[4];      /* row-major xx, xy, yx, yy */
     double vx_mps;
     double vy_mps;
+    double state_covariance[16];  /* row-major 4x4 of [x, y, vx, vy]: m^2, m^2/s, m^2/s^2 */
     double prior_x_m;             /* valid when prior_valid == 1 */
     double prior_y_m;
     double mode_probabilities[4]; /* PR, CV, CA, CT */
@@ -95,7 +98,9 @@ typedef struct primm_wire_track {
     double world_y_m;
     double world_vx_mps;
     double world_vy_mps;
+    double world_state_covariance[16]; /* row-major 4x4 of the world [x, y, vx, vy] */
     double existence_probability; /* probability that the object exists, (0, 1) */
+    double age_s;                 /* time since the track's first measurement */
     int64_t gt_id;                /* -1: none */
     uint32_t age_frames;
     uint32_t hits;
@@ -108,11 +113,12 @@ typedef struct primm_wire_track {
     uint8_t _pad0[4];
 } primm_wire_track;
 
-/* "primm::TrackFrame": 98368 bytes. */
+/* "primm::TrackFrame": 217160 bytes. */
 typedef struct primm_track_frame {
     uint64_t input_sequence;
     uint64_t source_frame;
     double sensor_timestamp_s;
+    double tracks_timestamp_s; /* the time the tracks describe (see the flags) */
     uint64_t input_publish_time_ns;
     uint64_t receive_time_ns;
     uint64_t publish_time_ns;

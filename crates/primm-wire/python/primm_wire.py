@@ -9,7 +9,7 @@ nanoseconds (``time.monotonic_ns()``), ``_s`` times are sensor seconds.
 
 import ctypes
 
-WIRE_VERSION = 3  # layout version; TrackFrame.wire_version carries the writer's
+WIRE_VERSION = 4  # layout version; TrackFrame.wire_version carries the writer's
 MEASUREMENT_CAPACITY = 256
 TRACK_CAPACITY = 512
 STAGE_CAPACITY = 12
@@ -22,6 +22,8 @@ FRAME_FLAG_STREAM_END = 1 << 2
 TRACK_FLAG_TRACKER_RESET = 1 << 0
 TRACK_FLAG_SEQUENCE_GAP = 1 << 1
 TRACK_FLAG_STREAM_END = 1 << 2
+TRACK_FLAG_LATE_FRAME = 1 << 3  # late input tracked in its place; tracks at tracks_timestamp_s
+TRACK_FLAG_PREDICTED = 1 << 4  # tracks predicted to tracks_timestamp_s (the publish time)
 
 STATUS_NAMES = {
     0: "tracked",
@@ -30,6 +32,8 @@ STATUS_NAMES = {
     3: "interval_too_long",
     4: "too_many_measurements",
     5: "association_failed",
+    6: "invalid_ego_pose",
+    7: "too_late",
 }
 CLASS_NAMES = {0: "car", 1: "pedestrian", 2: "two_wheeler"}
 
@@ -94,15 +98,15 @@ class MeasurementFrame(ctypes.Structure):
 
 
 class WireTrack(ctypes.Structure):
-    """One track's fused state (192 bytes)."""
+    """One track's fused state (424 bytes)."""
 
     _fields_ = [
         ("id", ctypes.c_uint64),
         ("x_m", ctypes.c_double),
         ("y_m", ctypes.c_double),
-        ("covariance_m2", ctypes.c_double * 4),
         ("vx_mps", ctypes.c_double),
         ("vy_mps", ctypes.c_double),
+        ("state_covariance", ctypes.c_double * 16),  # row-major 4x4 of [x, y, vx, vy]
         ("prior_x_m", ctypes.c_double),
         ("prior_y_m", ctypes.c_double),
         ("mode_probabilities", ctypes.c_double * 4),
@@ -110,7 +114,9 @@ class WireTrack(ctypes.Structure):
         ("world_y_m", ctypes.c_double),
         ("world_vx_mps", ctypes.c_double),
         ("world_vy_mps", ctypes.c_double),
+        ("world_state_covariance", ctypes.c_double * 16),
         ("existence_probability", ctypes.c_double),
+        ("age_s", ctypes.c_double),
         ("gt_id", ctypes.c_int64),
         ("age_frames", ctypes.c_uint32),
         ("hits", ctypes.c_uint32),
@@ -129,12 +135,13 @@ class WireTrack(ctypes.Structure):
 
 
 class TrackFrame(ctypes.Structure):
-    """The tracker's answer to one measurement frame (98368 bytes)."""
+    """The tracker's answer to one measurement frame (217160 bytes)."""
 
     _fields_ = [
         ("input_sequence", ctypes.c_uint64),
         ("source_frame", ctypes.c_uint64),
         ("sensor_timestamp_s", ctypes.c_double),
+        ("tracks_timestamp_s", ctypes.c_double),
         ("input_publish_time_ns", ctypes.c_uint64),
         ("receive_time_ns", ctypes.c_uint64),
         ("publish_time_ns", ctypes.c_uint64),

@@ -57,9 +57,12 @@
 /// into every [`TrackFrame`] (`wire_version`), and the C header (`PRIMM_WIRE_VERSION`) and the
 /// Python module (`WIRE_VERSION`) declare it beside their layouts. Version 2 added the
 /// world-frame fields of [`WireTrack`] and [`FrameStatus::RejectedInvalidEgoPose`]; version 3
-/// its `existence_probability` and the status code 2 (coasting). (iceoryx2
+/// its `existence_probability` and the status code 2 (coasting); version 4 the 4×4
+/// position–velocity covariances (in place of the 2×2 position covariance) and `age_s` of
+/// [`WireTrack`], [`TrackFrame::tracks_timestamp_s`], the flags for late frames and predicted
+/// tracks, and [`FrameStatus::RejectedTooLate`]. (iceoryx2
 /// also refuses to connect a publisher and a subscriber whose payload sizes differ.)
-pub const WIRE_VERSION: u16 = 3;
+pub const WIRE_VERSION: u16 = 4;
 
 mod latency_report;
 mod measurement_frame;
@@ -72,6 +75,7 @@ pub use measurement_frame::{
     MEASUREMENT_CAPACITY, SENSOR_UNKNOWN,
 };
 pub use track_frame::{
-    FrameStatus, TrackFrame, TrackFrameHeader, TrackFrameWriter, WireTrack, MEASUREMENT_INDEX_NONE,
-    TRACK_CAPACITY, TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
+    row_major, FrameStatus, TrackFrame, TrackFrameHeader, TrackFrameWriter, WireTrack,
+    MEASUREMENT_INDEX_NONE, TRACK_CAPACITY, TRACK_FLAG_LATE_FRAME, TRACK_FLAG_PREDICTED,
+    TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
 };

@@ -24,6 +24,13 @@ pub const TRACK_FLAG_TRACKER_RESET: u8 = 1 << 0;
 pub const TRACK_FLAG_SEQUENCE_GAP: u8 = 1 << 1;
 /// [`TrackFrame::flags`] bit: the input frame was the last of a finite stream.
 pub const TRACK_FLAG_STREAM_END: u8 = 1 << 2;
+/// [`TrackFrame::flags`] bit: the input frame was late (older than the newest tracked frame)
+/// and was tracked in its place; the tracks are those at `tracks_timestamp_s`, the newest
+/// frame's time, and their measurement indices refer to that frame.
+pub const TRACK_FLAG_LATE_FRAME: u8 = 1 << 3;
+/// [`TrackFrame::flags`] bit: the tracks were predicted from the newest frame to
+/// `tracks_timestamp_s` (`primm serve --publish-time now`); they carry no measurement index.
+pub const TRACK_FLAG_PREDICTED: u8 = 1 << 4;
 
 /// What the tracker did with an input frame ([`TrackFrame::status`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -45,6 +52,9 @@ pub enum FrameStatus {
     /// Rejected: the frame's ego pose is not finite or absurdly far out (only when tracking in
     /// the world frame). No track changed.
     RejectedInvalidEgoPose = 6,
+    /// Rejected: the frame is older than the newest tracked frame by more than the late-frame
+    /// window reaches (`tracker.max_frame_delay_s`, `tracker.replay_frames`). No track changed.
+    RejectedTooLate = 7,
 }
 
 impl FrameStatus {
@@ -63,6 +73,7 @@ impl FrameStatus {
             Self::RejectedTooManyMeasurements,
             Self::AssociationFailed,
             Self::RejectedInvalidEgoPose,
+            Self::RejectedTooLate,
         ]
         .get(usize::from(code))
         .copied()
@@ -82,6 +93,7 @@ impl FrameStatus {
                 Self::RejectedTooManyMeasurements
             }
             StepError::InvalidFrame(FrameError::InvalidEgoPose { .. }) => Self::RejectedInvalidEgoPose,
+            StepError::InvalidFrame(FrameError::TooLate { .. }) => Self::RejectedTooLate,
             StepError::Association(_) => Self::AssociationFailed,
         }
     }
@@ -96,16 +108,18 @@ impl FrameStatus {
             Self::RejectedTooManyMeasurements => "too_many_measurements",
             Self::AssociationFailed => "association_failed",
             Self::RejectedInvalidEgoPose => "invalid_ego_pose",
+            Self::RejectedTooLate => "too_late",
         }
     }
 }
 
-/// One track's fused state: 192 bytes, alignment 8.
+/// One track's fused state: 424 bytes, alignment 8.
 ///
-/// When the frame was tracked in the world frame (`world_valid` 1), the position, covariance,
-/// prior and velocity are in the vehicle frame of the input frame (the velocity is the velocity
-/// over ground in the vehicle's axes) and the `world_*` fields hold the world-frame position
-/// and velocity; otherwise everything is in the vehicle frame and `world_*` are 0.
+/// When the frame was tracked in the world frame (`world_valid` 1), the position, velocity,
+/// covariance and prior are in the vehicle frame of the input frame (the velocity is the
+/// velocity over ground in the vehicle's axes) and the `world_*` fields hold the world-frame
+/// position, velocity and covariance; otherwise everything is in the vehicle frame and
+/// `world_*` are 0.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
 #[type_name("primm::WireTrack")]
@@ -116,12 +130,13 @@ pub struct WireTrack {
     pub x_m: f64,
     /// Fused posterior position, m.
     pub y_m: f64,
-    /// Covariance of the fused position, row-major `[xx, xy, yx, yy]`, m².
-    pub covariance_m2: [f64; 4],
     /// Fused velocity, m/s.
     pub vx_mps: f64,
     /// Fused velocity, m/s.
     pub vy_mps: f64,
+    /// Covariance of `[x, y, vx, vy]`, row-major 4×4 (m², m²/s, m²/s²); its upper-left 2×2
+    /// block is the position covariance.
+    pub state_covariance: [f64; 16],
     /// Fused one-step prior used for association, m (valid when `prior_valid` is 1).
     pub prior_x_m: f64,
     /// Fused one-step prior used for association, m (valid when `prior_valid` is 1).
@@ -136,8 +151,13 @@ pub struct WireTrack {
     pub world_vx_mps: f64,
     /// Fused velocity over ground in the world frame, m/s (valid when `world_valid` is 1).
     pub world_vy_mps: f64,
+    /// Covariance of the world-frame `[x, y, vx, vy]`, row-major 4×4 (valid when `world_valid`
+    /// is 1).
+    pub world_state_covariance: [f64; 16],
     /// Probability that the track's object exists, in (0, 1).
     pub existence_probability: f64,
+    /// Time since the track's first measurement, s.
+    pub age_s: f64,
     /// Ground-truth id of the measurement that updated or started the track in this frame;
     /// -1 when none (coasting, or no ground truth).
     pub gt_id: i64,
@@ -163,11 +183,16 @@ pub struct WireTrack {
     pub _pad0: [u8; 4],
 }
 
+/// A 4×4 matrix as 16 values, row-major.
+#[inline]
+pub fn row_major(matrix: &glam::DMat4) -> [f64; 16] {
+    matrix.transpose().to_cols_array()
+}
+
 impl WireTrack {
     /// The wire form of a tracker output.
     #[inline]
     pub fn from_output(output: &TrackOutput) -> Self {
-        let covariance = output.position_covariance_m2;
         let prior = output.prior_position_m;
         let (world_position, world_velocity) = match (output.world_position_m, output.world_velocity_mps) {
             (Some(position), Some(velocity)) => (Some(position), Some(velocity)),
@@ -177,12 +202,7 @@ impl WireTrack {
             id: output.id,
             x_m: output.position_m.x,
             y_m: output.position_m.y,
-            covariance_m2: [
-                covariance.x_axis.x,
-                covariance.y_axis.x,
-                covariance.x_axis.y,
-                covariance.y_axis.y,
-            ],
+            state_covariance: row_major(&output.state_covariance),
             vx_mps: output.velocity_mps.x,
             vy_mps: output.velocity_mps.y,
             prior_x_m: prior.map_or(0.0, |p| p.x),
@@ -192,7 +212,12 @@ impl WireTrack {
             world_y_m: world_position.map_or(0.0, |p| p.y),
             world_vx_mps: world_velocity.map_or(0.0, |v| v.x),
             world_vy_mps: world_velocity.map_or(0.0, |v| v.y),
+            world_state_covariance: match (world_position, output.world_state_covariance) {
+                (Some(_), Some(covariance)) => row_major(&covariance),
+                _ => [0.0; 16],
+            },
             existence_probability: output.existence_probability,
+            age_s: output.age_s,
             gt_id: output.ground_truth_id.and_then(|id| i64::try_from(id).ok()).unwrap_or(-1),
             age_frames: output.age_frames,
             hits: output.hits,
@@ -221,13 +246,20 @@ impl WireTrack {
         ])
     }
 
+    /// The position covariance `[xx, xy, yx, yy]`, m² (the upper-left block of
+    /// `state_covariance`).
+    pub fn position_covariance_m2(&self) -> [f64; 4] {
+        let c = &self.state_covariance;
+        [c[0], c[1], c[4], c[5]]
+    }
+
     /// The measurement index, `None` when the track coasted.
     pub fn measurement_index(&self) -> Option<usize> {
         usize::try_from(self.measurement_index).ok()
     }
 }
 
-/// The tracker's output for one input frame: 98 368 bytes, alignment 8.
+/// The tracker's output for one input frame: 217 160 bytes, alignment 8.
 #[repr(C)]
 #[derive(Debug, ZeroCopySend)]
 #[type_name("primm::TrackFrame")]
@@ -238,6 +270,10 @@ pub struct TrackFrame {
     pub source_frame: u64,
     /// Sensor time of the input frame, s.
     pub sensor_timestamp_s: f64,
+    /// The time the tracks describe, s on the sensor clock: the input frame's time, the newest
+    /// tracked frame's after a late frame ([`TRACK_FLAG_LATE_FRAME`]), or the publish time the
+    /// tracks were predicted to ([`TRACK_FLAG_PREDICTED`]).
+    pub tracks_timestamp_s: f64,
     /// `publish_time_ns` of the input frame (publisher send time), `CLOCK_MONOTONIC` ns.
     pub input_publish_time_ns: u64,
     /// When the tracker took the input frame from its buffer, `CLOCK_MONOTONIC` ns.
@@ -284,6 +320,8 @@ pub struct TrackFrameHeader {
     pub source_frame: u64,
     /// See [`TrackFrame::sensor_timestamp_s`].
     pub sensor_timestamp_s: f64,
+    /// See [`TrackFrame::tracks_timestamp_s`].
+    pub tracks_timestamp_s: f64,
     /// See [`TrackFrame::input_publish_time_ns`].
     pub input_publish_time_ns: u64,
     /// See [`TrackFrame::receive_time_ns`].
@@ -366,6 +404,7 @@ impl<'a> TrackFrameWriter<'a> {
             addr_of_mut!((*frame).input_sequence).write(header.input_sequence);
             addr_of_mut!((*frame).source_frame).write(header.source_frame);
             addr_of_mut!((*frame).sensor_timestamp_s).write(header.sensor_timestamp_s);
+            addr_of_mut!((*frame).tracks_timestamp_s).write(header.tracks_timestamp_s);
             addr_of_mut!((*frame).input_publish_time_ns).write(header.input_publish_time_ns);
             addr_of_mut!((*frame).receive_time_ns).write(header.receive_time_ns);
             addr_of_mut!((*frame).publish_time_ns).write(header.publish_time_ns);

@@ -89,9 +89,9 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 id,
                 x_m,
                 y_m,
-                covariance_m2,
                 vx_mps,
                 vy_mps,
+                state_covariance,
                 prior_x_m,
                 prior_y_m,
                 mode_probabilities,
@@ -99,7 +99,9 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 world_y_m,
                 world_vx_mps,
                 world_vy_mps,
+                world_state_covariance,
                 existence_probability,
+                age_s,
                 gt_id,
                 age_frames,
                 hits,
@@ -119,6 +121,7 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 input_sequence,
                 source_frame,
                 sensor_timestamp_s,
+                tracks_timestamp_s,
                 input_publish_time_ns,
                 receive_time_ns,
                 publish_time_ns,
@@ -212,8 +215,8 @@ fn the_rust_types_have_no_implicit_padding() {
     }
     assert_eq!(size_of::<WireMeasurement>(), 64);
     assert_eq!(size_of::<MeasurementFrame>(), 16_448);
-    assert_eq!(size_of::<WireTrack>(), 192);
-    assert_eq!(size_of::<TrackFrame>(), 98_368);
+    assert_eq!(size_of::<WireTrack>(), 424);
+    assert_eq!(size_of::<TrackFrame>(), 217_160);
     assert_eq!(size_of::<LatencyReport>(), 1032);
 }
 

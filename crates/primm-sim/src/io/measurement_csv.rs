@@ -78,13 +78,13 @@ pub enum CsvErrorKind {
     /// A value required on this row is empty.
     #[error("missing value")]
     MissingValue,
-    /// A frame index smaller than the one of the previous row.
-    #[error("frame index {found} is smaller than the previous frame index {previous}")]
-    FrameDecreasing {
-        /// Frame index of the previous row.
-        previous: u64,
-        /// Frame index of this row.
-        found: u64,
+    /// The rows of a frame are not contiguous, or (writing) a frame index appears twice. Frames
+    /// may come in any order (arrival order: a late scan after a newer one), but each frame's
+    /// rows come together, once.
+    #[error("frame {frame} appears again after other frames; the rows of one frame must be contiguous and each frame index used once")]
+    FrameRepeated {
+        /// The frame.
+        frame: u64,
     },
     /// Rows of one frame carry different timestamps.
     #[error(
@@ -98,20 +98,6 @@ pub enum CsvErrorKind {
         /// Timestamp of the frame's first row.
         expected: f64,
         /// Timestamp of this row.
-        found: f64,
-    },
-    /// A frame starts earlier than the previous frame.
-    #[error(
-        "timestamp {} of frame {frame} is earlier than {}, the timestamp of the previous frame",
-        readable(.found),
-        readable(.previous)
-    )]
-    TimeDecreasing {
-        /// The frame.
-        frame: u64,
-        /// Timestamp of the previous frame.
-        previous: f64,
-        /// Timestamp of this frame.
         found: f64,
     },
     /// A frame-level value (sensor id, ego pose) differs between rows of one frame.
@@ -138,14 +124,6 @@ pub enum CsvErrorKind {
     TooManyMeasurements {
         /// The frame.
         frame: u64,
-    },
-    /// Writer: frame indices of a sequence must strictly increase.
-    #[error("frame index {found} does not follow frame index {previous}; indices must increase")]
-    FrameOrder {
-        /// Index of the previous frame.
-        previous: u64,
-        /// Index of this frame.
-        found: u64,
     },
     /// Writer: a value to be written is NaN or infinite.
     #[error("non-finite value {}", readable(.0))]
@@ -245,18 +223,11 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
     let header: Vec<&str> = REQUIRED_COLUMNS.iter().chain(OPTIONAL_COLUMNS.iter()).copied().collect();
     out.write_record(&header).map_err(CsvError::from_csv)?;
     let mut line = 1u64;
-    let mut previous: Option<u64> = None;
+    let mut written = std::collections::HashSet::new();
     for frame in &sequence.frames {
-        if let Some(previous) = previous {
-            if frame.index <= previous {
-                return Err(CsvError::at(
-                    line + 1,
-                    Some("frame"),
-                    CsvErrorKind::FrameOrder { previous, found: frame.index },
-                ));
-            }
+        if !written.insert(frame.index) {
+            return Err(CsvError::at(line + 1, Some("frame"), CsvErrorKind::FrameRepeated { frame: frame.index }));
         }
-        previous = Some(frame.index);
         let fail = |line: u64, kind| CsvError::at(line, None, kind);
         let frame_fields =
             [frame.index.to_string(), fmt_f64(frame.timestamp_s).map_err(|k| fail(line + 1, k))?];
@@ -560,26 +531,6 @@ impl OpenFrame {
         }
     }
 
-    /// Checks that `row`, the first of the next frame, does not go back in frame index or time.
-    fn check_followed_by(&self, parser: &RowParser<'_>, row: &Row) -> Result<(), CsvError> {
-        if row.frame < self.frame.index {
-            return Err(parser.error(
-                "frame",
-                CsvErrorKind::FrameDecreasing { previous: self.frame.index, found: row.frame },
-            ));
-        }
-        if row.t < self.frame.timestamp_s {
-            return Err(parser.error(
-                "t",
-                CsvErrorKind::TimeDecreasing {
-                    frame: row.frame,
-                    previous: self.frame.timestamp_s,
-                    found: row.t,
-                },
-            ));
-        }
-        Ok(())
-    }
 }
 
 fn fmt_opt<T: std::fmt::Debug>(value: &Option<T>) -> String {
@@ -600,6 +551,7 @@ pub fn read_sequence<R: Read>(reader: R, name: &str) -> Result<Sequence, CsvErro
     let columns = Columns::from_header(&header)?;
     let mut sequence = Sequence::new(name);
     let mut open: Option<OpenFrame> = None;
+    let mut seen = std::collections::HashSet::new();
     let mut record = csv::StringRecord::new();
     loop {
         let more = input.read_record(&mut record).map_err(CsvError::from_csv)?;
@@ -612,8 +564,11 @@ pub fn read_sequence<R: Read>(reader: R, name: &str) -> Result<Sequence, CsvErro
         match &mut open {
             Some(current) if current.frame.index == row.frame => current.add_row(&parser, row)?,
             _ => {
+                // Frames come in arrival order (a late scan may follow a newer one), each once.
+                if !seen.insert(row.frame) {
+                    return Err(parser.error("frame", CsvErrorKind::FrameRepeated { frame: row.frame }));
+                }
                 if let Some(previous) = open.take() {
-                    previous.check_followed_by(&parser, &row)?;
                     sequence.frames.push(previous.frame);
                 }
                 open = Some(OpenFrame::start(row));
@@ -803,11 +758,21 @@ mod tests {
     }
 
     #[test]
-    fn decreasing_frame_index_is_reported() {
+    fn frames_in_arrival_order_are_read_as_they_come() {
+        let text = format!(
+            "{HEADER}0,0,1,car,1,2,3,4,,,,,,\n2,0.1,1,car,1,2,3,4,,,,,,\n1,0.05,1,car,1,2,3,4,,,,,,\n"
+        );
+        let sequence = read_sequence(text.as_bytes(), "late").unwrap();
+        let order: Vec<(u64, f64)> = sequence.frames.iter().map(|f| (f.index, f.timestamp_s)).collect();
+        assert_eq!(order, vec![(0, 0.0), (2, 0.1), (1, 0.05)]);
+    }
+
+    #[test]
+    fn a_frame_whose_rows_are_not_contiguous_is_reported() {
         let err = read_err(&format!(
-            "{HEADER}0,0,1,car,1,2,3,4,,,,,,\n2,0.1,1,car,1,2,3,4,,,,,,\n1,0.2,1,car,1,2,3,4,,,,,,\n"
+            "{HEADER}0,0,1,car,1,2,3,4,,,,,,\n2,0.1,1,car,1,2,3,4,,,,,,\n0,0,1,car,1,2,3,4,,,,,,\n"
         ));
-        assert!(matches!(err.kind, CsvErrorKind::FrameDecreasing { previous: 2, found: 1 }));
+        assert!(matches!(err.kind, CsvErrorKind::FrameRepeated { frame: 0 }));
         assert_eq!(err.line, Some(4));
     }
 
@@ -816,12 +781,6 @@ mod tests {
         let err = read_err(&format!("{HEADER}0,0.1,1,car,1,2,3,4,,,,,,\n0,0.2,2,car,1,2,3,4,,,,,,\n"));
         assert!(matches!(err.kind, CsvErrorKind::TimeMismatch { frame: 0, .. }));
         assert_eq!((err.line, err.column.as_deref()), (Some(3), Some("t")));
-    }
-
-    #[test]
-    fn decreasing_time_between_frames_is_reported() {
-        let err = read_err(&format!("{HEADER}0,0.2,1,car,1,2,3,4,,,,,,\n1,0.1,2,car,1,2,3,4,,,,,,\n"));
-        assert!(matches!(err.kind, CsvErrorKind::TimeDecreasing { frame: 1, .. }));
     }
 
     #[test]
@@ -873,7 +832,7 @@ mod tests {
         let mut sequence = sample();
         sequence.frames[2].index = 1;
         let err = write_sequence(Vec::new(), &sequence).unwrap_err();
-        assert!(matches!(err.kind, CsvErrorKind::FrameOrder { previous: 1, found: 1 }));
+        assert!(matches!(err.kind, CsvErrorKind::FrameRepeated { frame: 1 }));
         let mut sequence = sample();
         sequence.frames[0].measurements[0].measurement.x_m = f64::INFINITY;
         let err = write_sequence(Vec::new(), &sequence).unwrap_err();
