@@ -32,6 +32,7 @@ mod imm_behaviour;
 mod imm_properties;
 mod imm_spread_of_means;
 mod inference_faults;
+mod latency_files;
 mod learned_covariance;
 mod logging;
 mod motion_models;

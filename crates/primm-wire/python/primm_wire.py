@@ -9,7 +9,7 @@ nanoseconds (``time.monotonic_ns()``), ``_s`` times are sensor seconds.
 
 import ctypes
 
-WIRE_VERSION = 3  # layout version; TrackFrame.wire_version carries the writer's
+WIRE_VERSION = 4  # layout version; TrackFrame.wire_version carries the writer's
 MEASUREMENT_CAPACITY = 256
 TRACK_CAPACITY = 512
 STAGE_CAPACITY = 12
@@ -73,13 +73,14 @@ class WireMeasurement(ctypes.Structure):
 
 
 class MeasurementFrame(ctypes.Structure):
-    """One radar frame (16448 bytes)."""
+    """One radar frame (16456 bytes)."""
 
     _fields_ = [
         ("sequence", ctypes.c_uint64),
         ("source_frame", ctypes.c_uint64),
         ("sensor_timestamp_s", ctypes.c_double),
         ("publish_time_ns", ctypes.c_uint64),
+        ("scheduled_time_ns", ctypes.c_uint64),
         ("ego_x_m", ctypes.c_double),
         ("ego_y_m", ctypes.c_double),
         ("ego_yaw_rad", ctypes.c_double),
@@ -129,13 +130,14 @@ class WireTrack(ctypes.Structure):
 
 
 class TrackFrame(ctypes.Structure):
-    """The tracker's answer to one measurement frame (98368 bytes)."""
+    """The tracker's answer to one measurement frame (98376 bytes)."""
 
     _fields_ = [
         ("input_sequence", ctypes.c_uint64),
         ("source_frame", ctypes.c_uint64),
         ("sensor_timestamp_s", ctypes.c_double),
         ("input_publish_time_ns", ctypes.c_uint64),
+        ("input_scheduled_time_ns", ctypes.c_uint64),
         ("receive_time_ns", ctypes.c_uint64),
         ("publish_time_ns", ctypes.c_uint64),
         ("count", ctypes.c_uint32),

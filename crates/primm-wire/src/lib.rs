@@ -57,9 +57,10 @@
 /// into every [`TrackFrame`] (`wire_version`), and the C header (`PRIMM_WIRE_VERSION`) and the
 /// Python module (`WIRE_VERSION`) declare it beside their layouts. Version 2 added the
 /// world-frame fields of [`WireTrack`] and [`FrameStatus::RejectedInvalidEgoPose`]; version 3
-/// its `existence_probability` and the status code 2 (coasting). (iceoryx2
-/// also refuses to connect a publisher and a subscriber whose payload sizes differ.)
-pub const WIRE_VERSION: u16 = 3;
+/// its `existence_probability` and the status code 2 (coasting); version 4 the publisher's
+/// schedule (`MeasurementFrame::scheduled_time_ns`, `TrackFrame::input_scheduled_time_ns`).
+/// (iceoryx2 also refuses to connect a publisher and a subscriber whose payload sizes differ.)
+pub const WIRE_VERSION: u16 = 4;
 
 mod latency_report;
 mod measurement_frame;
