@@ -172,6 +172,12 @@ pub enum RateTrialError {
     Replay(#[from] ReplayError),
 }
 
+/// How often a trial looks for answers while it waits for the next send time. The iceoryx2
+/// listener's timed wait rounds its timeout up to the kernel's tick (several ms here), far too
+/// coarse to pace sends by; a short sleep is exact to tens of µs. The client's receive time of
+/// an answer is therefore late by up to this much (the tracker's own stamps are not).
+pub const ANSWER_POLL_INTERVAL: Duration = Duration::from_micros(100);
+
 /// A histogram of latencies in ns, as the service keeps them.
 pub fn latency_histogram() -> Histogram<u64> {
     Histogram::new_with_bounds(1, MAX_TRACKABLE_NS, 3).expect("valid histogram bounds")
@@ -180,8 +186,9 @@ pub fn latency_histogram() -> Histogram<u64> {
 /// Sends `scene` (repeated, each repetition a new stream) at `options.rate_hz` through
 /// `replayer` (opened with flow control, so that it reads the answers) for
 /// `options.duration`, each frame stamped with its scheduled send time, and reads the answers
-/// as they come (sleeping on their event between sends). `on_interval` is called with the
-/// latencies after every answer, for interval logs. Stops early on `shutdown`.
+/// as they come (every [`ANSWER_POLL_INTERVAL`] between sends). `on_answer` is called with the
+/// receive time and the latencies after every answer, for interval logs. Stops early on
+/// `shutdown`.
 pub fn run_rate_trial(
     replayer: &mut Replayer,
     scene: &Sequence,
@@ -240,7 +247,7 @@ pub fn run_rate_trial(
             if now >= due {
                 break;
             }
-            replayer.wait_for_answers(due - now)?;
+            std::thread::sleep((due - now).min(ANSWER_POLL_INTERVAL));
         }
         if Instant::now().duration_since(due) > interval {
             trial.late_sends += 1;
@@ -268,7 +275,7 @@ pub fn run_rate_trial(
         if now >= drain_until || trial.answered >= trial.sent {
             break;
         }
-        replayer.wait_for_answers((drain_until - now).min(Duration::from_millis(20)))?;
+        std::thread::sleep((drain_until - now).min(ANSWER_POLL_INTERVAL));
     }
     trial.elapsed = start.elapsed();
     Ok(trial)

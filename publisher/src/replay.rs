@@ -266,21 +266,6 @@ impl Replayer {
         Ok(received)
     }
 
-    /// Sleeps until the tracker notifies an answer or `timeout` passes (only with flow control;
-    /// without it, sleeps `timeout`).
-    pub fn wait_for_answers(&self, timeout: Duration) -> Result<(), ReplayError> {
-        match &self.answers {
-            Some((_, listener)) => match listener.timed_wait(|_| {}, timeout) {
-                Ok(_) | Err(ListenerWaitError::InterruptSignal) => Ok(()),
-                Err(error) => Err(ReplayError::Wait(error)),
-            },
-            None => {
-                std::thread::sleep(timeout);
-                Ok(())
-            }
-        }
-    }
-
     /// Frames sent and not yet answered.
     fn in_flight(&self) -> u64 {
         match self.answered_up_to {

@@ -1,7 +1,8 @@
 //! `primm bench-service`: a latency benchmark of the tracking service that a benchmarker can
 //! run and keep. It starts `primm serve` (this executable), sends a scene of `--objects`
 //! objects on lanes at `--rate-hz` for `--duration-s`, each frame stamped with its scheduled
-//! send time, and reads the answers as they come. It leaves in `--latency-out DIR`:
+//! send time, and reads the answers as they come (polling every 100 µs between sends). It
+//! leaves in `--latency-out DIR`:
 //!
 //! - the tracker's files (`primm serve --latency-out`): per stage `STAGE.hlog`, `STAGE.hgrm`,
 //!   and `tracker.svg`;
@@ -216,7 +217,7 @@ impl TrackerProcess {
         command
             .args(["serve", "--service-prefix", prefix, "--latency-every", "100"])
             .args(settings.serve_arguments())
-            .env("RUST_LOG", std::env::var("RUST_LOG").unwrap_or_else(|_| "warn".to_owned()))
+            .env("RUST_LOG", std::env::var("RUST_LOG").unwrap_or_else(|_| "error".to_owned()))
             .stdout(Stdio::piped());
         if let Some((directory, interval_s)) = latency_out {
             command
