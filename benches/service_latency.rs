@@ -17,7 +17,15 @@
 //! Prints HdrHistogram percentiles and writes `benches/results/service_latency.md`; nothing is
 //! asserted.
 //!
-//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--inference-threads N] [--engine native|tract] [--latency-every 100] [--no-write]`
+//! With `--latency-out DIR`, each wait mode leaves its files in `DIR/MODE/`: the tracker's
+//! (`primm serve --latency-out`: per stage `.hlog`, `.hgrm`, `tracker.svg`) and this client's
+//! legs (`send_to_answer`, `send_to_tracker_receive`, `tracker_receive_to_publish`,
+//! `tracker_publish_to_answer`, `ipc_overhead`: `.hlog`, `.hgrm`, `client.svg`). Frames go one
+//! at a time, each after the previous answer, so these are service times without queueing: a
+//! stall delays the next send instead of showing in the tail (coordinated omission;
+//! `primm bench-service` sends on a schedule and corrects for it).
+//!
+//! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--inference-threads N] [--engine native|tract] [--latency-every 100] [--latency-out DIR] [--no-write]`
 //!
 //! `--model FILE` runs the tracker with that PR model instead of the built-in one, and
 //! `--inference-threads N` with that many inference threads instead of the configuration's (to
@@ -29,9 +37,20 @@ mod common;
 use common::service::{spawn_serve, unique_prefix, TestClient};
 use hdrhistogram::Histogram;
 use primm_service::clock::monotonic_ns;
+use primm_service::latency_files::{LatencyFiles, StageDescription};
 use primm_service::ServiceNames;
 use std::fmt::Write as _;
+use std::path::Path;
 use std::time::Duration;
+
+/// File names of the legs (`--latency-out`).
+const LEG_FILES: [&str; 5] = [
+    "send_to_answer",
+    "send_to_tracker_receive",
+    "tracker_receive_to_publish",
+    "tracker_publish_to_answer",
+    "ipc_overhead",
+];
 
 const LEGS: [&str; 5] = [
     "send -> answer",
@@ -50,6 +69,7 @@ fn measure(
     model: Option<&str>,
     inference_threads: Option<&str>,
     engine: Option<&str>,
+    latency_out: Option<&Path>,
 ) -> Vec<Histogram<u64>> {
     let prefix = unique_prefix(&format!("bench-{mode}"));
     let client = TestClient::new(&ServiceNames::new(&prefix));
@@ -67,12 +87,30 @@ fn measure(
     if let Some(engine) = engine {
         extra.extend(["--engine", engine]);
     }
+    let directory = latency_out.map(|directory| directory.join(mode));
+    let directory_text = directory.as_ref().map(|directory| directory.display().to_string());
+    if let Some(directory) = &directory_text {
+        extra.extend(["--latency-out", directory.as_str()]);
+    }
     let serve = spawn_serve(&prefix, &extra);
     client.wait_for_tracker(Duration::from_secs(60));
     let scene = common::scene_frames(&common::lanes(objects), 500, 0.05, 0.2, 11);
     let mut histograms: Vec<Histogram<u64>> =
         LEGS.iter().map(|_| Histogram::<u64>::new_with_bounds(1, 60_000_000_000, 3).unwrap()).collect();
     let warm_up = 500;
+    let mut files = directory.as_ref().map(|directory| {
+        let stages: Vec<StageDescription> =
+            LEGS.iter().zip(LEG_FILES).map(|(leg, file)| StageDescription::new(file, *leg)).collect();
+        LatencyFiles::create(
+            directory,
+            "client",
+            &stages,
+            &histograms[0],
+            Duration::from_secs(1),
+            monotonic_ns(),
+        )
+        .expect("the latency files can be created")
+    });
     let mut frame = scene[0].clone();
     for k in 0..warm_up + frames {
         let source = &scene[k % scene.len()];
@@ -105,7 +143,22 @@ fn measure(
             for (histogram, value) in histograms.iter_mut().zip(values) {
                 histogram.saturating_record(value.max(1));
             }
+            if let Some(files) = &mut files {
+                files
+                    .write_due(received_ns, |index| &histograms[index])
+                    .expect("the latency files can be written");
+            }
         }
+    }
+    if let Some(files) = files {
+        let written = files
+            .finish(monotonic_ns(), |index| &histograms[index])
+            .expect("the latency files can be written");
+        eprintln!(
+            "{mode}: wrote {} latency files in {}",
+            written.len(),
+            directory.as_ref().unwrap().display()
+        );
     }
     serve.signal(libc::SIGINT);
     let (_, stdout) = serve.wait(Duration::from_secs(10));
@@ -133,6 +186,7 @@ fn main() {
     let model = argument("--model");
     let inference_threads = argument("--inference-threads");
     let engine = argument("--engine");
+    let latency_out = argument("--latency-out").map(std::path::PathBuf::from);
     let us = |h: &Histogram<u64>, q: f64| h.value_at_quantile(q) as f64 / 1000.0;
     let mut table = String::new();
     writeln!(table, "| wait mode | leg | frames | p50 µs | p90 µs | p99 µs | p99.9 µs | max µs |").unwrap();
@@ -147,6 +201,7 @@ fn main() {
             model.as_deref(),
             inference_threads.as_deref(),
             engine.as_deref(),
+            latency_out.as_deref(),
         );
         for (leg, h) in LEGS.iter().zip(&histograms) {
             writeln!(

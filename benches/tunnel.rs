@@ -15,7 +15,7 @@
 //!
 //! A track frame is written as the tracker would leave it for `--objects` tracks (header and
 //! count; the slots' contents do not change what crosses: every sample crosses whole, 94 272
-//! bytes, as a measurement frame crosses as 16 448 bytes whatever its count).
+//! bytes, as a measurement frame crosses as 16 456 bytes whatever its count).
 //!
 //! `cargo bench --features tunnel --bench tunnel [-- --objects 64] [--seconds 5] [--latency-seconds 20] [--start-hz 100] [--steps 4] [--paths local,tunnel] [--streams measurements,tracks]`
 

@@ -33,6 +33,10 @@ enum Command {
     Score(cli::score::Args),
     /// Run the tracker over a long synthetic scene, checking it after every frame.
     Soak(cli::soak::Args),
+    /// Benchmark the tracking service: latency files, plots, a summary, the highest lossless rate.
+    BenchService(cli::bench_service::Args),
+    /// Plot HdrHistogram interval logs (.hlog) by percentile into one SVG to compare runs.
+    LatencyPlot(cli::latency_plot::Args),
     /// Relay the service's streams to other hosts through the iceoryx2 link tunnel over zenoh.
     #[cfg(feature = "tunnel")]
     Tunnel(cli::tunnel::Args),
@@ -68,6 +72,12 @@ enum CommandError {
     /// `primm soak` failed.
     #[error(transparent)]
     Soak(#[from] cli::soak::SoakError),
+    /// `primm bench-service` failed.
+    #[error(transparent)]
+    BenchService(#[from] cli::bench_service::BenchServiceError),
+    /// `primm latency-plot` failed.
+    #[error(transparent)]
+    LatencyPlot(#[from] cli::latency_plot::LatencyPlotError),
     /// `primm tunnel` failed.
     #[cfg(feature = "tunnel")]
     #[error(transparent)]
@@ -87,6 +97,8 @@ fn main() -> ExitCode {
         Command::Eval(args) => cli::eval::run(&args).map_err(Into::into),
         Command::Score(args) => cli::score::run(&args).map_err(Into::into),
         Command::Soak(args) => cli::soak::run(&args).map_err(Into::into),
+        Command::BenchService(args) => cli::bench_service::run(&args).map_err(Into::into),
+        Command::LatencyPlot(args) => cli::latency_plot::run(&args).map_err(Into::into),
         #[cfg(feature = "tunnel")]
         Command::Tunnel(args) => cli::tunnel::run(&args).map_err(Into::into),
     };

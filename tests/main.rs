@@ -33,6 +33,7 @@ mod imm_properties;
 mod imm_spread_of_means;
 mod inference_faults;
 mod late_frames;
+mod latency_files;
 mod learned_covariance;
 mod logging;
 mod motion_models;

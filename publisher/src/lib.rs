@@ -3,7 +3,8 @@
 //! Replays measurement CSV files, or a freshly generated scenario, onto `primm/measurements`
 //! as `primm::MeasurementFrame` samples written in place. The binary `primm-publisher` and the
 //! `primm publish` subcommand both run [`run`]; [`replay::Replayer`] is the loop itself, for
-//! programs that feed their own sequences.
+//! programs that feed their own sequences; [`load`] sends a scene at a fixed rate with every
+//! frame's scheduled send time and finds the highest rate a tracker sustains without loss.
 //!
 //! ```no_run
 //! use primm_publisher::replay::{Pacing, ReplayOptions, Replayer};
@@ -17,6 +18,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod load;
 pub mod replay;
 
 use crate::replay::{Pacing, ReplayError, ReplayOptions, Replayer};

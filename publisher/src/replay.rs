@@ -184,14 +184,27 @@ impl Replayer {
         self.next_sequence
     }
 
-    /// Sends one frame with the given `FRAME_FLAG_*` bits; returns its sequence number and how
-    /// many subscribers received it. Never waits: with safe overflow a full subscriber buffer
-    /// drops its oldest frame instead.
+    /// Sends one frame with the given `FRAME_FLAG_*` bits, without a schedule; returns its
+    /// sequence number and how many subscribers received it. Never waits: with safe overflow a
+    /// full subscriber buffer drops its oldest frame instead.
     pub fn send(
         &mut self,
         sequence_name: &str,
         frame: &RecordedFrame,
         flags: u32,
+    ) -> Result<SentFrame, ReplayError> {
+        self.send_scheduled(sequence_name, frame, flags, 0)
+    }
+
+    /// [`send`](Self::send) for a frame that was due at `scheduled_time_ns`
+    /// (`CLOCK_MONOTONIC`, ns; 0: no schedule), which the frame carries so that latencies can
+    /// be measured from the schedule too (corrected for coordinated omission).
+    pub fn send_scheduled(
+        &mut self,
+        sequence_name: &str,
+        frame: &RecordedFrame,
+        flags: u32,
+        scheduled_time_ns: u64,
     ) -> Result<SentFrame, ReplayError> {
         if frame.measurements.len() > MEASUREMENT_CAPACITY {
             return Err(ReplayError::TooManyMeasurements {
@@ -217,6 +230,7 @@ impl Replayer {
             source_frame: frame.index,
             sensor_timestamp_s: frame.timestamp_s,
             publish_time_ns: monotonic_ns(),
+            scheduled_time_ns,
             flags,
             ego: frame.ego_pose.map(|pose| (pose.x_m, pose.y_m, pose.yaw_rad)),
         });
@@ -233,14 +247,23 @@ impl Replayer {
 
     /// Reads the tracker's answers that arrived so far.
     fn collect_answers(&mut self) -> Result<(), ReplayError> {
-        let Some((subscriber, _)) = &self.answers else { return Ok(()) };
+        self.receive_answers(|_| {}).map(|_| ())
+    }
+
+    /// Hands every answer that arrived so far to `on_answer` (only with flow control, see
+    /// [`new`](Self::new)); returns how many.
+    pub fn receive_answers(&mut self, mut on_answer: impl FnMut(&TrackFrame)) -> Result<usize, ReplayError> {
+        let Some((subscriber, _)) = &self.answers else { return Ok(0) };
+        let mut received = 0;
         while let Some(answer) = subscriber.receive().map_err(ReplayError::Receive)? {
+            received += 1;
+            on_answer(&answer);
             let sequence = answer.input_sequence;
             if sequence < self.next_sequence {
                 self.answered_up_to = Some(self.answered_up_to.map_or(sequence, |up_to| up_to.max(sequence)));
             }
         }
-        Ok(())
+        Ok(received)
     }
 
     /// Frames sent and not yet answered.
@@ -312,14 +335,19 @@ impl Replayer {
             for (sequence_index, sequence) in sequences.iter().enumerate() {
                 let Some(first) = sequence.frames.first() else { continue };
                 let start = Instant::now();
+                let start_ns = monotonic_ns();
                 for (frame_index, frame) in sequence.frames.iter().enumerate() {
                     if shutdown.is_requested() {
                         summary.interrupted = true;
                         return Ok(summary);
                     }
+                    let mut scheduled_time_ns = 0;
                     if let Pacing::Recorded { speed } = options.pacing {
-                        let offset_s = ((frame.timestamp_s - first.timestamp_s) / speed).max(0.0);
-                        let due = start + Duration::from_secs_f64(offset_s);
+                        let offset = Duration::from_secs_f64(
+                            ((frame.timestamp_s - first.timestamp_s) / speed).clamp(0.0, 1.0e9),
+                        );
+                        let due = start + offset;
+                        scheduled_time_ns = start_ns.saturating_add(offset.as_nanos() as u64).max(1);
                         let now = Instant::now();
                         if due > now {
                             std::thread::sleep(due - now);
@@ -340,7 +368,7 @@ impl Replayer {
                     if last_of_replay || last_of_limit {
                         flags |= FRAME_FLAG_STREAM_END;
                     }
-                    match self.send(&sequence.name, frame, flags) {
+                    match self.send_scheduled(&sequence.name, frame, flags, scheduled_time_ns) {
                         Ok(sent) => {
                             summary.frames_sent += 1;
                             summary.measurements_sent += frame.measurements.len() as u64;

@@ -6,6 +6,7 @@
 //! otherwise this executable runs the same code as `primm publish` / `primm subscribe`, so
 //! `cargo run --release -- demo` works from a fresh checkout.
 
+use super::latency_out::LatencyOutArgs;
 use primm_core::mode::Method;
 use primm_publisher::DEFAULT_SCENARIO_SEED;
 use primm_service::catalog;
@@ -46,6 +47,10 @@ pub struct Args {
     /// by two `primm tunnel`s over zenoh on 127.0.0.1; needs the `tunnel` feature).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=2))]
     pub hosts: u8,
+    /// Latency files of the tracker and the subscriber (`--latency-out DIR`): `.hlog`, `.hgrm`
+    /// per stage, `tracker.svg` and `subscriber.svg`.
+    #[command(flatten)]
+    pub latency_files: LatencyOutArgs,
 }
 
 /// Why the demo failed.
@@ -271,8 +276,31 @@ pub fn run(args: Args) -> Result<(), DemoError> {
     if !complete {
         return Err(DemoError::Incomplete);
     }
+    print_latency_files(&args);
     println!("demo finished: every frame tracked and answered over shared memory");
     Ok(())
+}
+
+/// Says where the latency files are, with `--latency-out`.
+fn print_latency_files(args: &Args) {
+    if let Some(directory) = args.latency_files.directory() {
+        println!(
+            "latency files in {}: per stage STAGE.hlog (HdrHistogram interval log) and STAGE.hgrm (percentile \
+             distribution), values in µs; plots tracker.svg and subscriber.svg (latency by percentile); \
+             compare runs with `primm latency-plot DIR1/end_to_end.hlog DIR2/end_to_end.hlog --output FILE.svg`",
+            directory.display()
+        );
+    }
+}
+
+/// Passes `--latency-out DIR` on to a child.
+fn pass_latency_files(command: &mut Command, args: &Args) {
+    if let Some(directory) = args.latency_files.directory() {
+        command
+            .arg("--latency-out")
+            .arg(directory)
+            .args(["--latency-interval-s", &args.latency_files.latency_interval_s.to_string()]);
+    }
 }
 
 /// Runs `command` in the iceoryx2 domain `domain` (see [`catalog::ICEORYX2_DOMAIN_ENV`]), or in
@@ -307,6 +335,7 @@ fn spawn_tracker(
     if args.busy_poll {
         command.arg("--busy-poll");
     }
+    pass_latency_files(&mut command, args);
     quiet_logs(&mut command);
     Managed::spawn("the tracker (primm serve)", &mut command, stderr_path)
 }
@@ -330,6 +359,7 @@ fn spawn_subscriber(
     if args.busy_poll {
         command.arg("--busy-poll");
     }
+    pass_latency_files(&mut command, args);
     quiet_logs(&mut command);
     Managed::spawn("the subscriber", &mut command, stderr_path)
 }

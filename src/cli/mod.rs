@@ -2,9 +2,12 @@
 //! and its `run` function; `src/main.rs` only dispatches. `primm publish` and
 //! `primm subscribe` run the loops of the `primm-publisher` and `primm-subscriber` packages.
 
+pub mod bench_service;
 pub mod demo;
 pub mod eval;
 pub mod generate;
+pub mod latency_out;
+pub mod latency_plot;
 pub mod score;
 pub mod serve;
 pub mod soak;

@@ -1,5 +1,6 @@
 //! `primm serve`: the tracker as a shared-memory service.
 
+use super::latency_out::{print_files, LatencyOutArgs};
 use primm_config::ConfigError;
 use primm_core::config::{Config, InferenceEngine};
 use primm_core::mode::Method;
@@ -10,6 +11,7 @@ use primm_predictor::onnx::ModelError;
 use primm_predictor::split::{on_inference_threads, InferenceThreadsError, SplitPredictor};
 use primm_predictor::threaded::ThreadedPredictor;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
+use primm_service::latency_files::LatencyFilesError;
 use primm_service::{
     ConnectError, PublishTime, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService,
     WaitMode,
@@ -58,6 +60,9 @@ pub struct Args {
     /// step, and the learned mode sits the prediction out). See docs/integrating.md.
     #[arg(long, value_enum, default_value = "frame", value_name = "WHEN")]
     pub publish_time: PublishTimeArg,
+    /// Latency files (`--latency-out DIR`).
+    #[command(flatten)]
+    pub latency_files: LatencyOutArgs,
 }
 
 /// `--publish-time`.
@@ -106,6 +111,9 @@ pub enum ServeError {
     /// The tracking loop failed.
     #[error(transparent)]
     Loop(#[from] TrackingLoopError),
+    /// The latency files could not be written.
+    #[error(transparent)]
+    LatencyFiles(#[from] LatencyFilesError),
 }
 
 /// Runs the service until SIGINT or SIGTERM, then prints the counters and the latency table.
@@ -170,6 +178,9 @@ fn serve<P: DisplacementPredictor>(tracker: Tracker<P>, args: &Args) -> Result<(
     };
     let names = options.names.clone();
     let mut service = TrackingService::new(tracker, options)?;
+    if let Some(directory) = args.latency_files.directory() {
+        service.write_latency_files(directory, args.latency_files.interval())?;
+    }
     tracing::info!(
         method = %args.method,
         input = %names.measurements(),
@@ -180,7 +191,9 @@ fn serve<P: DisplacementPredictor>(tracker: Tracker<P>, args: &Args) -> Result<(
     );
     let result = service.run(&shutdown);
     println!("{}", service.summary());
+    let files = service.finish_latency_files();
     result?;
+    print_files("latency files", &files?);
     tracing::info!("tracker stopped");
     Ok(())
 }

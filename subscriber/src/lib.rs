@@ -38,7 +38,8 @@ use iceoryx2::waitset::{WaitSet, WaitSetAttachmentError, WaitSetCreateError, Wai
 use primm_core::measurement::ObjectClass;
 use primm_service::catalog::{self, Ipc, SERVICE_PREFIX_ENV};
 use primm_service::clock::monotonic_ns;
-use primm_service::latency::{format_table, summarise, MAX_TRACKABLE_NS};
+use primm_service::latency::{format_named_table, format_table, summarise, MAX_TRACKABLE_NS};
+use primm_service::latency_files::{LatencyFiles, LatencyFilesError, StageDescription};
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_wire::{
@@ -81,6 +82,24 @@ pub struct Args {
     /// Prefix of the service names (`PREFIX/primm/...`).
     #[arg(long, env = SERVICE_PREFIX_ENV, default_value = "")]
     pub service_prefix: String,
+    /// Write the subscriber's latencies (publisher_to_subscriber, its coordinated-omission
+    /// corrected twin, tracker_to_subscriber) into this directory: an HdrHistogram interval log
+    /// (`.hlog`) and percentile distribution (`.hgrm`) each, and the plot `subscriber.svg`.
+    #[arg(long, value_name = "DIR")]
+    pub latency_out: Option<PathBuf>,
+    /// Length of one interval of the `.hlog` files, s.
+    #[arg(long, default_value_t = 1.0, value_name = "S", value_parser = parse_positive_seconds)]
+    pub latency_interval_s: f64,
+}
+
+/// Parses a positive, finite number of seconds (at most a day).
+fn parse_positive_seconds(text: &str) -> Result<f64, String> {
+    let seconds: f64 = text.parse().map_err(|_| format!("`{text}` is not a number of seconds"))?;
+    if seconds.is_finite() && seconds > 0.0 && seconds <= 86_400.0 {
+        Ok(seconds)
+    } else {
+        Err(format!("`{text}`: the interval must be more than 0 and at most 86400 s"))
+    }
 }
 
 /// Why the subscriber failed.
@@ -104,6 +123,9 @@ pub enum SubscribeError {
     /// Receiving a sample failed.
     #[error("cannot receive: {0}")]
     Receive(ReceiveError),
+    /// The latency files could not be written.
+    #[error(transparent)]
+    LatencyFiles(#[from] LatencyFilesError),
     /// The CSV or JSON output could not be written.
     #[error("cannot write {path}: {source}")]
     Output {
@@ -176,6 +198,10 @@ pub struct SubscriberSummary {
     /// From the publisher's send of the measurement frame to this subscriber's receive of the
     /// answer.
     pub end_to_end_latency: Option<LatencyRow>,
+    /// From the time the publisher was due to send the measurement frame (its schedule) to this
+    /// subscriber's receive of the answer: the end-to-end latency corrected for coordinated
+    /// omission (equal to it for frames sent without a schedule).
+    pub end_to_end_corrected_latency: Option<LatencyRow>,
     /// The tracker's last latency report.
     pub tracker_latency: Vec<LatencyRow>,
     /// Frames the tracker received, per its last report.
@@ -184,6 +210,8 @@ pub struct SubscriberSummary {
     pub tracker_frames_rejected: u64,
     /// Measurements the tracker rejected, per its last report.
     pub tracker_measurements_rejected: u64,
+    /// The latency files written (`--latency-out`).
+    pub latency_files: Vec<PathBuf>,
 }
 
 impl SubscriberSummary {
@@ -211,9 +239,10 @@ impl SubscriberSummary {
                 accuracy.idf1.map_or_else(|| "n/a".to_owned(), |v| format!("{v:.3}"))
             );
         }
-        let mut rows: Vec<StageLatency> = Vec::new();
+        let mut rows: Vec<(&str, StageLatency)> = Vec::new();
         for (row, name) in [
             (&self.end_to_end_latency, "publisher_to_subscriber"),
+            (&self.end_to_end_corrected_latency, "publisher_to_subscriber_corrected"),
             (&self.delivery_latency, "tracker_to_subscriber"),
         ] {
             if let Some(row) = row {
@@ -225,12 +254,12 @@ impl SubscriberSummary {
                 stage.p999_ns = row.p999_ns;
                 stage.max_ns = row.max_ns;
                 stage.mean_ns = row.mean_ns;
-                rows.push(stage);
+                rows.push((name, stage));
             }
         }
         if !rows.is_empty() {
             text += "latency seen by the subscriber:\n";
-            text += &format_table(&rows);
+            text += &format_named_table(rows.iter().map(|(name, stage)| (*name, stage)));
         }
         if !self.tracker_latency.is_empty() {
             let stages: Vec<StageLatency> = self
@@ -261,8 +290,9 @@ struct Viewer {
     summary: SubscriberSummary,
     accuracy: Option<AccuracyMonitor>,
     csv: Option<CsvOutput>,
-    delivery: Histogram<u64>,
-    end_to_end: Histogram<u64>,
+    /// Indexed by [`SubscriberLatency`].
+    latencies: [Histogram<u64>; SubscriberLatency::COUNT],
+    files: Option<LatencyFiles>,
     last_sequence: Option<u64>,
     last_report: Option<LatencyReport>,
     live: bool,
@@ -276,8 +306,8 @@ impl Viewer {
             summary: SubscriberSummary::default(),
             accuracy: truth.then(AccuracyMonitor::new),
             csv,
-            delivery: histogram(),
-            end_to_end: histogram(),
+            latencies: std::array::from_fn(|_| histogram()),
+            files: None,
             last_sequence: None,
             last_report: None,
             live: !args.quiet && std::io::stdout().is_terminal(),
@@ -328,10 +358,27 @@ impl Viewer {
         summary.confirmed_tracks_last_frame =
             frame.valid_tracks().iter().filter(|t| t.status == 1).count() as u64;
         if frame.publish_time_ns != 0 && now_ns >= frame.publish_time_ns {
-            self.delivery.saturating_record(now_ns - frame.publish_time_ns);
+            self.latencies[SubscriberLatency::TrackerToSubscriber as usize]
+                .saturating_record(now_ns - frame.publish_time_ns);
         }
         if frame.input_publish_time_ns != 0 && now_ns >= frame.input_publish_time_ns {
-            self.end_to_end.saturating_record(now_ns - frame.input_publish_time_ns);
+            self.latencies[SubscriberLatency::PublisherToSubscriber as usize]
+                .saturating_record(now_ns - frame.input_publish_time_ns);
+            let due_ns = match frame.input_scheduled_time_ns {
+                0 => frame.input_publish_time_ns,
+                scheduled => scheduled,
+            };
+            if now_ns >= due_ns {
+                self.latencies[SubscriberLatency::PublisherToSubscriberCorrected as usize]
+                    .saturating_record(now_ns - due_ns);
+            }
+        }
+        if let Some(files) = &mut self.files {
+            let latencies = &self.latencies;
+            if let Err(error) = files.write_due(now_ns, |index| &latencies[index]) {
+                tracing::warn!(%error, "cannot write the latency files; no more intervals are written");
+                self.files = None;
+            }
         }
         if let Some(accuracy) = &mut self.accuracy {
             accuracy.add_tracks(frame);
@@ -407,10 +454,20 @@ impl Viewer {
         }
         let mut summary = self.summary;
         summary.accuracy = self.accuracy.as_mut().map(AccuracyMonitor::summary);
-        summary.delivery_latency = (!self.delivery.is_empty())
-            .then(|| LatencyRow::from(&summarise("tracker_to_subscriber", &self.delivery)));
-        summary.end_to_end_latency = (!self.end_to_end.is_empty())
-            .then(|| LatencyRow::from(&summarise("publisher_to_subscriber", &self.end_to_end)));
+        let row = |latency: SubscriberLatency| {
+            let histogram = &self.latencies[latency as usize];
+            (!histogram.is_empty()).then(|| LatencyRow {
+                name: latency.name().to_owned(),
+                ..LatencyRow::from(&summarise(latency.name(), histogram))
+            })
+        };
+        summary.delivery_latency = row(SubscriberLatency::TrackerToSubscriber);
+        summary.end_to_end_latency = row(SubscriberLatency::PublisherToSubscriber);
+        summary.end_to_end_corrected_latency = row(SubscriberLatency::PublisherToSubscriberCorrected);
+        if let Some(files) = self.files.take() {
+            let latencies = &self.latencies;
+            summary.latency_files = files.finish(monotonic_ns(), |index| &latencies[index])?;
+        }
         if let Some(report) = &self.last_report {
             summary.tracker_latency = report.valid_stages().iter().map(LatencyRow::from).collect();
             summary.tracker_frames_received = report.frames_received;
@@ -418,6 +475,38 @@ impl Viewer {
             summary.tracker_measurements_rejected = report.measurements_rejected;
         }
         Ok(summary)
+    }
+}
+
+/// The latencies the subscriber measures, in the order of its histograms and files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SubscriberLatency {
+    PublisherToSubscriber = 0,
+    PublisherToSubscriberCorrected = 1,
+    TrackerToSubscriber = 2,
+}
+
+impl SubscriberLatency {
+    const COUNT: usize = 3;
+    const ALL: [SubscriberLatency; Self::COUNT] =
+        [Self::PublisherToSubscriber, Self::PublisherToSubscriberCorrected, Self::TrackerToSubscriber];
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::PublisherToSubscriber => "publisher_to_subscriber",
+            Self::PublisherToSubscriberCorrected => "publisher_to_subscriber_corrected",
+            Self::TrackerToSubscriber => "tracker_to_subscriber",
+        }
+    }
+
+    fn description(self) -> &'static str {
+        match self {
+            Self::PublisherToSubscriber => "publisher send of the measurement frame to subscriber receive of its answer",
+            Self::PublisherToSubscriberCorrected => {
+                "corrected for coordinated omission: publisher's scheduled send time of the measurement frame to subscriber receive of its answer"
+            }
+            Self::TrackerToSubscriber => "tracker send of the track frame to subscriber receive",
+        }
     }
 }
 
@@ -429,6 +518,12 @@ fn histogram() -> Histogram<u64> {
 pub fn run(args: Args) -> Result<(), SubscribeError> {
     let summary = subscribe(&args)?;
     print!("{}", summary.text());
+    if !summary.latency_files.is_empty() {
+        println!("latency files:");
+        for file in &summary.latency_files {
+            println!("  {}", file.display());
+        }
+    }
     if let Some(path) = &args.json {
         let json = serde_json::to_string_pretty(&summary).expect("the summary serialises");
         std::fs::write(path, json).map_err(|source| SubscribeError::Output { path: path.clone(), source })?;
@@ -444,6 +539,20 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
     let ports = Ports::open(&node, &names, !args.no_truth)?;
     tracing::info!(service = %names.tracks(), "subscribed");
     let mut viewer = Viewer::new(args, ports.truth.is_some(), open_csv(args)?);
+    if let Some(directory) = &args.latency_out {
+        let stages: Vec<StageDescription> = SubscriberLatency::ALL
+            .iter()
+            .map(|latency| StageDescription::new(latency.name(), latency.description()))
+            .collect();
+        viewer.files = Some(LatencyFiles::create(
+            directory,
+            "subscriber",
+            &stages,
+            &histogram(),
+            Duration::from_secs_f64(args.latency_interval_s),
+            monotonic_ns(),
+        )?);
+    }
     let waitset = WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<Ipc>()

@@ -63,6 +63,7 @@ mod tests {
             sensor_timestamp_s: timestamp_s,
             tracks_timestamp_s: timestamp_s,
             input_publish_time_ns: 0,
+            input_scheduled_time_ns: 0,
             receive_time_ns: 0,
             publish_time_ns: 0,
             status,

@@ -21,12 +21,24 @@ pub fn unique_prefix(test: &str) -> String {
     format!("primm-test-{test}-{}-{}", std::process::id(), monotonic_ns())
 }
 
-/// Writes an owned frame into a loaned sample's payload.
+/// Writes an owned frame into a loaned sample's payload (sent without a schedule).
 pub fn write_frame(
     slot: &mut std::mem::MaybeUninit<MeasurementFrame>,
     frame: &Frame,
     sequence: u64,
     flags: u32,
+) {
+    write_scheduled_frame(slot, frame, sequence, flags, 0);
+}
+
+/// Writes an owned frame into a loaned sample's payload, stamped with the time it was due to
+/// be sent (`CLOCK_MONOTONIC` ns; 0: no schedule).
+pub fn write_scheduled_frame(
+    slot: &mut std::mem::MaybeUninit<MeasurementFrame>,
+    frame: &Frame,
+    sequence: u64,
+    flags: u32,
+    scheduled_time_ns: u64,
 ) {
     let mut writer = MeasurementFrameWriter::new(slot);
     for measurement in &frame.measurements {
@@ -37,6 +49,7 @@ pub fn write_frame(
         source_frame: sequence,
         sensor_timestamp_s: frame.timestamp_s,
         publish_time_ns: monotonic_ns(),
+        scheduled_time_ns,
         flags,
         ego: None,
     });
@@ -97,8 +110,13 @@ impl TestClient {
 
     /// Sends `frame` with `sequence` and `flags`.
     pub fn send(&self, frame: &Frame, sequence: u64, flags: u32) {
+        self.send_scheduled(frame, sequence, flags, 0);
+    }
+
+    /// Sends a frame that was due at `scheduled_time_ns` (`CLOCK_MONOTONIC`; 0: no schedule).
+    pub fn send_scheduled(&self, frame: &Frame, sequence: u64, flags: u32, scheduled_time_ns: u64) {
         let mut loan = self.publisher.loan_uninit().unwrap();
-        write_frame(loan.payload_mut(), frame, sequence, flags);
+        write_scheduled_frame(loan.payload_mut(), frame, sequence, flags, scheduled_time_ns);
         // SAFETY: header and measurements written; the rest is plain data in shared memory.
         let sample = unsafe { loan.assume_init() };
         sample.send().unwrap();

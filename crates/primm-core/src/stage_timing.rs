@@ -33,11 +33,17 @@ pub enum Stage {
     /// Host: from the publisher's send of the input frame to the tracker's send of its track
     /// frame (same host, `CLOCK_MONOTONIC`).
     EndToEnd = 8,
+    /// Host: [`EndToEnd`](Self::EndToEnd) corrected for coordinated omission: from the time
+    /// the publisher was due to send the input frame (its schedule) to the tracker's send of
+    /// the track frame. A publisher that falls behind its schedule (a stall anywhere upstream,
+    /// or flow control holding it back) sends late, which the uncorrected latency does not see;
+    /// this one does. Equal to `EndToEnd` for frames sent without a schedule.
+    EndToEndCorrected = 9,
 }
 
 impl Stage {
     /// Number of stages.
-    pub const COUNT: usize = 9;
+    pub const COUNT: usize = 10;
     /// All stages in report order.
     pub const ALL: [Stage; Stage::COUNT] = [
         Stage::Validate,
@@ -49,6 +55,7 @@ impl Stage {
         Stage::Publish,
         Stage::ReceiveToPublish,
         Stage::EndToEnd,
+        Stage::EndToEndCorrected,
     ];
     /// Number of stages of one tracker step.
     pub const TRACKER_COUNT: usize = 6;
@@ -63,7 +70,7 @@ impl Stage {
     }
 
     /// Short name used in reports (`validate`, `predict`, `learned_wait`, `associate`, `update`,
-    /// `report`, `publish`, `receive_to_publish`, `end_to_end`).
+    /// `report`, `publish`, `receive_to_publish`, `end_to_end`, `end_to_end_corrected`).
     pub fn name(self) -> &'static str {
         match self {
             Stage::Validate => "validate",
@@ -75,6 +82,25 @@ impl Stage {
             Stage::Publish => "publish",
             Stage::ReceiveToPublish => "receive_to_publish",
             Stage::EndToEnd => "end_to_end",
+            Stage::EndToEndCorrected => "end_to_end_corrected",
+        }
+    }
+
+    /// What the stage measures, one line (for the comments of latency files).
+    pub fn description(self) -> &'static str {
+        match self {
+            Stage::Validate => "tracker: frame and measurement validation",
+            Stage::Predict => "tracker: learned-predictor batch submitted, IMM mixing, CV/CA/CT predictions",
+            Stage::LearnedWait => "tracker: wait for the learned displacements and PR prior fusion",
+            Stage::Associate => "tracker: gated association",
+            Stage::Update => "tracker: Kalman and mode updates, track management",
+            Stage::Report => "tracker: track output written",
+            Stage::Publish => "host: track frame sent and listeners notified",
+            Stage::ReceiveToPublish => "host: input sample taken to track frame sent",
+            Stage::EndToEnd => "publisher send of the input frame to tracker send of its track frame",
+            Stage::EndToEndCorrected => {
+                "corrected for coordinated omission: publisher's scheduled send time of the input frame to tracker send of its track frame"
+            }
         }
     }
 }

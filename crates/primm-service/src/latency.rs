@@ -102,18 +102,26 @@ pub fn summarise(name: &str, histogram: &Histogram<u64>) -> StageLatency {
 
 /// A fixed-width table (µs) of stage percentiles; stages without samples are left out.
 pub fn format_table(rows: &[StageLatency]) -> String {
+    format_named_table(rows.iter().map(|row| (row.name_str(), row)))
+}
+
+/// [`format_table`] with each row's name given beside it (for names longer than a
+/// [`StageLatency`] holds).
+pub fn format_named_table<'a>(rows: impl IntoIterator<Item = (&'a str, &'a StageLatency)>) -> String {
+    let rows: Vec<(&str, &StageLatency)> = rows.into_iter().filter(|(_, row)| row.count > 0).collect();
+    let width = rows.iter().map(|(name, _)| name.chars().count()).max().unwrap_or(0).max(24);
     let us = |ns: u64| ns as f64 / 1000.0;
     let mut table = String::new();
     let _ = writeln!(
         table,
-        "{:<24} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}",
+        "{:<width$} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>10}",
         "stage", "count", "p50 µs", "p90 µs", "p99 µs", "p99.9 µs", "max µs", "mean µs"
     );
-    for row in rows.iter().filter(|row| row.count > 0) {
+    for (name, row) in rows {
         let _ = writeln!(
             table,
-            "{:<24} {:>9} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
-            row.name_str(),
+            "{:<width$} {:>9} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1} {:>10.1}",
+            name,
             row.count,
             us(row.p50_ns),
             us(row.p90_ns),

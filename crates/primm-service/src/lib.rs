@@ -10,6 +10,9 @@
 //! - [`tracking`]: the tracking loop.
 //! - [`frame_step`]: one received frame through the tracker, as the loop does it.
 //! - [`latency`]: latency histograms, reports and tables.
+//! - [`latency_files`]: the histograms as HdrHistogram interval logs (`.hlog`) and percentile
+//!   distributions (`.hgrm`) in a directory (`--latency-out`).
+//! - [`latency_plot`]: latency-by-percentile plots (SVG).
 //! - [`clock`]: the monotonic clock the latencies are measured with.
 //! - [`shutdown`]: SIGINT/SIGTERM handling.
 //! - [`log_limit`]: bounded logging of repeated faults.
@@ -40,6 +43,8 @@ pub mod catalog;
 pub mod clock;
 pub mod frame_step;
 pub mod latency;
+pub mod latency_files;
+pub mod latency_plot;
 pub mod log_limit;
 pub mod logging;
 pub mod shutdown;

@@ -20,6 +20,7 @@ use super::catalog::{self, ConnectError, Ipc, ServiceNames};
 use super::clock::monotonic_ns;
 use super::frame_step::{starts_stream, step_received_frame};
 use super::latency::{LatencyHistograms, StageTimer};
+use super::latency_files::{LatencyFiles, LatencyFilesError, StageDescription};
 use super::log_limit::LogLimiter;
 use super::shutdown::ShutdownFlag;
 use iceoryx2::identifiers::UniquePublisherId;
@@ -43,6 +44,7 @@ use primm_wire::{
     TRACK_FLAG_SEQUENCE_GAP, TRACK_FLAG_STREAM_END, TRACK_FLAG_TRACKER_RESET,
 };
 use std::mem::MaybeUninit;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// How the tracking loop waits for measurement frames.
@@ -126,6 +128,8 @@ pub struct ServiceCounters {
     pub latency_report_failures: u64,
     /// Latency reports sent.
     pub latency_reports: u64,
+    /// Failures to write the latency files (after the first, no more intervals are written).
+    pub latency_file_failures: u64,
 }
 
 impl ServiceCounters {
@@ -185,6 +189,7 @@ pub struct TrackingService<P: DisplacementPredictor> {
     /// Room for every track predicted to the publish time ([`PublishTime::Now`]), allocated
     /// once.
     predicted: Box<[TrackOutput]>,
+    latency_files: Option<LatencyFiles>,
     counters: ServiceCounters,
     stream: StreamState,
     logs: LogLimits,
@@ -214,6 +219,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             tracker,
             histograms: LatencyHistograms::new(),
             predicted: vec![TrackOutput::default(); primm_core::track_table::MAX_TRACKS].into_boxed_slice(),
+            latency_files: None,
             counters: ServiceCounters::default(),
             stream: StreamState::default(),
             logs: LogLimits::default(),
@@ -302,8 +308,14 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             // the zeroes the OS mapped), and every field of `WireTrack` is a plain integer or
             // float for which any bit pattern is a valid value.
             self.send_track_frame(unsafe { loan.assume_init() });
-            self.record_publish_latencies(receive_ns, publish_start, header.input_publish_time_ns);
+            self.record_publish_latencies(
+                receive_ns,
+                publish_start,
+                header.input_publish_time_ns,
+                header.input_scheduled_time_ns,
+            );
         }
+        self.write_latency_interval();
 
         let interval = self.options.latency_report_interval_frames;
         if interval > 0 && self.counters.frames_received % interval == 0 {
@@ -431,14 +443,75 @@ impl<P: DisplacementPredictor> TrackingService<P> {
 
     /// Records the host's stages of an answer sent now: [`Stage::Publish`] from `publish_start`,
     /// [`Stage::ReceiveToPublish`] from `receive_ns`, and [`Stage::EndToEnd`] from the input's
-    /// publish time to `publish_start` (when the publisher stamped one that is not later).
-    fn record_publish_latencies(&mut self, receive_ns: u64, publish_start: u64, input_publish_time_ns: u64) {
+    /// publish time to `publish_start` (when the publisher stamped one that is not later), and
+    /// [`Stage::EndToEndCorrected`] from the input's scheduled send time (its publish time when
+    /// it was sent without a schedule).
+    fn record_publish_latencies(
+        &mut self,
+        receive_ns: u64,
+        publish_start: u64,
+        input_publish_time_ns: u64,
+        input_scheduled_time_ns: u64,
+    ) {
         let done_ns = monotonic_ns();
         self.histograms.record(Stage::Publish, done_ns.saturating_sub(publish_start));
         self.histograms.record(Stage::ReceiveToPublish, done_ns.saturating_sub(receive_ns));
         if input_publish_time_ns != 0 && input_publish_time_ns <= publish_start {
             self.histograms.record(Stage::EndToEnd, publish_start - input_publish_time_ns);
+            let due_ns =
+                if input_scheduled_time_ns != 0 { input_scheduled_time_ns } else { input_publish_time_ns };
+            if due_ns <= publish_start {
+                self.histograms.record(Stage::EndToEndCorrected, publish_start - due_ns);
+            }
         }
+    }
+
+    /// Writes every stage's histogram into interval logs and, at
+    /// [`finish_latency_files`](Self::finish_latency_files), percentile distributions and a
+    /// plot, in `directory` (see [`latency_files`](super::latency_files)); an interval ends
+    /// every `interval`. The files are written on the tracking thread after a frame's answer
+    /// has been sent, once per interval.
+    pub fn write_latency_files(
+        &mut self,
+        directory: &Path,
+        interval: Duration,
+    ) -> Result<(), LatencyFilesError> {
+        let stages: Vec<StageDescription> =
+            Stage::ALL.iter().map(|stage| StageDescription::new(stage.name(), stage.description())).collect();
+        let files = LatencyFiles::create(
+            directory,
+            "tracker",
+            &stages,
+            self.histograms.histogram(Stage::Validate),
+            interval,
+            monotonic_ns(),
+        )?;
+        self.latency_files = Some(files);
+        Ok(())
+    }
+
+    /// Appends an interval to the latency files if one has ended; a failure is counted and
+    /// logged, and the files are given up.
+    fn write_latency_interval(&mut self) {
+        let Some(files) = &mut self.latency_files else { return };
+        let now_ns = monotonic_ns();
+        if !files.due(now_ns) {
+            return;
+        }
+        let histograms = &self.histograms;
+        if let Err(error) = files.write_due(now_ns, |index| histograms.histogram(Stage::ALL[index])) {
+            self.counters.latency_file_failures += 1;
+            tracing::warn!(%error, "cannot write the latency files; no more intervals are written");
+            self.latency_files = None;
+        }
+    }
+
+    /// Writes the last interval, the percentile distributions and the plot of the latency files
+    /// (if [`write_latency_files`](Self::write_latency_files) was called); returns the files.
+    pub fn finish_latency_files(&mut self) -> Result<Vec<PathBuf>, LatencyFilesError> {
+        let Some(files) = self.latency_files.take() else { return Ok(Vec::new()) };
+        let histograms = &self.histograms;
+        files.finish(monotonic_ns(), |index| histograms.histogram(Stage::ALL[index]))
     }
 
     /// Resets the tracker when a new stream or publisher starts; counts sequence gaps. Returns
@@ -610,6 +683,7 @@ fn track_frame_header(
         sensor_timestamp_s: frame.sensor_timestamp_s,
         tracks_timestamp_s: frame.sensor_timestamp_s,
         input_publish_time_ns: frame.publish_time_ns,
+        input_scheduled_time_ns: frame.scheduled_time_ns,
         receive_time_ns: receive_ns,
         publish_time_ns: 0,
         status,

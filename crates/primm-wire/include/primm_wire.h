@@ -67,12 +67,13 @@ typedef struct primm_wire_measurement {
     uint8_t _pad0[4];
 } primm_wire_measurement;
 
-/* "primm::MeasurementFrame": 16448 bytes. count is not trusted by the tracker. */
+/* "primm::MeasurementFrame": 16456 bytes. count is not trusted by the tracker. */
 typedef struct primm_measurement_frame {
     uint64_t sequence;
     uint64_t source_frame;
     double sensor_timestamp_s;
     uint64_t publish_time_ns;
+    uint64_t scheduled_time_ns; /* when the publisher was due to send it; 0: no schedule */
     double ego_x_m;
     double ego_y_m;
     double ego_yaw_rad;
@@ -113,13 +114,14 @@ typedef struct primm_wire_track {
     uint8_t _pad0[4];
 } primm_wire_track;
 
-/* "primm::TrackFrame": 217160 bytes. */
+/* "primm::TrackFrame": 217168 bytes. */
 typedef struct primm_track_frame {
     uint64_t input_sequence;
     uint64_t source_frame;
     double sensor_timestamp_s;
     double tracks_timestamp_s; /* the time the tracks describe (see the flags) */
     uint64_t input_publish_time_ns;
+    uint64_t input_scheduled_time_ns;
     uint64_t receive_time_ns;
     uint64_t publish_time_ns;
     uint32_t count;

@@ -77,13 +77,14 @@ class WireMeasurement(ctypes.Structure):
 
 
 class MeasurementFrame(ctypes.Structure):
-    """One radar frame (16448 bytes)."""
+    """One radar frame (16456 bytes)."""
 
     _fields_ = [
         ("sequence", ctypes.c_uint64),
         ("source_frame", ctypes.c_uint64),
         ("sensor_timestamp_s", ctypes.c_double),
         ("publish_time_ns", ctypes.c_uint64),
+        ("scheduled_time_ns", ctypes.c_uint64),
         ("ego_x_m", ctypes.c_double),
         ("ego_y_m", ctypes.c_double),
         ("ego_yaw_rad", ctypes.c_double),
@@ -135,7 +136,7 @@ class WireTrack(ctypes.Structure):
 
 
 class TrackFrame(ctypes.Structure):
-    """The tracker's answer to one measurement frame (217160 bytes)."""
+    """The tracker's answer to one measurement frame (217168 bytes)."""
 
     _fields_ = [
         ("input_sequence", ctypes.c_uint64),
@@ -143,6 +144,7 @@ class TrackFrame(ctypes.Structure):
         ("sensor_timestamp_s", ctypes.c_double),
         ("tracks_timestamp_s", ctypes.c_double),
         ("input_publish_time_ns", ctypes.c_uint64),
+        ("input_scheduled_time_ns", ctypes.c_uint64),
         ("receive_time_ns", ctypes.c_uint64),
         ("publish_time_ns", ctypes.c_uint64),
         ("count", ctypes.c_uint32),

@@ -60,7 +60,8 @@
 /// its `existence_probability` and the status code 2 (coasting); version 4 the 4×4
 /// position–velocity covariances (in place of the 2×2 position covariance) and `age_s` of
 /// [`WireTrack`], [`TrackFrame::tracks_timestamp_s`], the flags for late frames and predicted
-/// tracks, and [`FrameStatus::RejectedTooLate`]. (iceoryx2
+/// tracks, [`FrameStatus::RejectedTooLate`], and the publisher's schedule
+/// (`MeasurementFrame::scheduled_time_ns`, `TrackFrame::input_scheduled_time_ns`). (iceoryx2
 /// also refuses to connect a publisher and a subscriber whose payload sizes differ.)
 pub const WIRE_VERSION: u16 = 4;
 

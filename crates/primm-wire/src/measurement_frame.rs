@@ -99,7 +99,7 @@ impl WireMeasurement {
     }
 }
 
-/// One radar frame: 16 448 bytes, alignment 8.
+/// One radar frame: 16 456 bytes, alignment 8.
 ///
 /// `count` comes from another process and is not trusted: [`FrameView::len`] reports it as it
 /// is, so that a frame claiming more than [`MEASUREMENT_CAPACITY`] measurements is rejected by
@@ -118,6 +118,10 @@ pub struct MeasurementFrame {
     pub sensor_timestamp_s: f64,
     /// `CLOCK_MONOTONIC` time at which the publisher sent the frame, ns (0 if unknown).
     pub publish_time_ns: u64,
+    /// `CLOCK_MONOTONIC` time at which the publisher was due to send the frame by its schedule
+    /// (its pacing), ns; 0 when it sends without a schedule. A publisher that falls behind sends
+    /// after this time; latencies measured from it are corrected for coordinated omission.
+    pub scheduled_time_ns: u64,
     /// Ego vehicle position in the world frame, m (valid with [`FRAME_FLAG_EGO_VALID`]).
     pub ego_x_m: f64,
     /// Ego vehicle position in the world frame, m (valid with [`FRAME_FLAG_EGO_VALID`]).
@@ -242,6 +246,7 @@ impl<'a> MeasurementFrameWriter<'a> {
             addr_of_mut!((*frame).source_frame).write(header.source_frame);
             addr_of_mut!((*frame).sensor_timestamp_s).write(header.sensor_timestamp_s);
             addr_of_mut!((*frame).publish_time_ns).write(header.publish_time_ns);
+            addr_of_mut!((*frame).scheduled_time_ns).write(header.scheduled_time_ns);
             addr_of_mut!((*frame).ego_x_m).write(ego_x_m);
             addr_of_mut!((*frame).ego_y_m).write(ego_y_m);
             addr_of_mut!((*frame).ego_yaw_rad).write(ego_yaw_rad);
@@ -263,6 +268,8 @@ pub struct MeasurementFrameHeader {
     pub sensor_timestamp_s: f64,
     /// See [`MeasurementFrame::publish_time_ns`].
     pub publish_time_ns: u64,
+    /// See [`MeasurementFrame::scheduled_time_ns`].
+    pub scheduled_time_ns: u64,
     /// `FRAME_FLAG_*` bits; [`FRAME_FLAG_EGO_VALID`] follows `ego`.
     pub flags: u32,
     /// Ego pose `(x_m, y_m, yaw_rad)`, if known.

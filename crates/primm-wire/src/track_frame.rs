@@ -259,7 +259,7 @@ impl WireTrack {
     }
 }
 
-/// The tracker's output for one input frame: 217 160 bytes, alignment 8.
+/// The tracker's output for one input frame: 217 168 bytes, alignment 8.
 #[repr(C)]
 #[derive(Debug, ZeroCopySend)]
 #[type_name("primm::TrackFrame")]
@@ -276,6 +276,9 @@ pub struct TrackFrame {
     pub tracks_timestamp_s: f64,
     /// `publish_time_ns` of the input frame (publisher send time), `CLOCK_MONOTONIC` ns.
     pub input_publish_time_ns: u64,
+    /// `scheduled_time_ns` of the input frame (when its publisher was due to send it), ns; 0
+    /// when it was sent without a schedule.
+    pub input_scheduled_time_ns: u64,
     /// When the tracker took the input frame from its buffer, `CLOCK_MONOTONIC` ns.
     pub receive_time_ns: u64,
     /// When the tracker sent this frame, `CLOCK_MONOTONIC` ns.
@@ -324,6 +327,8 @@ pub struct TrackFrameHeader {
     pub tracks_timestamp_s: f64,
     /// See [`TrackFrame::input_publish_time_ns`].
     pub input_publish_time_ns: u64,
+    /// See [`TrackFrame::input_scheduled_time_ns`].
+    pub input_scheduled_time_ns: u64,
     /// See [`TrackFrame::receive_time_ns`].
     pub receive_time_ns: u64,
     /// See [`TrackFrame::publish_time_ns`].
@@ -406,6 +411,7 @@ impl<'a> TrackFrameWriter<'a> {
             addr_of_mut!((*frame).sensor_timestamp_s).write(header.sensor_timestamp_s);
             addr_of_mut!((*frame).tracks_timestamp_s).write(header.tracks_timestamp_s);
             addr_of_mut!((*frame).input_publish_time_ns).write(header.input_publish_time_ns);
+            addr_of_mut!((*frame).input_scheduled_time_ns).write(header.input_scheduled_time_ns);
             addr_of_mut!((*frame).receive_time_ns).write(header.receive_time_ns);
             addr_of_mut!((*frame).publish_time_ns).write(header.publish_time_ns);
             addr_of_mut!((*frame).count).write(self.count as u32);

@@ -74,6 +74,7 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 source_frame,
                 sensor_timestamp_s,
                 publish_time_ns,
+                scheduled_time_ns,
                 ego_x_m,
                 ego_y_m,
                 ego_yaw_rad,
@@ -123,6 +124,7 @@ fn rust_layouts() -> Vec<TypeLayout> {
                 sensor_timestamp_s,
                 tracks_timestamp_s,
                 input_publish_time_ns,
+                input_scheduled_time_ns,
                 receive_time_ns,
                 publish_time_ns,
                 count,
@@ -214,9 +216,9 @@ fn the_rust_types_have_no_implicit_padding() {
         println!("{}: {} fields, {} bytes, no gaps", layout.name, layout.fields.len(), layout.size);
     }
     assert_eq!(size_of::<WireMeasurement>(), 64);
-    assert_eq!(size_of::<MeasurementFrame>(), 16_448);
+    assert_eq!(size_of::<MeasurementFrame>(), 16_456);
     assert_eq!(size_of::<WireTrack>(), 424);
-    assert_eq!(size_of::<TrackFrame>(), 217_160);
+    assert_eq!(size_of::<TrackFrame>(), 217_168);
     assert_eq!(size_of::<LatencyReport>(), 1032);
 }
 

@@ -103,6 +103,7 @@ pub(super) fn run(args: Args) -> Result<(), DemoError> {
     if !complete {
         return Err(DemoError::Incomplete);
     }
+    super::print_latency_files(&args);
     println!("demo finished: every frame tracked on host A and answered on host B through the tunnel");
     Ok(())
 }
