@@ -62,8 +62,8 @@ for library in libprimm_ffi.a libprimm_ffi.so; do
     fi
 done
 
-abi_version=$(sed -n 's/^#define PRIMM_ABI_VERSION \([0-9][0-9]*\)$/\1/p' "$root/include/primm.h")
-version=$(sed -n '/^\[workspace.package\]/,/^\[/s/^version = "\([^"]*\)"$/\1/p' "$root/Cargo.toml")
+abi_version=$(sed -n 's/^#define PRIMM_ABI_VERSION \([0-9][0-9]*\)$/\1/p' "$root/include/primm.h" | head -n 1)
+version=$(sed -n '/^\[workspace.package\]/,/^\[/s/^version = "\([^"]*\)"$/\1/p' "$root/Cargo.toml" | head -n 1)
 if [ -z "$abi_version" ] || [ -z "$version" ]; then
     echo "install_c_api.sh: cannot read PRIMM_ABI_VERSION from include/primm.h or the version from Cargo.toml" >&2
     exit 1

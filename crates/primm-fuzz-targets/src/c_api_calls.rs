@@ -86,7 +86,8 @@ impl FrameView for MirrorFrame<'_> {
             rcs_dbsm: measurement.rcs_dbsm,
             class,
             sensor_id: u16::try_from(measurement.sensor_id).ok(),
-            ground_truth_id: u64::try_from(measurement.ground_truth_id).ok(),
+            ground_truth_id: (measurement.ground_truth_id != PRIMM_NO_GROUND_TRUTH_ID)
+                .then_some(measurement.ground_truth_id as u64),
         })
     }
 
