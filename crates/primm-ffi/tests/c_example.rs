@@ -67,7 +67,8 @@ fn run_checked(command: &mut Command, what: &str) -> Output {
 fn compile(compiler_variable: &str, default: &str, arguments: &[OsString], what: &str) {
     let compiler = std::env::var_os(compiler_variable).unwrap_or_else(|| default.into());
     let output = run_checked(Command::new(&compiler).args(arguments), what);
-    let printed = String::from_utf8_lossy(&output.stderr).into_owned() + &String::from_utf8_lossy(&output.stdout);
+    let printed =
+        String::from_utf8_lossy(&output.stderr).into_owned() + &String::from_utf8_lossy(&output.stdout);
     assert!(printed.trim().is_empty(), "{what}: the compiler or linker printed:\n{printed}");
 }
 
@@ -203,7 +204,11 @@ fn the_c_example_writes_the_same_track_file_as_primm_track_with_imm() {
 fn the_cpp_example_writes_the_same_track_file_as_primm_track_with_imm() {
     let dir = scratch_directory("cpp-example");
     let executable = dir.join("track_csv_cpp");
-    compile_cpp_source(&Path::new(WORKSPACE).join("examples/cpp/track_csv.cpp"), &executable, &static_library());
+    compile_cpp_source(
+        &Path::new(WORKSPACE).join("examples/cpp/track_csv.cpp"),
+        &executable,
+        &static_library(),
+    );
     assert_non_executable_stack(&executable);
 
     let input = write_scene(&dir);
@@ -212,9 +217,13 @@ fn the_cpp_example_writes_the_same_track_file_as_primm_track_with_imm() {
     assert_same_track_file(&executable, &input, &from_rust, "examples/cpp/track_csv.cpp");
 
     // Faults come out as the wrapper's exceptions, printed with the library's message.
-    std::fs::write(dir.join("bad.csv"), "frame,t,gt_id,class,x,y,vr,rcs\n0,0.1,,car,1,2,3,4\n1,0.05,,car,1,2,3,4\n")
-        .unwrap();
-    let run = Command::new(&executable).arg(dir.join("bad.csv")).arg(dir.join("bad-tracks.csv")).output().unwrap();
+    std::fs::write(
+        dir.join("bad.csv"),
+        "frame,t,gt_id,class,x,y,vr,rcs\n0,0.1,,car,1,2,3,4\n1,0.05,,car,1,2,3,4\n",
+    )
+    .unwrap();
+    let run =
+        Command::new(&executable).arg(dir.join("bad.csv")).arg(dir.join("bad-tracks.csv")).output().unwrap();
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.contains("frame 1: frame timestamp 0.05 s does not advance"), "{stderr}");
@@ -240,7 +249,10 @@ fn under_ci() -> bool {
 
 /// The first of `names` that runs with `--version`, or `None`.
 fn find_tool(names: &[&str]) -> Option<String> {
-    names.iter().find(|name| Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success())).map(|name| name.to_string())
+    names
+        .iter()
+        .find(|name| Command::new(name).arg("--version").output().is_ok_and(|o| o.status.success()))
+        .map(|name| name.to_string())
 }
 
 /// The `NEEDED` entries of an ELF file (`readelf -dW`).
@@ -256,27 +268,39 @@ fn needed_libraries(executable: &Path) -> Vec<String> {
 #[test]
 fn the_installed_package_builds_the_examples_with_cmake_and_pkg_config() {
     let Some(cmake) = find_tool(&["cmake"]) else {
-        assert!(!under_ci(), "cmake is not in PATH: pip install -r tools/requirements-test.txt (./test.sh does)");
+        assert!(
+            !under_ci(),
+            "cmake is not in PATH: pip install -r tools/requirements-test.txt (./test.sh does)"
+        );
         eprintln!("skipped: cmake is not in PATH (pip install -r tools/requirements-test.txt)");
         return;
     };
     let Some(pkg_config) = find_tool(&["pkg-config", "pkgconf"]) else {
-        assert!(!under_ci(), "pkg-config is not in PATH: pip install -r tools/requirements-test.txt (./test.sh does)");
+        assert!(
+            !under_ci(),
+            "pkg-config is not in PATH: pip install -r tools/requirements-test.txt (./test.sh does)"
+        );
         eprintln!("skipped: pkg-config is not in PATH (pip install -r tools/requirements-test.txt)");
         return;
     };
+    // Ninja from the test environment where it is there (a C toolchain need not bring make).
+    let generator = find_tool(&["ninja"]).map(|_| "-GNinja".to_string());
     let workspace = Path::new(WORKSPACE);
     let dir = scratch_directory("install");
     let prefix = dir.join("prefix");
     let library_dir = static_library().parent().unwrap().to_path_buf();
     run_checked(
-        Command::new(workspace.join("tools/install_c_api.sh")).arg("--library-dir").arg(&library_dir).arg(&prefix),
+        Command::new(workspace.join("tools/install_c_api.sh"))
+            .arg("--library-dir")
+            .arg(&library_dir)
+            .arg(&prefix),
         "tools/install_c_api.sh",
     );
     let abi_version = primm_ffi::PRIMM_ABI_VERSION;
     let soname = format!("libprimm_ffi.so.{abi_version}");
     assert_eq!(std::fs::read_link(prefix.join("lib/libprimm_ffi.so")).unwrap(), Path::new(&soname));
-    let dynamic = run_checked(Command::new("readelf").arg("-dW").arg(prefix.join("lib").join(&soname)), "readelf -dW");
+    let dynamic =
+        run_checked(Command::new("readelf").arg("-dW").arg(prefix.join("lib").join(&soname)), "readelf -dW");
     assert!(
         String::from_utf8_lossy(&dynamic.stdout).contains(&format!("Library soname: [{soname}]")),
         "the shared library's soname is {soname}"
@@ -297,12 +321,19 @@ fn the_installed_package_builds_the_examples_with_cmake_and_pkg_config() {
                 .arg(&build)
                 .arg(format!("-DCMAKE_PREFIX_PATH={}", prefix.display()))
                 .arg(format!("-DPRIMM_USE_SHARED={shared}"))
-                .arg("-DCMAKE_BUILD_TYPE=Release"),
+                .arg("-DCMAKE_BUILD_TYPE=Release")
+                .args(&generator),
             &format!("cmake configure ({linkage})"),
         );
-        let output = run_checked(Command::new(&cmake).arg("--build").arg(&build), &format!("cmake --build ({linkage})"));
+        let output = run_checked(
+            Command::new(&cmake).arg("--build").arg(&build),
+            &format!("cmake --build ({linkage})"),
+        );
         let printed = String::from_utf8_lossy(&output.stdout);
-        assert!(!printed.to_lowercase().contains("warning"), "cmake --build ({linkage}) printed a warning:\n{printed}");
+        assert!(
+            !printed.to_lowercase().contains("warning"),
+            "cmake --build ({linkage}) printed a warning:\n{printed}"
+        );
         let executable = build.join("track_csv");
         assert_non_executable_stack(&executable);
         let needed = needed_libraries(&executable);

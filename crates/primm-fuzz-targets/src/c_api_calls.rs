@@ -133,7 +133,7 @@ struct Session {
 ///
 /// | opcode | call | operands |
 /// |---|---|---|
-/// | 0 | create | slot, method code (mod 8; 7 is unknown), configuration (mod 5, [`CONFIGS`]) |
+/// | 0 | create | slot, method code (mod 8; 7 is unknown), configuration (mod 5, `CONFIGS`) |
 /// | 1 | step | slot, advance in ms (255: a raw `f64` time follows), pose kind (mod 3: NULL, `i16`×3 in cm/cm/mrad, `f64`×3) and its fields, count, buffer mode (mod 4: exact, NULL, oversized beyond the frame limit, no summary), then per measurement class `u8` (bit 7: x is NaN), x and y `i16` in cm, radial velocity `i8`, sensor `u8` |
 /// | 2 | copy the tracks | slot, capacity `u16`, flags (bit 0 NULL buffer, bit 1 NULL count) |
 /// | 3 | counters | slot, flags (bit 0 NULL output) |
@@ -479,7 +479,12 @@ fn destroy(input: &mut Input, session: &mut Session) -> Option<()> {
 
 /// Checks the `snprintf` contract of a message function: `read(buffer, length)` returns the
 /// full length of `full` and writes a NUL-terminated prefix of it that fits.
-fn check_message_copy(full: &str, length: usize, null_buffer: bool, read: impl Fn(*mut c_char, usize) -> usize) {
+fn check_message_copy(
+    full: &str,
+    length: usize,
+    null_buffer: bool,
+    read: impl Fn(*mut c_char, usize) -> usize,
+) {
     let mut buffer = vec![0x55 as c_char; length];
     let pointer = if null_buffer { null_mut() } else { buffer.as_mut_ptr() };
     let returned = read(pointer, length);

@@ -26,8 +26,8 @@ use primm_core::tracker::{StepError, Tracker};
 use primm_core::validation::FrameError;
 use primm_service::frame_step::{starts_stream, step_received_frame};
 use primm_wire::{
-    FrameStatus, MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, TrackFrame, TrackFrameHeader,
-    TrackFrameWriter, WireMeasurement, FRAME_FLAG_STREAM_START,
+    FrameStatus, MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, TrackFrame,
+    TrackFrameHeader, TrackFrameWriter, WireMeasurement, FRAME_FLAG_STREAM_START,
 };
 use std::f64::consts::TAU;
 
@@ -75,7 +75,10 @@ fn read_frame(input: &mut &[u8]) -> Option<PoseFrame> {
             forward_cm: i16::from_le_bytes(*take(input)?),
             turn_mrad: i16::from_le_bytes(*take(input)?),
         },
-        1 => PoseStep::Jump { x_mm: i32::from_le_bytes(*take(input)?), y_mm: i32::from_le_bytes(*take(input)?) },
+        1 => PoseStep::Jump {
+            x_mm: i32::from_le_bytes(*take(input)?),
+            y_mm: i32::from_le_bytes(*take(input)?),
+        },
         2 => PoseStep::Wrap { turns: i8::from_le_bytes(*take(input)?) },
         3 => PoseStep::Raw {
             x_m: f64::from_le_bytes(*take(input)?),
@@ -99,12 +102,15 @@ fn take<'a, const N: usize>(input: &mut &'a [u8]) -> Option<&'a [u8; N]> {
     Some(head)
 }
 
-/// Turns `data` into up to [`MAX_FRAMES`] frames ([`read_frame`]) and puts each through the
-/// service's path.
+/// Turns `data` into up to [`MAX_FRAMES`] frames and puts each through the service's path.
+/// Each frame is a record: `advance_ms: u8`, a control byte (bits 0–2: the pose kind, mod 5:
+/// drive, jump, whole turns, raw, none; bits 3–4: the number of objects; bit 5: stream start),
+/// then the kind's little-endian fields (`i16` cm and `i16` mrad; `i32` mm twice; `i8` turns;
+/// `f64` x, y and yaw; nothing).
 pub fn run(data: &[u8]) {
     let mut input = data;
-    let mut tracker =
-        Tracker::new(Config::default().with_modes(Method::Imm.modes())).expect("the default configuration is valid");
+    let mut tracker = Tracker::new(Config::default().with_modes(Method::Imm.modes()))
+        .expect("the default configuration is valid");
     let mut frame = Box::<MeasurementFrame>::new_uninit();
     let mut answer = Box::<TrackFrame>::new_zeroed();
     let mut timestamp_s = 0.0;
@@ -230,7 +236,8 @@ fn receive(
         // With a valid pose (or none) only a time that does not advance rejects the frame: the
         // times only grow, and the service path bridges a long gap with a reset.
         assert!(
-            advance_ms == 0 && matches!(error, StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. })),
+            advance_ms == 0
+                && matches!(error, StepError::InvalidFrame(FrameError::TimestampNotIncreasing { .. })),
             "a frame with a valid pose {pose:?}, {advance_ms} ms after the last, was rejected: {error}"
         );
         assert_eq!(snapshot(tracker), before, "a rejected frame changed the tracks");
@@ -241,7 +248,10 @@ fn receive(
     let answer = unsafe { answer.assume_init_ref() };
     assert_eq!(answer.count as usize, count);
     for track in answer.valid_tracks() {
-        assert!(track.x_m.is_finite() && track.y_m.is_finite(), "a track with a non-finite position: {track:?}");
+        assert!(
+            track.x_m.is_finite() && track.y_m.is_finite(),
+            "a track with a non-finite position: {track:?}"
+        );
         match (pose, track.world()) {
             (None, world) => assert_eq!(world, None, "a world estimate without a pose"),
             (Some(pose), Some([world_x_m, world_y_m, _, _])) => {

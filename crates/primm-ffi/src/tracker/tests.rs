@@ -567,8 +567,12 @@ fn pr_imm_through_the_c_api_equals_the_core_tracker_with_the_built_in_model_and_
 
     let mut pr_weight_seen = false;
     for (k, frame) in frames.iter().enumerate() {
-        let expected: Vec<String> =
-            core.step(frame).unwrap().iter().map(|output| format!("{:?}", PrimmTrack::from(output))).collect();
+        let expected: Vec<String> = core
+            .step(frame)
+            .unwrap()
+            .iter()
+            .map(|output| format!("{:?}", PrimmTrack::from(output)))
+            .collect();
         for (name, tracker) in [("built-in model", built_in), ("model bytes", from_bytes)] {
             assert_eq!(step_frame(tracker, frame, Some(&c_pose(frame))).0, PrimmStatus::Ok, "{name}");
             assert_eq!(tracks_text(tracker), expected, "{name}, frame {k}");
@@ -608,7 +612,10 @@ fn an_invalid_pose_is_rejected_with_a_message_and_leaves_the_tracker_as_it_was()
             rejected += 1;
             assert_eq!(summary, PrimmStepSummary::default(), "a rejected step's summary is zeroed");
             let message = tracker_message(faulty);
-            assert!(message.contains("ego pose") && message.contains("not finite or too far out"), "{message}");
+            assert!(
+                message.contains("ego pose") && message.contains("not finite or too far out"),
+                "{message}"
+            );
             assert_eq!(thread_message(), message);
             assert_eq!(tracks_text(faulty), before, "frame {k}: the rejected frame changed the tracks");
             let stats_after = stats(faulty);
@@ -623,7 +630,8 @@ fn an_invalid_pose_is_rejected_with_a_message_and_leaves_the_tracker_as_it_was()
     assert!(rejected >= 4, "{rejected} invalid poses tried");
 
     // A NULL pose is not an error: the frame is tracked in the vehicle frame and counted.
-    let next = Frame { timestamp_s: frames.last().unwrap().timestamp_s + 0.05, ..frames.last().unwrap().clone() };
+    let next =
+        Frame { timestamp_s: frames.last().unwrap().timestamp_s + 0.05, ..frames.last().unwrap().clone() };
     let (status, summary) = step_frame(faulty, &next, None);
     assert_eq!(status, PrimmStatus::Ok);
     assert!(summary.track_count > 0);
