@@ -278,10 +278,14 @@ class Tracker {
         return out.first(count);
     }
 
-    /* The number of tracks of the last step. */
+    /* The number of tracks of the last step (a query with no buffer: the C API answers
+     * PRIMM_STATUS_BUFFER_TOO_SMALL with the count whenever there is a track). */
     std::size_t track_count() {
         std::size_t count = 0;
-        check(primm_tracker_tracks(require(), nullptr, 0, &count), "primm_tracker_tracks");
+        const PrimmStatus status = primm_tracker_tracks(require(), nullptr, 0, &count);
+        if (status != PRIMM_STATUS_BUFFER_TOO_SMALL) {
+            check(status, "primm_tracker_tracks");
+        }
         return count;
     }
 
