@@ -226,7 +226,8 @@ fn the_cpp_example_writes_the_same_track_file_as_primm_track_with_imm() {
         Command::new(&executable).arg(dir.join("bad.csv")).arg(dir.join("bad-tracks.csv")).output().unwrap();
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);
-    assert!(stderr.contains("frame 1: frame timestamp 0.05 s does not advance"), "{stderr}");
+    assert!(stderr.starts_with("track_csv: frame 1: "), "{stderr}");
+    assert!(stderr.contains("frame timestamp 0.05 s does not advance"), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
