@@ -1,9 +1,17 @@
 /*
  * primm C API: the PR-IMM radar multi-object tracker behind an opaque handle.
  *
- * Link libprimm_ffi.a (cargo build --release -p primm-ffi) with -lpthread -ldl -lm.
+ * Link libprimm_ffi.a (cargo build --release -p primm-ffi) with -lpthread -ldl -lm, or
+ * install with tools/install_c_api.sh PREFIX and use find_package(primm) or pkg-config;
+ * C++ programs include primm.hpp. Build lines: docs/integrating-c-cpp.md.
  * Every fallible call returns a PrimmStatus; primm_last_error_message and
  * primm_tracker_last_error give the detailed message. Units are part of field names.
+ *
+ * Versions: primm_version() is the release version. PRIMM_ABI_VERSION is raised by one for
+ * every change that can break a program compiled against an older header (a struct's size or
+ * field offsets, a function's signature or removal, the meaning of a code); adding functions
+ * keeps it. Check primm_abi_version() == PRIMM_ABI_VERSION at start-up; the shared library's
+ * soname is libprimm_ffi.so.<PRIMM_ABI_VERSION>.
  * Safety rules and a walk-through: the crate documentation of primm-ffi (crates/primm-ffi/src/lib.rs).
  */
 
@@ -35,6 +43,10 @@
 
 // `measurement_index` value of a track that coasted (no measurement in this frame).
 #define PRIMM_NO_MEASUREMENT_INDEX -1
+
+// The ABI version of this header (see the crate documentation of primm-ffi for the policy):
+// compare it with `primm_abi_version()`, the ABI version of the linked library.
+#define PRIMM_ABI_VERSION 1
 
 // Result of a C API call.
 typedef enum PrimmStatus {
@@ -472,6 +484,15 @@ void primm_tracker_destroy(struct PrimmTracker *tracker);
 // `tracker` is NULL or a live handle used by no other thread; `buf` is NULL or points to `len`
 // writable bytes.
 size_t primm_tracker_last_error(const struct PrimmTracker *tracker, char *buf, size_t len);
+
+// The release version of the linked library as `MAJOR.MINOR.PATCH` (a static string; never
+// free it).
+const char *primm_version(void);
+
+// The ABI version the linked library was built with. A program compares it with the
+// `PRIMM_ABI_VERSION` of the header it was compiled against; they differ when the library
+// and the header do not belong together.
+uint32_t primm_abi_version(void);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -74,6 +74,7 @@ fn dependencies_between_primm_crates_point_one_way() {
             "primm-fuzz-targets",
             "primm-config",
             "primm-predictor",
+            "primm-ffi",
             "primm-wire",
             "primm-service",
             "primm-sim",

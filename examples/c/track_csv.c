@@ -6,8 +6,8 @@
  *   cc -O2 -Iinclude examples/c/track_csv.c target/release/libprimm_ffi.a -lpthread -ldl -lm -o track_csv
  *   ./track_csv INPUT.csv OUTPUT.csv
  *
- * (GNU ld warns that tract's assembly objects lack a .note.GNU-stack section; add
- * -Wl,-z,noexecstack to the link line to keep the stack non-executable and the warning away.)
+ * The program links without a warning and with a non-executable stack (docs/integrating-c-cpp.md);
+ * examples/cpp/track_csv.cpp is the same program in C++ over include/primm.hpp.
  *
  * Input: the measurement CSV format of docs/scenario.md. Columns are found by their header
  * names (frame, t, gt_id, class, x, y, vr, rcs required; sensor_id and the ego pose ego_x,

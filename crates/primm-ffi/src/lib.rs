@@ -13,7 +13,16 @@
 //! ```
 //!
 //! `examples/c/track_csv.c` reads a measurement CSV file (`docs/scenario.md`) and writes the
-//! same track CSV file as `primm track --method imm`, byte for byte.
+//! same track CSV file as `primm track --method imm`, byte for byte. The static library links
+//! with a non-executable stack and no linker warning: the workspace's `.cargo/config.toml`
+//! has the assembler mark tract's assembly objects (a test checks the linked example with
+//! `readelf -lW`).
+//!
+//! C++ programs include `include/primm.hpp`, a header-only C++17 wrapper (a move-only tracker,
+//! exceptions for errors, views over caller buffers); `examples/cpp/track_csv.cpp` is the same
+//! example in C++. `tools/install_c_api.sh PREFIX` installs the headers, both libraries, a CMake
+//! package (`find_package(primm)`, target `primm::primm`) and pkg-config files; build lines
+//! for C and C++, static and shared, are in `docs/integrating-c-cpp.md`.
 //!
 //! ## The calls
 //!
@@ -33,6 +42,26 @@
 //!   the frame fault.
 //! * [`primm_format_f64`] formats a double as primm's CSV files do (Rust's `{}`),
 //!   [`primm_object_class_name`] and [`primm_object_class_from_name`] map class codes and names.
+//!
+//! ## Versions and the ABI
+//!
+//! * [`primm_version`] is the release version of primm (the workspace's package version,
+//!   `MAJOR.MINOR.PATCH`). It names a release; it says nothing about binary compatibility.
+//! * [`PRIMM_ABI_VERSION`] (a `#define` in `include/primm.h`) and [`primm_abi_version`] (what
+//!   the linked library was built with) number the binary interface. It is raised by one for
+//!   every change that can break a program compiled against the previous header: a field of a
+//!   `#[repr(C)]` struct added, removed, reordered or retyped (so a size or offset changes); a
+//!   function removed, renamed or given another signature; a constant, status code or code
+//!   value given another meaning. Adding a new function, or a new status code or constant at
+//!   the end of its range, keeps the ABI version: a program built against the older header
+//!   never sees the new ones (every function returns only the statuses its documentation
+//!   lists, plus the new ones a new function documents).
+//! * The shared library carries the ABI version in its name on Linux: its soname is
+//!   `libprimm_ffi.so.ABI` (set by this crate's build script), so the dynamic loader refuses a
+//!   library of another ABI version instead of running with mismatched layouts.
+//! * A program linked statically, or loading the library by hand, compares
+//!   `primm_abi_version()` with `PRIMM_ABI_VERSION` at start-up and refuses to run when they
+//!   differ (`include/primm.hpp` does it when the first tracker is created).
 //!
 //! ## Safety rules for callers
 //!
@@ -109,6 +138,7 @@ mod status;
 mod text;
 mod tracker;
 mod types;
+mod version;
 
 pub use helpers::{
     primm_format_f64, primm_last_error_message, primm_object_class_from_name, primm_object_class_name,
@@ -121,3 +151,4 @@ pub use tracker::{
     primm_tracker_step, primm_tracker_step_with_pose, primm_tracker_tracks, PrimmTracker,
 };
 pub use types::*;
+pub use version::{primm_abi_version, primm_version, PRIMM_ABI_VERSION};

@@ -12,13 +12,19 @@
 //! | [`tracker_steps::run`] | a frame sequence built with `arbitrary` | IMM and PR-IMM steps |
 //! | [`measurement_frame_bytes::run`] | raw `MeasurementFrame` images | the service's frame path |
 //! | [`config_toml::run`] | bytes of a TOML file | `primm_config`, `Config::validate`, tracker |
+//! | [`ego_pose_frames::run`] | frames with ego poses (driving, jumps, yaw wrapping, raw values) | the service's frame path in the world frame |
 //! | `onnx_model_bytes::run` | bytes of an ONNX file | `PrModel::from_bytes`, a prediction |
+//! | `c_api_calls::run` | sequences of C API calls with their buffers and sizes | `primm-ffi` against a core mirror |
 //!
-//! The ONNX target needs tract, whose instrumented build is the bulk of the fuzz build's time;
-//! it sits behind the `onnx` feature (on by default, so the test suite replays its corpus), and
-//! the fuzz crate builds it only with `--features onnx`.
+//! The ONNX and C API targets need tract (primm-ffi links the PR model), whose instrumented
+//! build is the bulk of the fuzz build's time; they sit behind the `onnx` and `c_api` features
+//! (on by default, so the test suite replays their corpora), and the fuzz crate builds them only
+//! with `--features onnx` or `--features c_api`.
 
+#[cfg(feature = "c_api")]
+pub mod c_api_calls;
 pub mod config_toml;
+pub mod ego_pose_frames;
 pub mod extrapolating_predictor;
 pub mod invariant_check;
 pub mod measurement_csv;
@@ -38,6 +44,9 @@ pub const TARGETS: &[(&str, Target)] = &[
     ("tracker_steps", tracker_steps::run),
     ("measurement_frame_bytes", measurement_frame_bytes::run),
     ("config_toml", config_toml::run),
+    ("ego_pose_frames", ego_pose_frames::run),
     #[cfg(feature = "onnx")]
     ("onnx_model_bytes", onnx_model_bytes::run),
+    #[cfg(feature = "c_api")]
+    ("c_api_calls", c_api_calls::run),
 ];

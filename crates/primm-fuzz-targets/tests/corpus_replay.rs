@@ -71,3 +71,13 @@ fn every_config_toml_corpus_file_replays_without_a_panic() {
 fn every_onnx_model_bytes_corpus_file_replays_without_a_panic() {
     replay_corpus("onnx_model_bytes");
 }
+
+#[test]
+fn every_ego_pose_frames_corpus_file_replays_without_a_panic() {
+    replay_corpus("ego_pose_frames");
+}
+
+#[test]
+fn every_c_api_calls_corpus_file_replays_without_a_panic() {
+    replay_corpus("c_api_calls");
+}

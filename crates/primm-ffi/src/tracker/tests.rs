@@ -418,3 +418,232 @@ fn the_inference_thread_option_runs_the_pr_mode() {
     assert_eq!(tracks(tracker).len(), 2);
     destroy(tracker);
 }
+
+/// The frames of a generated scene (`duration_s` long), with the ego poses the scene carries.
+fn scenario_frames(duration_s: f64) -> Vec<Frame> {
+    use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
+    let mut config = Preset::Default.config();
+    config.sequence.duration_s = duration_s;
+    let generated = ScenarioGenerator::new(config).unwrap().generate(Split::Evaluation, 0);
+    let frames = generated.sequence.to_frames().unwrap();
+    assert!(frames.iter().all(|frame| frame.ego_pose.is_some()), "the generated scene carries poses");
+    frames
+}
+
+/// A core measurement as C passes it.
+fn to_c(measurement: &primm_core::measurement::Measurement) -> PrimmMeasurement {
+    PrimmMeasurement {
+        x_m: measurement.x_m,
+        y_m: measurement.y_m,
+        radial_velocity_mps: measurement.radial_velocity_mps,
+        rcs_dbsm: measurement.rcs_dbsm,
+        ground_truth_id: measurement.ground_truth_id.map_or(PRIMM_NO_GROUND_TRUTH_ID, |id| id as i64),
+        sensor_id: measurement.sensor_id.map_or(PRIMM_NO_SENSOR_ID, i32::from),
+        class_code: measurement.class.code(),
+    }
+}
+
+/// Steps `frame` (with `pose`, NULL for none) through the C API.
+fn step_frame(
+    tracker: *mut PrimmTracker,
+    frame: &Frame,
+    pose: Option<&PrimmEgoPose>,
+) -> (PrimmStatus, PrimmStepSummary) {
+    let measurements: Vec<PrimmMeasurement> = frame.measurements.iter().map(to_c).collect();
+    let mut summary = PrimmStepSummary { track_count: 99, ..Default::default() };
+    let pose = pose.map_or(null(), |pose| pose as *const PrimmEgoPose);
+    // SAFETY: a live tracker, a readable pose or NULL, `measurements.len()` readable
+    // measurements, a writable summary.
+    let status = unsafe {
+        primm_tracker_step_with_pose(
+            tracker,
+            frame.timestamp_s,
+            pose,
+            measurements.as_ptr(),
+            measurements.len(),
+            &mut summary,
+        )
+    };
+    (status, summary)
+}
+
+/// The pose of a core frame as C passes it.
+fn c_pose(frame: &Frame) -> PrimmEgoPose {
+    let pose = frame.ego_pose.expect("a frame with a pose");
+    PrimmEgoPose { x_m: pose.x_m, y_m: pose.y_m, yaw_rad: pose.yaw_rad }
+}
+
+/// Tracks as text, field for field (NaN priors compare unequal as numbers).
+fn tracks_text(tracker: *mut PrimmTracker) -> Vec<String> {
+    tracks(tracker).iter().map(|track| format!("{track:?}")).collect()
+}
+
+#[test]
+fn trackers_on_several_threads_step_at_once_and_keep_their_error_messages_apart() {
+    const THREADS: usize = 4;
+    /// The frame before which every thread sends a frame back in time.
+    const FAULT_FRAME: usize = 12;
+    let frames = std::sync::Arc::new(scenario_frames(2.0));
+    assert!(frames.len() > FAULT_FRAME + 10);
+
+    // The reference: one tracker on this thread, without the faulty frames.
+    let reference = create(&imm_options()).unwrap();
+    let expected: Vec<Vec<String>> = frames
+        .iter()
+        .map(|frame| {
+            assert_eq!(step_frame(reference, frame, Some(&c_pose(frame))).0, PrimmStatus::Ok);
+            tracks_text(reference)
+        })
+        .collect();
+    destroy(reference);
+    assert!(expected.iter().any(|tracks| tracks.len() > 3), "the scene has several tracks at once");
+
+    let barrier = std::sync::Arc::new(std::sync::Barrier::new(THREADS));
+    let workers: Vec<_> = (0..THREADS)
+        .map(|thread| {
+            let frames = std::sync::Arc::clone(&frames);
+            let barrier = std::sync::Arc::clone(&barrier);
+            std::thread::spawn(move || {
+                let tracker = create(&imm_options()).unwrap();
+                let mut outputs = Vec::with_capacity(frames.len());
+                for (k, frame) in frames.iter().enumerate() {
+                    if k == FAULT_FRAME {
+                        // Every thread fails at once, each with its own timestamp in the message.
+                        barrier.wait();
+                        let stale = -1.0 - thread as f64;
+                        let (status, _) = step(tracker, stale, &two_objects(0));
+                        assert_eq!(status, PrimmStatus::InvalidFrame);
+                        barrier.wait();
+                        let own = format!("frame timestamp {stale} s does not advance");
+                        for message in [thread_message(), tracker_message(tracker)] {
+                            assert!(message.contains(&own), "thread {thread}: {message}");
+                            for other in (0..THREADS).filter(|other| *other != thread) {
+                                let foreign = format!("timestamp {} s", -1.0 - other as f64);
+                                assert!(!message.contains(&foreign), "thread {thread}: {message}");
+                            }
+                        }
+                    }
+                    assert_eq!(step_frame(tracker, frame, Some(&c_pose(frame))).0, PrimmStatus::Ok);
+                    outputs.push(tracks_text(tracker));
+                }
+                assert_eq!(stats(tracker).frames_rejected_timestamp_not_increasing, 1);
+                destroy(tracker);
+                outputs
+            })
+        })
+        .collect();
+    for (thread, worker) in workers.into_iter().enumerate() {
+        let outputs = worker.join().expect("no thread panics");
+        assert_eq!(outputs.len(), expected.len());
+        for (k, (got, want)) in outputs.iter().zip(&expected).enumerate() {
+            assert_eq!(got, want, "thread {thread}, frame {k}: tracks differ from the single-threaded run");
+        }
+    }
+}
+
+#[test]
+fn pr_imm_through_the_c_api_equals_the_core_tracker_with_the_built_in_model_and_with_model_bytes() {
+    use primm_predictor::onnx::OnnxPredictor;
+    let frames = scenario_frames(1.5);
+    let config = Config::default().with_modes(primm_core::mode::Method::PrImm.modes());
+    let mut predictor = OnnxPredictor::embedded().unwrap();
+    predictor.set_engine(config.predictor.engine);
+    let mut core = Tracker::with_predictor(config, predictor).unwrap();
+
+    let built_in = create(&PrimmTrackerOptions {
+        method: PRIMM_METHOD_PR_IMM,
+        use_builtin_model: true,
+        ..primm_tracker_options_default()
+    })
+    .unwrap();
+    let from_bytes = create(&PrimmTrackerOptions {
+        method: PRIMM_METHOD_PR_IMM,
+        model_onnx: primm_predictor::DEFAULT_MODEL_ONNX.as_ptr(),
+        model_onnx_len: primm_predictor::DEFAULT_MODEL_ONNX.len(),
+        use_builtin_model: false,
+        ..primm_tracker_options_default()
+    })
+    .unwrap();
+
+    let mut pr_weight_seen = false;
+    for (k, frame) in frames.iter().enumerate() {
+        let expected: Vec<String> = core
+            .step(frame)
+            .unwrap()
+            .iter()
+            .map(|output| format!("{:?}", PrimmTrack::from(output)))
+            .collect();
+        for (name, tracker) in [("built-in model", built_in), ("model bytes", from_bytes)] {
+            assert_eq!(step_frame(tracker, frame, Some(&c_pose(frame))).0, PrimmStatus::Ok, "{name}");
+            assert_eq!(tracks_text(tracker), expected, "{name}, frame {k}");
+        }
+        pr_weight_seen |= tracks(built_in).iter().any(|track| track.mode_probabilities[0] > 0.0);
+    }
+    assert!(pr_weight_seen, "the PR mode carries weight in some track");
+    for tracker in [built_in, from_bytes] {
+        let stats = stats(tracker);
+        assert_eq!(stats.frames_tracked, frames.len() as u64);
+        assert_eq!(stats.learned_predictions_missing, 0);
+        assert_eq!(stats.frames_in_world_frame, frames.len() as u64);
+        destroy(tracker);
+    }
+}
+
+#[test]
+fn an_invalid_pose_is_rejected_with_a_message_and_leaves_the_tracker_as_it_was() {
+    let frames = scenario_frames(1.0);
+    let faulty = create(&imm_options()).unwrap();
+    let clean = create(&imm_options()).unwrap();
+    let invalid_poses = [
+        PrimmEgoPose { x_m: f64::NAN, y_m: 0.0, yaw_rad: 0.0 },
+        PrimmEgoPose { x_m: 0.0, y_m: f64::INFINITY, yaw_rad: 0.0 },
+        PrimmEgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: f64::NAN },
+        PrimmEgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: f64::NEG_INFINITY },
+        PrimmEgoPose { x_m: 1.0e12, y_m: 0.0, yaw_rad: 0.0 },
+    ];
+    let mut rejected = 0;
+    for (k, frame) in frames.iter().enumerate() {
+        if k % 4 == 3 {
+            let before = tracks_text(faulty);
+            let stats_before = stats(faulty);
+            let pose = &invalid_poses[(k / 4) % invalid_poses.len()];
+            let (status, summary) = step_frame(faulty, frame, Some(pose));
+            assert_eq!(status, PrimmStatus::InvalidFrame, "frame {k}, pose {pose:?}");
+            rejected += 1;
+            assert_eq!(summary, PrimmStepSummary::default(), "a rejected step's summary is zeroed");
+            let message = tracker_message(faulty);
+            assert!(
+                message.contains("ego pose") && message.contains("not finite or too far out"),
+                "{message}"
+            );
+            assert_eq!(thread_message(), message);
+            assert_eq!(tracks_text(faulty), before, "frame {k}: the rejected frame changed the tracks");
+            let stats_after = stats(faulty);
+            assert_eq!(stats_after.frames_tracked, stats_before.frames_tracked);
+            assert_eq!(stats_after.frames_rejected_invalid_ego_pose, rejected);
+        }
+        for tracker in [faulty, clean] {
+            assert_eq!(step_frame(tracker, frame, Some(&c_pose(frame))).0, PrimmStatus::Ok, "frame {k}");
+        }
+        assert_eq!(tracks_text(faulty), tracks_text(clean), "frame {k}: the rejected poses left a trace");
+    }
+    assert!(rejected >= 4, "{rejected} invalid poses tried");
+
+    // A NULL pose is not an error: the frame is tracked in the vehicle frame and counted.
+    let next =
+        Frame { timestamp_s: frames.last().unwrap().timestamp_s + 0.05, ..frames.last().unwrap().clone() };
+    let (status, summary) = step_frame(faulty, &next, None);
+    assert_eq!(status, PrimmStatus::Ok);
+    assert!(summary.track_count > 0);
+    assert!(tracks(faulty).iter().all(|track| !track.has_world_estimate));
+    assert_eq!(stats(faulty).frames_without_ego_pose, 1);
+    assert_eq!(stats(faulty).frames_rejected_invalid_ego_pose, rejected);
+
+    // A NULL tracker with a valid pose is refused before anything is read.
+    let pose = c_pose(&frames[0]);
+    // SAFETY: NULL tracker (refused), a readable pose, no measurements.
+    let status = unsafe { primm_tracker_step_with_pose(null_mut(), 1.0, &pose, null(), 0, null_mut()) };
+    assert_eq!(status, PrimmStatus::NullArgument);
+    destroy(faulty);
+    destroy(clean);
+}
