@@ -289,6 +289,24 @@ class Tracker {
         return count;
     }
 
+    /* Writes every track's prediction to `timestamp_s` into `out` without changing the
+     * tracker (see primm_tracker_predict_to) and returns the filled part of it; `pose` is the
+     * ego pose at that time, or nullptr. Throws Error for a time out of range or too small a
+     * buffer. */
+    Span<PrimmTrack> predict_to(double timestamp_s, const PrimmEgoPose *pose, Span<PrimmTrack> out) {
+        std::size_t count = 0;
+        check(primm_tracker_predict_to(require(), timestamp_s, pose, out.data(), out.size(), &count),
+              "primm_tracker_predict_to");
+        return out.first(count);
+    }
+
+    /* The newest tracked frame's time: the time of the tracks (NaN before the first frame). */
+    double newest_timestamp() {
+        double timestamp_s = 0.0;
+        check(primm_tracker_newest_timestamp(require(), &timestamp_s), "primm_tracker_newest_timestamp");
+        return timestamp_s;
+    }
+
     /* The counters since the tracker was built. */
     PrimmStats stats() {
         PrimmStats stats{};

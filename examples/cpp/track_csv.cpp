@@ -68,8 +68,11 @@ constexpr int REQUIRED_COLUMNS = COL_SENSOR_ID;
 
 /* The header of the track file; the world-frame columns follow when the input has a pose. */
 constexpr const char *TRACK_COLUMNS =
-    "frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,existence_probability";
-constexpr const char *WORLD_COLUMNS = ",world_x,world_y,world_vx,world_vy";
+    "frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,existence_probability,"
+    "vx,vy,age_s,cov_xx,cov_xy,cov_xvx,cov_xvy,cov_yy,cov_yvx,cov_yvy,cov_vxvx,cov_vxvy,cov_vyvy";
+constexpr const char *WORLD_COLUMNS =
+    ",world_x,world_y,world_vx,world_vy,world_cov_xx,world_cov_xy,world_cov_xvx,world_cov_xvy,world_cov_yy,"
+    "world_cov_yvx,world_cov_yvy,world_cov_vxvx,world_cov_vxvy,world_cov_vyvy";
 
 /* A fault in the input file, with its place. */
 class InputError : public std::runtime_error {
@@ -254,6 +257,16 @@ const char *track_status_name(PrimmTrackStatus status) {
 
 /* Writes the row of one track; with `world_columns`, the row ends with the world-frame estimate
  * (empty without one). */
+/* Writes the upper triangle of a row-major 4x4 covariance, each value after a comma. */
+void print_upper_triangle(std::FILE *out, const double (&covariance)[16]) {
+    for (std::size_t row = 0; row < 4; row++) {
+        for (std::size_t column = row; column < 4; column++) {
+            std::fputc(',', out);
+            print_double(out, covariance[4 * row + column]);
+        }
+    }
+}
+
 void write_track_row(std::FILE *out, std::uint64_t frame, double timestamp_s, const PrimmTrack &track,
                      bool world_columns) {
     std::fprintf(out, "%" PRIu64 ",", frame);
@@ -277,6 +290,11 @@ void write_track_row(std::FILE *out, std::uint64_t frame, double timestamp_s, co
     }
     std::fprintf(out, ",%s,", track_status_name(track.status));
     print_double(out, track.existence_probability);
+    for (double value : {track.velocity_x_mps, track.velocity_y_mps, track.age_s}) {
+        std::fputc(',', out);
+        print_double(out, value);
+    }
+    print_upper_triangle(out, track.state_covariance);
     if (world_columns && track.has_world_estimate) {
         const double world[4] = {track.world_x_m, track.world_y_m, track.world_velocity_x_mps,
                                  track.world_velocity_y_mps};
@@ -284,21 +302,33 @@ void write_track_row(std::FILE *out, std::uint64_t frame, double timestamp_s, co
             std::fputc(',', out);
             print_double(out, value);
         }
+        print_upper_triangle(out, track.world_state_covariance);
     } else if (world_columns) {
-        std::fputs(",,,,", out);
+        std::fputs(",,,,,,,,,,,,,,", out);
     }
     std::fputc('\n', out);
 }
 
 /* Tracks one frame (with its ego pose, or none) and writes the rows of the tracks a measurement
- * updated. */
+ * updated. Frames come in file order, which is arrival order: a late frame is tracked in its
+ * place and writes no rows (its tracks are those of the newest frame); one older than the
+ * late-frame window is skipped, as `primm track` does. */
 void track_frame(primm::Tracker &tracker, std::FILE *out, std::uint64_t frame, double timestamp_s,
                  const std::optional<PrimmEgoPose> &pose, primm::Span<const PrimmMeasurement> measurements,
                  primm::Span<PrimmTrack> buffer, bool world_columns) {
+    const std::uint64_t too_late_before = tracker.stats().frames_rejected_too_late;
+    PrimmStepSummary summary{};
     try {
-        tracker.step(timestamp_s, pose ? &*pose : nullptr, measurements);
+        summary = tracker.step(timestamp_s, pose ? &*pose : nullptr, measurements);
     } catch (const primm::Error &) {
+        if (tracker.stats().frames_rejected_too_late > too_late_before) {
+            std::fprintf(stderr, "frame %" PRIu64 ": older than the late-frame window reaches; skipped\n", frame);
+            return;
+        }
         throw std::runtime_error("frame " + std::to_string(frame) + ": " + tracker.last_error());
+    }
+    if (summary.late_frame) {
+        return;
     }
     for (const PrimmTrack &track : tracker.tracks(buffer)) {
         if (track.measurement_index == PRIMM_NO_MEASUREMENT_INDEX) {
@@ -348,9 +378,6 @@ int run(const std::string &input_path, const std::string &output_path) {
         const double row_t = in.parse_double(COL_T);
         if (!open || row_frame != frame) {
             if (open) {
-                if (row_frame < frame) {
-                    in.fail("frame index `" + in.field(COL_FRAME) + "` decreases");
-                }
                 track_frame(tracker, out, frame, timestamp_s, pose, primm::Span<const PrimmMeasurement>(measurements.data(), count),
                             tracks, world_columns);
             }
