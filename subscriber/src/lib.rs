@@ -39,6 +39,7 @@ use primm_core::measurement::ObjectClass;
 use primm_service::catalog::{self, Ipc, SERVICE_PREFIX_ENV};
 use primm_service::clock::monotonic_ns;
 use primm_service::latency::{format_table, summarise, MAX_TRACKABLE_NS};
+use primm_service::realtime::{RealtimeArgs, RealtimeRefused, RealtimeReport};
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_wire::{
@@ -81,6 +82,9 @@ pub struct Args {
     /// Prefix of the service names (`PREFIX/primm/...`).
     #[arg(long, env = SERVICE_PREFIX_ENV, default_value = "")]
     pub service_prefix: String,
+    /// Real-time settings of the receiving thread (docs/realtime-tuning.md).
+    #[command(flatten)]
+    pub realtime: RealtimeArgs,
 }
 
 /// Why the subscriber failed.
@@ -112,6 +116,9 @@ pub enum SubscribeError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A real-time setting could not be applied and `--require-realtime` was given.
+    #[error(transparent)]
+    Realtime(#[from] RealtimeRefused),
 }
 
 /// Percentiles of one latency, for the JSON summary.
@@ -457,6 +464,11 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
             Some(waitset.attach_interval(Duration::from_millis(200)).map_err(SubscribeError::WaitSetAttach)?);
     }
     let idle_timeout = args.idle_timeout_s.map(Duration::from_secs_f64);
+    let realtime = args.realtime.settings();
+    let mut report = RealtimeReport::default();
+    realtime.apply_to_current_thread("receiving thread", &mut report);
+    realtime.lock_memory_now(&mut report);
+    report.finish(realtime.require_realtime)?;
     loop {
         if args.busy_poll {
             std::hint::spin_loop();

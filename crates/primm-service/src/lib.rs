@@ -14,6 +14,7 @@
 //! - [`shutdown`]: SIGINT/SIGTERM handling.
 //! - [`log_limit`]: bounded logging of repeated faults.
 //! - [`logging`]: the programs' log output.
+//! - [`realtime`]: CPU affinity, `SCHED_FIFO` priority and locked memory for the programs' threads.
 //!
 //! The publisher's replay loop and the subscriber's loop live in the `primm-publisher` and
 //! `primm-subscriber` packages; both use [`catalog`] to open the same services.
@@ -42,6 +43,7 @@ pub mod frame_step;
 pub mod latency;
 pub mod log_limit;
 pub mod logging;
+pub mod realtime;
 pub mod shutdown;
 pub mod tracking;
 
