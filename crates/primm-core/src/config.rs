@@ -94,7 +94,7 @@ impl Default for PredictorConfig {
             learned_process_noise_scale: 1.0,
             inference_threads: 2,
             engine: InferenceEngine::Native,
-            classes: ClassSet::ALL,
+            classes: ClassSet::ALL.without(ObjectClass::Car),
         }
     }
 }
