@@ -5,7 +5,7 @@
 //! lowered in the child before it starts), the service warns and serves, or with
 //! `--require-realtime` refuses to start and names each setting, its OS error and the remedy.
 
-use crate::common::service::{unique_prefix, ChildGuard, Iceoryx2Domain, TestClient};
+use crate::common::service::{unique_prefix, wait_until, ChildGuard, Iceoryx2Domain, TestClient};
 use primm_service::catalog::ServiceNames;
 use std::io::Read;
 use std::os::unix::process::CommandExt;
@@ -156,7 +156,11 @@ fn where_permitted_the_tracking_and_inference_threads_run_pinned_under_sched_fif
     );
     client.wait_for_tracker(Duration::from_secs(60));
     let pid = child.pid();
-    // The tracking loop runs on the main thread, whose task id is the process id.
+    // The tracking loop runs on the main thread, whose task id is the process id; its settings
+    // follow right after the services open, so wait for them.
+    wait_until("the tracking thread under SCHED_FIFO", Duration::from_secs(20), || {
+        policy_of(pid).0 == libc::SCHED_FIFO
+    });
     assert_eq!(affinity_of(pid), vec![tracking_cpu]);
     assert_eq!(policy_of(pid), (libc::SCHED_FIFO, 7));
     let threads = inference_threads(pid);
