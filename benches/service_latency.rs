@@ -27,6 +27,9 @@
 //!
 //! `cargo bench --bench service_latency [-- --frames 100000] [--objects 64] [--modes event,busy-poll] [--method imm] [--model FILE] [--inference-threads N] [--engine native|tract] [--latency-every 100] [--latency-out DIR] [--no-write]`
 //!
+//! `--serve-args "OPTIONS"` passes more options to `primm serve`, e.g. its real-time settings
+//! (`--cpu-affinity 1 --realtime-priority 50 --lock-memory`, docs/realtime-tuning.md).
+//!
 //! `--model FILE` runs the tracker with that PR model instead of the built-in one, and
 //! `--inference-threads N` with that many inference threads instead of the configuration's (to
 //! compare side by side on one machine); their results are printed, not written.
@@ -92,6 +95,9 @@ fn measure(
     if let Some(directory) = &directory_text {
         extra.extend(["--latency-out", directory.as_str()]);
     }
+    // `--serve-args "…"`: more options for `primm serve` (e.g. its real-time settings).
+    let serve_args = argument("--serve-args").unwrap_or_default();
+    extra.extend(serve_args.split_whitespace());
     let serve = spawn_serve(&prefix, &extra);
     client.wait_for_tracker(Duration::from_secs(60));
     let scene = common::scene_frames(&common::lanes(objects), 500, 0.05, 0.2, 11);

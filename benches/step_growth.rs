@@ -15,7 +15,10 @@
 //!
 //! Prints a table and writes `benches/results/step_growth.{md,json,svg}`. Nothing is asserted.
 //!
-//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64] [-- --inference-threads N] [-- --engine native|tract] [-- --config FILE] [-- --no-write]`
+//! `cargo bench --bench step_growth [-- --frames N] [-- --methods imm,pr-imm] [-- --counts 8,64] [-- --inference-threads N] [-- --engine native|tract] [-- --config FILE] [-- --sequence FILE] [-- --no-write]`
+//!
+//! `--sequence FILE` replays a measurement CSV (e.g. a generated evaluation sequence) instead of
+//! the lanes, once per method.
 
 use hdrhistogram::Histogram;
 use plotters::prelude::*;
@@ -112,9 +115,20 @@ fn run<P: DisplacementPredictor>(
     count: usize,
     frames: usize,
 ) -> Row {
+    run_frames(base, method, predictor, count, &scene(count, WARM_UP_FRAMES + frames, 7 + count as u64))
+}
+
+/// Times every step of `scene` after the first [`WARM_UP_FRAMES`]; `count` is the number of
+/// objects reported in the row.
+fn run_frames<P: DisplacementPredictor>(
+    base: &Config,
+    method: Method,
+    predictor: P,
+    count: usize,
+    scene: &[Frame],
+) -> Row {
     let config = base.clone().with_modes(method.modes());
     let mut tracker = Tracker::with_predictor(config, predictor).unwrap();
-    let scene = scene(count, WARM_UP_FRAMES + frames, 7 + count as u64);
     let mut step = histogram();
     let mut stages: Vec<Histogram<u64>> = (0..Stage::TRACKER_COUNT).map(|_| histogram()).collect();
     let mut emitted = 0usize;
@@ -259,17 +273,43 @@ fn main() {
     let base = argument("--config").map_or_else(Config::default, |path| {
         primm_config::from_file(Path::new(&path)).expect("--config names a valid configuration")
     });
+    // `--sequence FILE`: a measurement CSV (e.g. a generated evaluation sequence) instead of the
+    // lanes; its frames are replayed once (the first WARM_UP_FRAMES untimed) and the row's
+    // object count is the number of distinct ground-truth objects in it.
+    let sequence = argument("--sequence").map(|path| {
+        let sequence =
+            primm_sim::io::read_sequence_file(Path::new(&path)).expect("--sequence names a measurement CSV");
+        let frames: Vec<Frame> = sequence
+            .frames
+            .iter()
+            .map(|frame| frame.to_frame().expect("a frame within the limits"))
+            .collect();
+        let objects: std::collections::BTreeSet<u64> = frames
+            .iter()
+            .flat_map(|frame| frame.measurements.iter().filter_map(|m| m.ground_truth_id))
+            .collect();
+        eprintln!("{path}: {} frames, {} objects", frames.len(), objects.len());
+        (frames, objects.len())
+    });
+    let counts = match &sequence {
+        Some((_, objects)) => vec![*objects],
+        None => counts,
+    };
     let mut rows = Vec::new();
     for &method in &methods {
         for &count in &counts {
+            let measure = |predictor: Box<dyn DisplacementPredictor>| match &sequence {
+                Some((scene, objects)) => run_frames(&base, method, predictor, *objects, scene),
+                None => run(&base, method, predictor, count, frames),
+            };
             let row = if method.needs_predictor() {
                 let mut onnx = OnnxPredictor::load(&model).expect("models/pr.onnx loads");
                 assert_eq!(onnx.set_engine(engine), engine);
                 let threaded =
                     on_inference_threads(onnx, inference_threads, Duration::from_millis(50)).unwrap();
-                run(&base, method, threaded, count, frames)
+                measure(Box::new(threaded))
             } else {
-                run(&base, method, NoPredictor, count, frames)
+                measure(Box::new(NoPredictor))
             };
             eprintln!(
                 "{} {:>3} objects: step p50 {:.1} µs, p99 {:.1} µs",

@@ -163,8 +163,11 @@ impl DisplacementPredictor for FaultyPredictor {
     }
 }
 
+/// PR-IMM with every class predicted (the faults are counted per requested track).
 fn pr_imm() -> Config {
-    Config::default().with_modes(Method::PrImm.modes())
+    let mut config = Config::default().with_modes(Method::PrImm.modes());
+    config.predictor.classes = primm_core::measurement::ClassSet::ALL;
+    config
 }
 
 /// (live tracks, confirmed tracks, assigned) of every frame of a tracker without PR: the

@@ -24,6 +24,7 @@ pub mod replay;
 use crate::replay::{Pacing, ReplayError, ReplayOptions, Replayer};
 use primm_core::readable_number::readable;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
+use primm_service::realtime::{RealtimeArgs, RealtimeRefused, RealtimeReport};
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::{read_dataset_dir, read_sequence_file, CsvError, Sequence};
 use primm_sim::scenario::{ConfigError as ScenarioConfigError, Preset, ScenarioGenerator};
@@ -77,6 +78,9 @@ pub struct Args {
     /// Prefix of the service names (`PREFIX/primm/...`).
     #[arg(long, env = SERVICE_PREFIX_ENV, default_value = "")]
     pub service_prefix: String,
+    /// Real-time settings of the replay thread (docs/realtime-tuning.md).
+    #[command(flatten)]
+    pub realtime: RealtimeArgs,
 }
 
 /// Why the publisher failed.
@@ -111,6 +115,9 @@ pub enum PublishError {
     /// The replay failed.
     #[error(transparent)]
     Replay(#[from] ReplayError),
+    /// A real-time setting could not be applied and `--require-realtime` was given.
+    #[error(transparent)]
+    Realtime(#[from] RealtimeRefused),
 }
 
 /// The built-in scenario: the default generator preset with `seed`.
@@ -159,6 +166,11 @@ pub fn run(args: Args) -> Result<(), PublishError> {
         max_in_flight: args.max_in_flight,
         answer_timeout: Duration::from_secs(5),
     };
+    let realtime = args.realtime.settings();
+    let mut report = RealtimeReport::default();
+    realtime.apply_to_current_thread("replay thread", &mut report);
+    realtime.lock_memory_now(&mut report);
+    report.finish(realtime.require_realtime)?;
     let frames: usize = sequences.iter().map(|sequence| sequence.frames.len()).sum();
     tracing::info!(
         sequences = sequences.len(),

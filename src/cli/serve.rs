@@ -12,6 +12,7 @@ use primm_predictor::split::{on_inference_threads, InferenceThreadsError, SplitP
 use primm_predictor::threaded::ThreadedPredictor;
 use primm_service::catalog::SERVICE_PREFIX_ENV;
 use primm_service::latency_files::LatencyFilesError;
+use primm_service::realtime::{RealtimeRefused, RealtimeReport, RealtimeSettings, TrackerRealtimeArgs};
 use primm_service::{
     ConnectError, PublishTime, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService,
     WaitMode,
@@ -63,6 +64,9 @@ pub struct Args {
     /// Latency files (`--latency-out DIR`).
     #[command(flatten)]
     pub latency_files: LatencyOutArgs,
+    /// Real-time settings of the tracking and inference threads (docs/realtime-tuning.md).
+    #[command(flatten)]
+    pub realtime: TrackerRealtimeArgs,
 }
 
 /// `--publish-time`.
@@ -114,6 +118,9 @@ pub enum ServeError {
     /// The latency files could not be written.
     #[error(transparent)]
     LatencyFiles(#[from] LatencyFilesError),
+    /// A real-time setting could not be applied and `--require-realtime` was given.
+    #[error(transparent)]
+    Realtime(#[from] RealtimeRefused),
 }
 
 /// Runs the service until SIGINT or SIGTERM, then prints the counters and the latency table.
@@ -134,11 +141,21 @@ pub fn run(args: Args) -> Result<(), ServeError> {
     }
     // Checked before the model and its threads are set up, so a bad value is named, not spawned.
     config.validate()?;
+    let realtime = args.realtime.settings();
+    let mut report = RealtimeReport::default();
     if args.method.needs_predictor() {
         let predictor = learned_predictor(args.model.as_deref(), &config, args.method)?;
-        serve(Tracker::with_predictor(config, predictor)?, &args)
+        for (index, part) in predictor.parts().iter().enumerate() {
+            if let Some(thread) = part.inference_thread() {
+                realtime.apply_to_inference_thread(thread, index, &mut report);
+            }
+        }
+        serve(Tracker::with_predictor(config, predictor)?, &args, &realtime, report)
     } else {
-        serve(Tracker::with_predictor(config, NoPredictor)?, &args)
+        if realtime.inference_cpu_affinity.is_some() {
+            tracing::warn!(method = %args.method, "--inference-cpu-affinity ignored: the method runs no inference thread");
+        }
+        serve(Tracker::with_predictor(config, NoPredictor)?, &args, &realtime, report)
     }
 }
 
@@ -163,8 +180,14 @@ fn learned_predictor(
         .map_err(ServeError::InferenceThread)
 }
 
-/// Serves with `tracker` until SIGINT or SIGTERM.
-fn serve<P: DisplacementPredictor>(tracker: Tracker<P>, args: &Args) -> Result<(), ServeError> {
+/// Serves with `tracker` until SIGINT or SIGTERM. The tracking thread's real-time settings
+/// and the memory lock are applied once the service is built (its allocations made).
+fn serve<P: DisplacementPredictor>(
+    tracker: Tracker<P>,
+    args: &Args,
+    realtime: &RealtimeSettings,
+    mut report: RealtimeReport,
+) -> Result<(), ServeError> {
     let shutdown = ShutdownFlag::on_signals().map_err(ServeError::Signals)?;
     let options = TrackingOptions {
         names: ServiceNames::new(&args.service_prefix),
@@ -181,6 +204,9 @@ fn serve<P: DisplacementPredictor>(tracker: Tracker<P>, args: &Args) -> Result<(
     if let Some(directory) = args.latency_files.directory() {
         service.write_latency_files(directory, args.latency_files.interval())?;
     }
+    realtime.apply_to_current_thread("tracking thread", &mut report);
+    realtime.lock_memory_now(&mut report);
+    report.finish(realtime.require_realtime)?;
     tracing::info!(
         method = %args.method,
         input = %names.measurements(),

@@ -40,6 +40,7 @@ use primm_service::catalog::{self, Ipc, SERVICE_PREFIX_ENV};
 use primm_service::clock::monotonic_ns;
 use primm_service::latency::{format_named_table, format_table, summarise, MAX_TRACKABLE_NS};
 use primm_service::latency_files::{LatencyFiles, LatencyFilesError, StageDescription};
+use primm_service::realtime::{RealtimeArgs, RealtimeRefused, RealtimeReport};
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_wire::{
@@ -90,6 +91,9 @@ pub struct Args {
     /// Length of one interval of the `.hlog` files, s.
     #[arg(long, default_value_t = 1.0, value_name = "S", value_parser = parse_positive_seconds)]
     pub latency_interval_s: f64,
+    /// Real-time settings of the receiving thread (docs/realtime-tuning.md).
+    #[command(flatten)]
+    pub realtime: RealtimeArgs,
 }
 
 /// Parses a positive, finite number of seconds (at most a day).
@@ -134,6 +138,9 @@ pub enum SubscribeError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A real-time setting could not be applied and `--require-realtime` was given.
+    #[error(transparent)]
+    Realtime(#[from] RealtimeRefused),
 }
 
 /// Percentiles of one latency, for the JSON summary.
@@ -566,6 +573,11 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
             Some(waitset.attach_interval(Duration::from_millis(200)).map_err(SubscribeError::WaitSetAttach)?);
     }
     let idle_timeout = args.idle_timeout_s.map(Duration::from_secs_f64);
+    let realtime = args.realtime.settings();
+    let mut report = RealtimeReport::default();
+    realtime.apply_to_current_thread("receiving thread", &mut report);
+    realtime.lock_memory_now(&mut report);
+    report.finish(realtime.require_realtime)?;
     loop {
         if args.busy_poll {
             std::hint::spin_loop();

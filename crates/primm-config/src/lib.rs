@@ -138,6 +138,25 @@ mod tests {
     }
 
     #[test]
+    fn predictor_classes_are_read_by_name_and_an_unknown_name_is_a_parse_error_that_names_it() {
+        use primm_core::measurement::{ClassSet, ObjectClass};
+        let line = DEFAULT_CONFIG_TOML.lines().find(|line| line.starts_with("classes = [")).unwrap();
+        let text = DEFAULT_CONFIG_TOML.replace(line, r#"classes = ["pedestrian", "car"]"#);
+        let expected = ClassSet::of(&[ObjectClass::Car, ObjectClass::Pedestrian]);
+        assert_eq!(from_toml_str(&text).unwrap().predictor.classes, expected);
+        let text = DEFAULT_CONFIG_TOML.replace(line, "classes = []");
+        assert!(from_toml_str(&text).unwrap().predictor.classes.is_empty());
+        let text = DEFAULT_CONFIG_TOML.replace(line, r#"classes = ["truck"]"#);
+        let error = from_toml_str(&text).unwrap_err();
+        assert!(matches!(error, ConfigError::Parse(_)), "{error:?}");
+        assert!(error.to_string().contains("truck"), "{error}");
+        // Written back, the set reads the same.
+        let config =
+            from_toml_str(&DEFAULT_CONFIG_TOML.replace(line, r#"classes = ["two_wheeler"]"#)).unwrap();
+        assert_eq!(from_toml_str(&to_toml_string(&config).unwrap()).unwrap(), config);
+    }
+
+    #[test]
     fn a_missing_file_names_the_file() {
         let error = from_file(Path::new("/nonexistent/primm.toml")).unwrap_err();
         assert!(error.to_string().contains("/nonexistent/primm.toml"), "{error}");

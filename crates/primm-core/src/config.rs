@@ -6,7 +6,7 @@
 //! value and names the offending key.
 
 pub use crate::existence::{ExistenceConfig, Lifecycle};
-use crate::measurement::ObjectClass;
+use crate::measurement::{ClassSet, ObjectClass};
 use crate::mode::{ModeSet, MODE_COUNT};
 use crate::readable_number::readable;
 pub use crate::tracking_frame::{FrameConfig, TrackingFrame};
@@ -73,6 +73,13 @@ pub struct PredictorConfig {
     pub inference_threads: usize,
     /// What runs the PR model's forward pass.
     pub engine: InferenceEngine,
+    /// The classes whose tracks the learned model predicts when the PR mode is one of several
+    /// active modes (PR-IMM). A track of another class gets no request, and the PR mode sits
+    /// every step of it out exactly as after a missed deadline (see `src/imm.rs`): its prior
+    /// probability is spread over the physics modes, and it keeps that probability afterwards.
+    /// With PR as the only mode (the `pr` method) every class is predicted, since the tracker
+    /// would otherwise have no motion model for the classes left out.
+    pub classes: ClassSet,
 }
 
 /// Most inference threads `predictor.inference_threads` may ask for.
@@ -87,6 +94,7 @@ impl Default for PredictorConfig {
             learned_process_noise_scale: 1.0,
             inference_threads: 2,
             engine: InferenceEngine::Native,
+            classes: ClassSet::ALL.without(ObjectClass::Car),
         }
     }
 }
@@ -142,6 +150,12 @@ pub enum LearnedProcessNoise {
 }
 
 impl PredictorConfig {
+    /// Whether the learned model predicts the tracks of `class` under the active `modes` (see
+    /// [`classes`](Self::classes)).
+    pub fn predicts(&self, class: ObjectClass, modes: ModeSet) -> bool {
+        modes.len() == 1 || self.classes.contains(class)
+    }
+
     /// The deadline as a duration.
     pub fn deadline(&self) -> core::time::Duration {
         core::time::Duration::from_secs_f64(self.deadline_ms / 1000.0)

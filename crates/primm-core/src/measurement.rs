@@ -68,6 +68,68 @@ impl core::fmt::Display for ObjectClass {
     }
 }
 
+/// A set of object classes, as a bit mask indexed by [`ObjectClass::index`]. In configuration
+/// files it is a list of class names (`["pedestrian", "two_wheeler"]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct ClassSet(u8);
+
+impl ClassSet {
+    /// No class.
+    pub const EMPTY: ClassSet = ClassSet(0);
+    /// Every class.
+    pub const ALL: ClassSet = ClassSet((1 << ObjectClass::COUNT) - 1);
+
+    /// The set of the given classes.
+    pub fn of(classes: &[ObjectClass]) -> Self {
+        classes.iter().fold(Self::EMPTY, |set, &class| set.with(class))
+    }
+
+    /// This set plus `class`.
+    pub fn with(self, class: ObjectClass) -> Self {
+        ClassSet(self.0 | (1 << class.index()))
+    }
+
+    /// This set without `class`.
+    pub fn without(self, class: ObjectClass) -> Self {
+        ClassSet(self.0 & !(1 << class.index()))
+    }
+
+    /// Whether `class` is in the set.
+    pub fn contains(self, class: ObjectClass) -> bool {
+        self.0 & (1 << class.index()) != 0
+    }
+
+    /// Number of classes in the set.
+    pub fn len(self) -> usize {
+        self.0.count_ones() as usize
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The classes of the set in code order.
+    pub fn iter(self) -> impl Iterator<Item = ObjectClass> {
+        ObjectClass::ALL.into_iter().filter(move |&class| self.contains(class))
+    }
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for ClassSet {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_seq(self.iter())
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for ClassSet {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let classes = alloc::vec::Vec::<ObjectClass>::deserialize(deserializer)?;
+        Ok(ClassSet::of(&classes))
+    }
+}
+
 /// One object-level radar measurement (`eq:measurement_full`) with its class.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

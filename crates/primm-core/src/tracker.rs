@@ -158,7 +158,8 @@ pub struct StepSummary {
     /// Tracks deleted.
     pub deleted: usize,
     /// Tracks for which the PR mode had no usable learned displacement and sat out (none given,
-    /// or rejected: the next three counts).
+    /// or rejected: the next three counts). Tracks of a class outside `predictor.classes` are
+    /// never requested and not counted here.
     pub predictions_missing: usize,
     /// Learned displacements rejected for a NaN or infinite component.
     pub predictions_rejected_non_finite: usize,
@@ -293,6 +294,11 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     last_pose: Option<EgoPose>,
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
+    /// The table row of each request's track (`predictor.classes` may leave tracks out).
+    requested_rows: Box<ArrayVec<u16, MAX_TRACKS>>,
+    /// The predictor's answers, aligned with `requests`.
+    answers: Box<[Option<Displacement>; MAX_TRACKS]>,
+    /// Each track's checked displacement, aligned with the table (`None`: the PR mode sits out).
     displacements: Box<[Option<Displacement>; MAX_TRACKS]>,
     /// Each track's prior of the current frame (the first `table.len()` entries).
     priors: Box<[ImmPrior]>,
@@ -348,6 +354,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             step_pose: None,
             last_pose: None,
             requests: Box::new(ArrayVec::new()),
+            requested_rows: Box::new(ArrayVec::new()),
+            answers: Box::new([None; MAX_TRACKS]),
             displacements: Box::new([None; MAX_TRACKS]),
             priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
             dt_s: 0.0,
@@ -687,13 +695,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
         Ok(dt_s)
     }
 
-    /// Hands every track's history (`eq:pr_input`) to the learned predictor.
+    /// Hands the history (`eq:pr_input`) of every track of a class in `predictor.classes` to
+    /// the learned predictor.
     fn request_learned_predictions(&mut self, t: f64) {
         self.requests.clear();
-        if !self.config.imm.modes.contains(Mode::Learned) {
+        self.requested_rows.clear();
+        let modes = self.config.imm.modes;
+        if !modes.contains(Mode::Learned) {
             return;
         }
-        for track in self.table.tracks() {
+        for (row, track) in self.table.tracks().iter().enumerate() {
+            if !self.config.predictor.predicts(track.class, modes) {
+                continue;
+            }
             let (older, newer) = track.history.as_slices();
             let mut window = [Default::default(); crate::predictor::MAX_HISTORY];
             let len = older.len() + newer.len();
@@ -702,6 +716,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let step_start = self.last_timestamp_s.unwrap_or(t);
             self.requests
                 .push(PredictionRequest::from_history(&window[..len], t).with_step_start(step_start));
+            // The table holds at most MAX_TRACKS (512) rows, so the row fits in u16.
+            self.requested_rows.push(row as u16);
         }
         self.predictor.submit(&self.requests);
     }
@@ -765,17 +781,18 @@ impl<P: DisplacementPredictor> Tracker<P> {
         )
     }
 
-    /// Collects and checks the displacements (`displacement_check.rs`); the PR priors and the
-    /// fused priors (`eq:prior_fusion`).
+    /// Collects and checks the displacements (`displacement_check.rs`) and hands each to its
+    /// track's row (a track without a request gets none); the PR priors and the fused priors
+    /// (`eq:prior_fusion`).
     fn fuse_priors(&mut self) {
         let count = self.table.len();
         let displacements = &mut self.displacements[..count];
-        if self.requests.is_empty() {
-            displacements.fill(None);
-        } else {
-            self.predictor.collect(displacements);
+        displacements.fill(None);
+        if !self.requests.is_empty() {
+            let answers = &mut self.answers[..self.requests.len()];
+            self.predictor.collect(answers);
             let predictor = &self.config.predictor;
-            for (displacement, request) in displacements.iter_mut().zip(self.requests.iter()) {
+            for (displacement, request) in answers.iter_mut().zip(self.requests.iter()) {
                 let Some(answer) = displacement.as_mut() else { continue };
                 let counter = match check_answer(request, answer, predictor.max_displacement_speed_mps) {
                     Ok(()) => {
@@ -800,7 +817,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 *counter += 1;
                 *displacement = None;
             }
-            self.last_step.predictions_missing = displacements.iter().filter(|d| d.is_none()).count();
+            self.last_step.predictions_missing = answers.iter().filter(|d| d.is_none()).count();
+            for (answer, &row) in answers.iter().zip(self.requested_rows.iter()) {
+                displacements[usize::from(row)] = *answer;
+            }
         }
         track_loops::complete_priors(
             &self.imms,

@@ -255,6 +255,15 @@ impl ThreadedPredictor {
         }
     }
 
+    /// The inference thread's POSIX handle, for settings made from outside (CPU affinity,
+    /// scheduling policy); `None` once the thread has been joined or detached. The handle stays
+    /// valid while this predictor keeps the thread's join handle, even after the thread ended.
+    #[cfg(unix)]
+    pub fn inference_thread(&self) -> Option<std::os::unix::thread::RawPthread> {
+        use std::os::unix::thread::JoinHandleExt;
+        self.worker.as_ref().map(JoinHandleExt::as_pthread_t)
+    }
+
     /// Whether a batch has been with the inference thread for at least the hang threshold
     /// (as of the latest `submit` or `collect`).
     pub fn is_inference_thread_hung(&self) -> bool {

@@ -17,6 +17,7 @@
 //! - [`shutdown`]: SIGINT/SIGTERM handling.
 //! - [`log_limit`]: bounded logging of repeated faults.
 //! - [`logging`]: the programs' log output.
+//! - [`realtime`]: CPU affinity, `SCHED_FIFO` priority and locked memory for the programs' threads.
 //!
 //! The publisher's replay loop and the subscriber's loop live in the `primm-publisher` and
 //! `primm-subscriber` packages; both use [`catalog`] to open the same services.
@@ -47,6 +48,7 @@ pub mod latency_files;
 pub mod latency_plot;
 pub mod log_limit;
 pub mod logging;
+pub mod realtime;
 pub mod shutdown;
 pub mod tracking;
 
