@@ -47,8 +47,10 @@ fn load_sequences() -> BTreeMap<String, Vec<AssociationRecord>> {
             class: ObjectClass::Car,
             measured: DVec2::ZERO,
             true_position: None,
+            true_velocity: None,
             track_id,
             prior: None,
+            velocity: None,
             mode_probabilities: None,
             track_confirmed: Some(track_id.is_some()),
         });

@@ -56,8 +56,10 @@ fn scene(
                 class: ObjectClass::Car,
                 measured: truth,
                 true_position: Some(truth),
+                true_velocity: None,
                 track_id: Some(track),
                 prior: (k > 0).then_some(estimate),
+                velocity: None,
                 mode_probabilities: Some([0.35, 0.2, 0.3, 0.15]),
                 track_confirmed: Some(true),
             });

@@ -539,6 +539,11 @@ fn csv_round_trip_of_a_generated_sequence_is_exact() {
     write_sequence(&mut bytes, &sequence).expect("write");
     let back = read_sequence(bytes.as_slice(), &sequence.name).expect("read");
     assert_eq!(back, sequence);
+    // The true velocities travel with every real measurement.
+    let measurements = back.frames.iter().flat_map(|f| &f.measurements);
+    assert!(measurements.clone().count() > 100);
+    assert!(measurements.clone().all(|m| m.true_velocity.is_some()));
+    assert!(measurements.clone().any(|m| m.true_velocity.is_some_and(|v| v.length() > 5.0)));
     // Conversion to library frames keeps ground-truth ids and classes.
     for (recorded, frame) in back.frames.iter().zip(back.to_frames().expect("frames")) {
         assert_eq!(frame.timestamp_s, recorded.timestamp_s);

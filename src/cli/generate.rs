@@ -50,6 +50,18 @@ pub enum PresetChoice {
     /// The turning scene with the clutter preset's false detections.
     #[value(name = "clutter_turning", alias = "clutter-turning")]
     ClutterTurning,
+    /// The default scene with vehicles measured as extended objects: detections from the
+    /// visible contour and corners of each box, now and then several per vehicle and scan.
+    Extended,
+    /// The turning scene with extended vehicles.
+    #[value(name = "extended_turning", alias = "extended-turning")]
+    ExtendedTurning,
+    /// The clutter scene with extended vehicles.
+    #[value(name = "extended_clutter", alias = "extended-clutter")]
+    ExtendedClutter,
+    /// The clutter-turning scene with extended vehicles.
+    #[value(name = "extended_clutter_turning", alias = "extended-clutter-turning")]
+    ExtendedClutterTurning,
 }
 
 impl From<PresetChoice> for Preset {
@@ -60,6 +72,10 @@ impl From<PresetChoice> for Preset {
             PresetChoice::Turning => Preset::Turning,
             PresetChoice::Clutter => Preset::Clutter,
             PresetChoice::ClutterTurning => Preset::ClutterTurning,
+            PresetChoice::Extended => Preset::Extended,
+            PresetChoice::ExtendedTurning => Preset::ExtendedTurning,
+            PresetChoice::ExtendedClutter => Preset::ExtendedClutter,
+            PresetChoice::ExtendedClutterTurning => Preset::ExtendedClutterTurning,
         }
     }
 }

@@ -129,8 +129,10 @@ impl AccuracyMonitor {
                 class: measurement.class,
                 measured: measurement.measured,
                 true_position: measurement.true_position,
+                true_velocity: None,
                 track_id: track.map(|t| t.id),
                 prior: track.and_then(|t| t.prior_m()).map(DVec2::from),
+                velocity: None,
                 mode_probabilities: track.map(|t| t.mode_probabilities),
                 // Wire status 0 is tentative; every other status counts as confirmed.
                 track_confirmed: Some(track.is_some_and(|t| t.status != 0)),

@@ -80,6 +80,7 @@ pub fn association_records(
         if let Some(record) = records.get_mut(start + usize::from(index)) {
             record.track_id = Some(output.id);
             record.prior = output.prior_position_m;
+            record.velocity = Some(output.velocity_mps);
             record.track_confirmed = Some(counts_as_confirmed(output.status));
             if with_modes && output.prior_position_m.is_some() {
                 record.mode_probabilities = Some(output.mode_probabilities);
@@ -126,6 +127,7 @@ mod tests {
                     ground_truth_id: Some(1),
                 },
                 true_position: None,
+                true_velocity: None,
             });
             sequence.frames.push(frame);
         }

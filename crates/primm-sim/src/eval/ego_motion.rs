@@ -128,8 +128,10 @@ mod tests {
                 class: primm_core::measurement::ObjectClass::Car,
                 measured: glam::DVec2::ZERO,
                 true_position: None,
+                true_velocity: None,
                 track_id: None,
                 prior: None,
+                velocity: None,
                 mode_probabilities: None,
                 track_confirmed: Some(false),
             })

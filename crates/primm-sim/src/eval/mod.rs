@@ -16,6 +16,8 @@
 //! * mean IMM mode probabilities ([`modes`]),
 //! * the ego vehicle's motion (straight or turning) of each frame, for Tables II and IV split
 //!   by it ([`ego_motion`]),
+//! * velocity RMSE of the tracks and speed and heading errors of confirmed tracks, where the
+//!   data carry true velocities ([`velocity`]),
 //!
 //! and assembles them into plain-text tables and JSON ([`report`]) and SVG figures ([`plots`]).
 //! The exact definitions, thresholds and units are documented in `docs/evaluation-metrics.md`.
@@ -33,6 +35,7 @@ pub mod record;
 pub mod report;
 pub mod rmse;
 pub mod scenario;
+pub mod velocity;
 
 pub use confirmed::{
     confirmed_track_counts, tracks_born_of_clutter, ConfirmedTrackCounts, UnknownTrackStatus,
@@ -48,3 +51,4 @@ pub use record::{counts_as_confirmed, AssociationRecord, EvalError, Method};
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;
 pub use scenario::{classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules};
+pub use velocity::{SpeedHeadingAccumulator, VelocityRmseAccumulator, HEADING_MIN_TRUE_SPEED_MPS};

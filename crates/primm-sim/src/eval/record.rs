@@ -30,11 +30,20 @@ pub struct AssociationRecord {
     /// True object position when the data source knows it (simulation); otherwise the measurement
     /// is the reference position.
     pub true_position: Option<DVec2>,
+    /// True velocity over ground of the object in the vehicle frame's axes when the data source
+    /// knows it (simulation), m/s.
+    #[serde(default)]
+    pub true_velocity: Option<DVec2>,
     /// Track that this measurement updated or started; `None` when no track took it.
     pub track_id: Option<u64>,
     /// The track's fused one-step prior position before this update (`eq:prior_fusion` for the
     /// IMM variants); `None` when the measurement started a track or was not used.
     pub prior: Option<DVec2>,
+    /// The track's fused velocity estimate after this update, in the vehicle frame's axes, m/s
+    /// (`TrackOutput::velocity_mps`); `None` when no track took the measurement or the source
+    /// does not give it.
+    #[serde(default)]
+    pub velocity: Option<DVec2>,
     /// Posterior mode probabilities after the update, in PR, CV, CA, CT order
     /// (`eq:mode_update`); `None` for single-model methods and rows without an update. A mode the
     /// method does not have carries probability 0.
@@ -125,8 +134,10 @@ pub(crate) mod test_support {
             class: ObjectClass::Car,
             measured: DVec2::ZERO,
             true_position: None,
+            true_velocity: None,
             track_id: track,
             prior: None,
+            velocity: None,
             mode_probabilities: None,
             track_confirmed: Some(track.is_some()),
         }
@@ -141,8 +152,10 @@ pub(crate) mod test_support {
             class: ObjectClass::Car,
             measured: position,
             true_position: Some(position),
+            true_velocity: None,
             track_id: Some(gt),
             prior: None,
+            velocity: None,
             mode_probabilities: None,
             track_confirmed: Some(true),
         }

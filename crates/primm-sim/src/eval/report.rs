@@ -4,7 +4,8 @@
 //! [`MethodResult`] holds additive counters only, so results of separately evaluated sequences
 //! can be merged. [`EvaluationReport`] collects the results of all methods, prints
 //!
-//! * Table II (`tab:prior_rmse`): RMSE_x, RMSE_y, RMSE_xy per method,
+//! * Table II (`tab:prior_rmse`): RMSE_x, RMSE_y, RMSE_xy per method, by class, and the
+//!   velocity errors (velocity RMSE per class, speed and heading errors of confirmed tracks),
 //! * Table III (`tab:scenario_rmse`): RMSE_xy per motion scenario (rows) and method (columns),
 //! * Table IV (`tab:overall_mot`): IDSW and IDF1 per method,
 //! * Table V (`tab:scenario_mot`): IDSW and IDF1 per interaction/missed-detection scenario
@@ -32,6 +33,7 @@ use super::modes::{ModeProbabilityAccumulator, MODE_NAMES};
 use super::record::{AssociationRecord, EvalError, Method};
 use super::rmse::RmseAccumulator;
 use super::scenario::{classify_sequence, MotionCategory, ScenarioRules};
+use super::velocity::{SpeedHeadingAccumulator, VelocityRmseAccumulator, HEADING_MIN_TRUE_SPEED_MPS};
 
 /// Drop rates, in percent, of the missed-detection rows printed even without data.
 pub const DEFAULT_MISS_PERCENTS: [u32; 2] = [10, 20];
@@ -75,6 +77,18 @@ pub struct MethodResult {
     /// not say whether their tracks were confirmed (then the counts of the others would mislead).
     #[serde(default)]
     pub confirmed: Option<ConfirmedTrackCounts>,
+    /// Velocity RMSE over the rows of the prior RMSE that carry both velocities.
+    #[serde(default)]
+    pub velocity: VelocityRmseAccumulator,
+    /// Velocity RMSE per object class.
+    #[serde(default)]
+    pub class_velocity: BTreeMap<ObjectClass, VelocityRmseAccumulator>,
+    /// Speed and heading errors of confirmed tracks.
+    #[serde(default)]
+    pub confirmed_motion: SpeedHeadingAccumulator,
+    /// Speed and heading errors of confirmed tracks per object class.
+    #[serde(default)]
+    pub class_confirmed_motion: BTreeMap<ObjectClass, SpeedHeadingAccumulator>,
 }
 
 impl MethodResult {
@@ -96,6 +110,10 @@ impl MethodResult {
             ego_rmse: BTreeMap::new(),
             ego_identity: BTreeMap::new(),
             confirmed: Some(ConfirmedTrackCounts::default()),
+            velocity: VelocityRmseAccumulator::new(),
+            class_velocity: BTreeMap::new(),
+            confirmed_motion: SpeedHeadingAccumulator::new(),
+            class_confirmed_motion: BTreeMap::new(),
         }
     }
 
@@ -135,6 +153,14 @@ impl MethodResult {
         match (&mut self.confirmed, &other.confirmed) {
             (Some(mine), Some(theirs)) => mine.merge(theirs),
             _ => self.confirmed = None,
+        }
+        self.velocity.merge(&other.velocity);
+        for (class, acc) in &other.class_velocity {
+            self.class_velocity.entry(*class).or_default().merge(acc);
+        }
+        self.confirmed_motion.merge(&other.confirmed_motion);
+        for (class, acc) in &other.class_confirmed_motion {
+            self.class_confirmed_motion.entry(*class).or_default().merge(acc);
         }
     }
 
@@ -186,6 +212,12 @@ impl MethodEvaluator {
         for (record, label) in records.iter().zip(&labels) {
             result.rmse.push_record(record);
             result.class_rmse.entry(record.class).or_default().push_record(record);
+            if result.velocity.push_record(record) {
+                result.class_velocity.entry(record.class).or_default().push_record(record);
+            }
+            if result.confirmed_motion.push_record(record) {
+                result.class_confirmed_motion.entry(record.class).or_default().push_record(record);
+            }
             if result.modes.push_record(record) {
                 result.class_modes.entry(record.class).or_default().push_record(record);
             }
@@ -362,6 +394,95 @@ impl EvaluationReport {
         let mut text =
             render_table("Table II by class. One-step prior prediction RMSE_xy [m]", &header, &rows);
         self.append_notes(&mut text, "* lowest value in its row");
+        text
+    }
+
+    /// Table II, velocity: per method (rows) the velocity RMSE over all classes and per class
+    /// (over the rows of the prior RMSE), and the speed RMSE, mean speed error and heading RMSE
+    /// of confirmed tracks. Values are `n/a` where the data carry no true velocity.
+    pub fn table_velocity(&self) -> String {
+        let classes: Vec<ObjectClass> = ObjectClass::ALL
+            .into_iter()
+            .filter(|class| {
+                Method::ALL
+                    .iter()
+                    .any(|m| self.result(*m).is_some_and(|r| r.class_velocity.contains_key(class)))
+            })
+            .collect();
+        let mut header = vec!["Model".to_string(), "v RMSE [m/s]".to_string()];
+        header.extend(classes.iter().map(|class| format!("{} [m/s]", class.name())));
+        header.extend(
+            ["N", "speed RMSE [m/s]", "speed bias [m/s]", "heading RMSE [deg]", "N confirmed"]
+                .iter()
+                .map(|s| s.to_string()),
+        );
+        type Metric<'a> = Box<dyn Fn(&MethodResult) -> Option<f64> + 'a>;
+        let mut metrics: Vec<(Metric, usize)> = vec![(Box::new(|r: &MethodResult| r.velocity.rmse_mps()), 3)];
+        for class in &classes {
+            metrics.push((
+                Box::new(move |r: &MethodResult| r.class_velocity.get(class).and_then(|a| a.rmse_mps())),
+                3,
+            ));
+        }
+        let columns: Vec<Vec<Cell>> = metrics
+            .iter()
+            .map(|(metric, digits)| {
+                let values: Vec<Option<f64>> =
+                    Method::ALL.iter().map(|m| self.result(*m).and_then(metric)).collect();
+                mark_best(&values, Better::Lower, *digits)
+            })
+            .collect();
+        let motion: [(fn(&SpeedHeadingAccumulator) -> Option<f64>, usize, bool); 3] = [
+            (SpeedHeadingAccumulator::speed_rmse_mps, 3, true),
+            (SpeedHeadingAccumulator::speed_mean_error_mps, 3, false),
+            (SpeedHeadingAccumulator::heading_rmse_deg, 2, true),
+        ];
+        let motion_columns: Vec<Vec<Cell>> = motion
+            .iter()
+            .map(|(metric, digits, marked)| {
+                let values: Vec<Option<f64>> = Method::ALL
+                    .iter()
+                    .map(|m| self.result(*m).and_then(|r| metric(&r.confirmed_motion)))
+                    .collect();
+                if *marked {
+                    mark_best(&values, Better::Lower, *digits)
+                } else {
+                    mark_best(&values, Better::Lower, *digits).into_iter().map(Cell::unmarked).collect()
+                }
+            })
+            .collect();
+        let rows = Method::ALL
+            .iter()
+            .enumerate()
+            .map(|(row, method)| {
+                let result = self.result(*method);
+                let mut line = vec![method.row_label().to_string(), columns[0][row].to_string()];
+                line.extend(columns[1..].iter().map(|column| column[row].to_string()));
+                line.push(result.map_or_else(|| "n/a".into(), |r| group_thousands(r.velocity.count())));
+                line.extend(motion_columns.iter().map(|column| column[row].to_string()));
+                line.push(
+                    result
+                        .map_or_else(|| "n/a".into(), |r| group_thousands(r.confirmed_motion.speed_count())),
+                );
+                line
+            })
+            .collect::<Vec<_>>();
+        let mut text = render_table(
+            "Table II, velocity. Fused track velocity after the update against the true velocity",
+            &header,
+            &rows,
+        );
+        self.append_notes(
+            &mut text,
+            &format!(
+                "* lowest value in its column; v RMSE over the rows of the prior RMSE (N); speed and \
+                 heading of confirmed tracks (N confirmed; heading only where the true speed is at least \
+                 {HEADING_MIN_TRUE_SPEED_MPS} m/s); speed bias = mean of estimated minus true speed"
+            ),
+        );
+        if self.results.values().all(|r| r.velocity.count() == 0 && r.confirmed_motion.speed_count() == 0) {
+            let _ = writeln!(text, "n/a: the data carry no true velocity (columns true_vx, true_vy)");
+        }
         text
     }
 
@@ -620,6 +741,7 @@ impl EvaluationReport {
         [
             self.table_prior_rmse(),
             self.table_class_rmse(),
+            self.table_velocity(),
             self.table_scenario_rmse(),
             self.table_overall_mot(),
             self.table_scenario_mot(),
@@ -659,6 +781,7 @@ impl EvaluationReport {
                     "counts": null,
                     "scenarios": {},
                     "confirmed_tracks": null,
+                    "velocity": null,
                 }),
             };
             methods.insert(method.key().to_string(), value);
@@ -742,6 +865,7 @@ impl EvaluationReport {
             },
             "scenarios": scenarios,
             "confirmed_tracks": result.confirmed.as_ref().map(ConfirmedTrackCounts::to_json),
+            "velocity": velocity_json(result),
         })
     }
 
@@ -791,6 +915,47 @@ fn metric_row(
     line
 }
 
+/// The `velocity` entry of a method: the velocity RMSE overall and per class, and the speed and
+/// heading errors of confirmed tracks, overall and per class.
+fn velocity_json(result: &MethodResult) -> Value {
+    let rmse = |acc: &VelocityRmseAccumulator| {
+        json!({
+            "rmse_mps": acc.rmse_mps(),
+            "rmse_x_mps": acc.rmse_x_mps(),
+            "rmse_y_mps": acc.rmse_y_mps(),
+            "samples": acc.count(),
+        })
+    };
+    let motion = |acc: &SpeedHeadingAccumulator| {
+        json!({
+            "speed_rmse_mps": acc.speed_rmse_mps(),
+            "speed_mean_error_mps": acc.speed_mean_error_mps(),
+            "speed_samples": acc.speed_count(),
+            "heading_rmse_deg": acc.heading_rmse_deg(),
+            "heading_mean_abs_error_deg": acc.heading_mean_abs_deg(),
+            "heading_samples": acc.heading_count(),
+        })
+    };
+    let mut value = rmse(&result.velocity);
+    let by_class: Map<String, Value> =
+        result.class_velocity.iter().map(|(class, acc)| (class.name().to_string(), rmse(acc))).collect();
+    let mut confirmed = motion(&result.confirmed_motion);
+    let confirmed_by_class: Map<String, Value> = result
+        .class_confirmed_motion
+        .iter()
+        .map(|(class, acc)| (class.name().to_string(), motion(acc)))
+        .collect();
+    if let Some(object) = confirmed.as_object_mut() {
+        object.insert("by_class".into(), Value::Object(confirmed_by_class));
+    }
+    if let Some(object) = value.as_object_mut() {
+        object.insert("by_class".into(), Value::Object(by_class));
+        object.insert("confirmed_tracks".into(), confirmed);
+        object.insert("heading_min_true_speed_mps".into(), json!(HEADING_MIN_TRUE_SPEED_MPS));
+    }
+    value
+}
+
 fn identity_json(counts: &IdentityCounts) -> Value {
     json!({
         "idsw": counts.idsw,
@@ -821,6 +986,17 @@ enum Better {
 enum Cell {
     Missing,
     Value { text: String, best: bool },
+}
+
+impl Cell {
+    /// The same cell without a best-value mark (for a signed quantity such as a bias, where
+    /// lower is not better).
+    fn unmarked(self) -> Cell {
+        match self {
+            Cell::Value { text, .. } => Cell::Value { text, best: false },
+            Cell::Missing => Cell::Missing,
+        }
+    }
 }
 
 impl std::fmt::Display for Cell {
@@ -1001,6 +1177,83 @@ mod tests {
         // Mode probabilities averaged over 24 updates: (0.25, 0.25, 0.25, 0.25).
         let mean = result.modes.mean().unwrap();
         assert!(mean.iter().all(|p| (p - 0.25).abs() < 1e-12));
+    }
+
+    #[test]
+    fn velocity_errors_are_reported_per_class_in_the_table_and_the_json() {
+        // Object 1 (car): true (10, 0), estimate (10, 1): error 1 m/s, heading atan(0.1).
+        // Object 2 (pedestrian): true (1, 0), estimate (4, 0): error 3 m/s, heading 0.
+        // Object 1's first row is a tentative track's: no speed or heading sample there.
+        let mut records = sequence(0.5);
+        for record in &mut records {
+            if record.ground_truth_id == Some(1) {
+                record.true_velocity = Some(DVec2::new(10.0, 0.0));
+                record.velocity = Some(DVec2::new(10.0, 1.0));
+            } else {
+                record.class = ObjectClass::Pedestrian;
+                record.true_velocity = Some(DVec2::new(1.0, 0.0));
+                record.velocity = Some(DVec2::new(4.0, 0.0));
+            }
+        }
+        records[0].track_confirmed = Some(false);
+        let mut evaluator = MethodEvaluator::new(Method::Imm);
+        evaluator.add_sequence(&records);
+        let imm = evaluator.finish();
+        // Rows with a prior: 11 of object 1, 10 of object 2.
+        assert_eq!(imm.velocity.count(), 21);
+        let expected = ((11.0 * 1.0 + 10.0 * 9.0) / 21.0f64).sqrt();
+        assert!((imm.velocity.rmse_mps().unwrap() - expected).abs() < 1e-12);
+        assert_eq!(imm.class_velocity[&ObjectClass::Car].rmse_mps(), Some(1.0));
+        assert_eq!(imm.class_velocity[&ObjectClass::Pedestrian].rmse_mps(), Some(3.0));
+        // Confirmed rows: 11 of object 1, 12 of object 2 (starting rows included).
+        let motion = imm.confirmed_motion;
+        assert_eq!((motion.speed_count(), motion.heading_count()), (23, 23));
+        let car_speed_error = 101f64.sqrt() - 10.0;
+        let speed_rmse = ((11.0 * car_speed_error.powi(2) + 12.0 * 9.0) / 23.0).sqrt();
+        assert!((motion.speed_rmse_mps().unwrap() - speed_rmse).abs() < 1e-12);
+        let heading_rmse = (11.0 * 0.1f64.atan().powi(2) / 23.0).sqrt().to_degrees();
+        assert!((motion.heading_rmse_deg().unwrap() - heading_rmse).abs() < 1e-9);
+
+        // Merging two halves gives the joint result.
+        let mut merged = evaluate(Method::Imm, 0.5);
+        merged.merge(&imm);
+        assert_eq!(merged.velocity, imm.velocity);
+        assert_eq!(merged.class_confirmed_motion, imm.class_confirmed_motion);
+
+        let mut report = EvaluationReport::new();
+        report.insert(imm);
+        report.insert(evaluate(Method::ConstantVelocity, 1.0)); // rows without velocities
+        let table = report.table_velocity();
+        assert!(table.starts_with("Table II, velocity"), "{table}");
+        // Only one method has values: nothing is marked.
+        let cells = row(&table, "IMM (CV+CA+CT)");
+        assert_eq!(cells[..4], [format!("{expected:.3}"), "1.000".into(), "3.000".into(), "21".into()]);
+        assert_eq!(cells[4], format!("{speed_rmse:.3}"));
+        assert_eq!(cells[6], format!("{heading_rmse:.2}"));
+        assert_eq!(cells[7], "23");
+        assert_eq!(row(&table, "CV "), vec!["n/a", "n/a", "n/a", "0", "n/a", "n/a", "n/a", "0"]);
+        assert!(!table.contains("the data carry no true velocity"));
+        assert!(report.to_text().contains("Table II, velocity"));
+
+        let json = report.to_json();
+        let velocity = &json["methods"]["imm"]["velocity"];
+        assert!((velocity["rmse_mps"].as_f64().unwrap() - expected).abs() < 1e-12);
+        assert_eq!(velocity["samples"], json!(21));
+        assert_eq!(velocity["by_class"]["pedestrian"]["rmse_mps"], json!(3.0));
+        assert_eq!(velocity["by_class"]["car"]["rmse_x_mps"], json!(0.0));
+        let confirmed = &velocity["confirmed_tracks"];
+        assert_eq!(confirmed["speed_samples"], json!(23));
+        assert_eq!(confirmed["by_class"]["pedestrian"]["speed_mean_error_mps"], json!(3.0));
+        assert_eq!(confirmed["by_class"]["pedestrian"]["heading_rmse_deg"], json!(0.0));
+        assert_eq!(velocity["heading_min_true_speed_mps"], json!(HEADING_MIN_TRUE_SPEED_MPS));
+        assert!(json["methods"]["cv"]["velocity"]["rmse_mps"].is_null());
+        assert_eq!(json["methods"]["cv"]["velocity"]["samples"], json!(0));
+        assert!(json["methods"]["pr"]["velocity"].is_null());
+
+        // Data without true velocities say so.
+        let mut report = EvaluationReport::new();
+        report.insert(evaluate(Method::Imm, 1.0));
+        assert!(report.table_velocity().contains("n/a: the data carry no true velocity"));
     }
 
     #[test]

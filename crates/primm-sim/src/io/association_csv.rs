@@ -294,6 +294,7 @@ mod tests {
                         ground_truth_id: Some(j),
                     },
                     true_position: None,
+                    true_velocity: None,
                 });
             }
             sequence.frames.push(frame);

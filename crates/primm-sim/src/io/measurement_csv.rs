@@ -6,9 +6,10 @@
 //! frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw
 //! ```
 //!
-//! The first ten columns are required; `sensor_id`, `ego_x`, `ego_y` and `ego_yaw` are optional
-//! and unknown columns are ignored. The reader finds columns by name, so their order does not
-//! matter; the writer always writes all fourteen in the order above.
+//! followed by `true_vx,true_vy`. The first ten columns are required; `sensor_id`, `ego_x`,
+//! `ego_y`, `ego_yaw`, `true_vx` and `true_vy` are optional and unknown columns are ignored. The
+//! reader finds columns by name, so their order does not matter; the writer always writes all
+//! sixteen in the order above.
 //!
 //! * `frame`: 0-based frame index, non-decreasing from row to row; all rows of one frame are
 //!   consecutive and a larger index starts a new frame. Indices may skip values.
@@ -23,10 +24,12 @@
 //! * `sensor_id`: radar that produced the frame (frame-level, same on every row of a frame).
 //! * `ego_x`, `ego_y`, `ego_yaw`: ego pose in the world frame, metres and radians; all three or
 //!   none (frame-level).
+//! * `true_vx`, `true_vy`: true velocity over ground of the object's centre in the car frame's
+//!   axes, m/s, or both empty.
 //!
 //! A frame without measurements is written as one *empty-frame row*: `frame`, `t` and the
-//! frame-level columns filled, every measurement column (`gt_id` … `true_y`) empty. Such a row
-//! must be the only row of its frame.
+//! frame-level columns filled, every measurement column (`gt_id` … `true_y`, `true_vx`,
+//! `true_vy`) empty. Such a row must be the only row of its frame.
 //!
 //! Floats are written with Rust's shortest representation that parses back to the same `f64`,
 //! so a write/read round trip is exact. Lines starting with `#` are comments.
@@ -47,6 +50,9 @@ pub const REQUIRED_COLUMNS: [&str; 10] =
 
 /// Optional frame-level columns understood by the reader.
 pub const OPTIONAL_COLUMNS: [&str; 4] = ["sensor_id", "ego_x", "ego_y", "ego_yaw"];
+
+/// Optional measurement columns understood by the reader: the true velocity, m/s.
+pub const TRUE_VELOCITY_COLUMNS: [&str; 2] = ["true_vx", "true_vy"];
 
 /// Columns holding measurement values; all empty on an empty-frame row.
 const MEASUREMENT_COLUMNS: [&str; 8] = ["gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y"];
@@ -110,7 +116,8 @@ pub enum CsvErrorKind {
         /// Value on this row.
         found: String,
     },
-    /// Only some of `ego_x`, `ego_y`, `ego_yaw` (or of `true_x`, `true_y`) are given.
+    /// Only some of `ego_x`, `ego_y`, `ego_yaw` (or of `true_x`, `true_y`, or of `true_vx`,
+    /// `true_vy`) are given.
     #[error("incomplete group: the columns {0} must be all given or all empty")]
     IncompleteGroup(&'static str),
     /// An empty-frame row shares its frame with other rows.
@@ -220,7 +227,12 @@ fn fmt_opt_f64(value: Option<f64>) -> Result<String, CsvErrorKind> {
 /// without measurements).
 pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), CsvError> {
     let mut out = csv::WriterBuilder::new().has_headers(false).from_writer(writer);
-    let header: Vec<&str> = REQUIRED_COLUMNS.iter().chain(OPTIONAL_COLUMNS.iter()).copied().collect();
+    let header: Vec<&str> = REQUIRED_COLUMNS
+        .iter()
+        .chain(OPTIONAL_COLUMNS.iter())
+        .chain(TRUE_VELOCITY_COLUMNS.iter())
+        .copied()
+        .collect();
     out.write_record(&header).map_err(CsvError::from_csv)?;
     let mut line = 1u64;
     let mut written = std::collections::HashSet::new();
@@ -246,6 +258,7 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
             row.extend(std::iter::repeat_n(String::new(), MEASUREMENT_COLUMNS.len()));
             row.push(sensor.clone());
             row.extend(ego.iter().cloned());
+            row.extend(std::iter::repeat_n(String::new(), TRUE_VELOCITY_COLUMNS.len()));
             out.write_record(&row).map_err(CsvError::from_csv)?;
             continue;
         }
@@ -271,6 +284,8 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
                 ego[0].clone(),
                 ego[1].clone(),
                 ego[2].clone(),
+                fmt_opt_f64(recorded.true_velocity.map(|v| v.x)).map_err(|k| fail(line, k))?,
+                fmt_opt_f64(recorded.true_velocity.map(|v| v.y)).map_err(|k| fail(line, k))?,
             ];
             out.write_record(&row).map_err(CsvError::from_csv)?;
         }
@@ -293,6 +308,7 @@ struct Columns {
     required: [usize; 10],
     sensor_id: Option<usize>,
     ego: [Option<usize>; 3],
+    true_velocity: [Option<usize>; 2],
 }
 
 impl Columns {
@@ -322,6 +338,7 @@ impl Columns {
             required,
             sensor_id: find("sensor_id")?,
             ego: [find("ego_x")?, find("ego_y")?, find("ego_yaw")?],
+            true_velocity: [find("true_vx")?, find("true_vy")?],
         })
     }
 }
@@ -432,7 +449,8 @@ impl RowParser<'_> {
         if class_text.is_empty() {
             // An empty-frame row: every measurement column must be empty.
             let indices = [c_gt, c_class, c_x, c_y, c_vr, c_rcs, c_tx, c_ty];
-            if indices.iter().any(|&index| !self.field(index).is_empty()) {
+            let velocity = columns.true_velocity.iter().flatten();
+            if indices.iter().chain(velocity).any(|&index| !self.field(index).is_empty()) {
                 return Err(self.error("class", CsvErrorKind::MissingValue));
             }
             return Ok(None);
@@ -463,9 +481,22 @@ impl RowParser<'_> {
                 return Err(self.error("true_y", CsvErrorKind::IncompleteGroup("true_x, true_y")))
             }
         };
+        let true_velocity = self.true_velocity(columns.true_velocity)?;
         let measurement =
             Measurement { x_m, y_m, radial_velocity_mps, rcs_dbsm, class, sensor_id, ground_truth_id };
-        Ok(Some(RecordedMeasurement { measurement, true_position }))
+        Ok(Some(RecordedMeasurement { measurement, true_position, true_velocity }))
+    }
+
+    /// The optional `true_vx, true_vy` group: both or neither (absent columns count as empty).
+    fn true_velocity(&self, indices: [Option<usize>; 2]) -> Result<Option<DVec2>, CsvError> {
+        let vx = indices[0].map(|i| self.opt_f64(i, "true_vx")).transpose()?.flatten();
+        let vy = indices[1].map(|i| self.opt_f64(i, "true_vy")).transpose()?.flatten();
+        match (vx, vy) {
+            (Some(x), Some(y)) => Ok(Some(DVec2::new(x, y))),
+            (None, None) => Ok(None),
+            (None, Some(_)) => Err(self.error("true_vx", CsvErrorKind::IncompleteGroup("true_vx, true_vy"))),
+            (Some(_), None) => Err(self.error("true_vy", CsvErrorKind::IncompleteGroup("true_vx, true_vy"))),
+        }
     }
 }
 
@@ -612,7 +643,11 @@ pub fn read_dataset_dir(dir: &Path) -> Result<Vec<Sequence>, CsvError> {
 mod tests {
     use super::*;
 
+    /// The header of files without the true velocity columns (the tests' reading input).
     const HEADER: &str = "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw\n";
+    /// The header the writer writes.
+    const WRITTEN_HEADER: &str =
+        "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw,true_vx,true_vy\n";
 
     fn measurement(class: ObjectClass, id: Option<u64>, x: f64) -> RecordedMeasurement {
         RecordedMeasurement {
@@ -626,6 +661,7 @@ mod tests {
                 ground_truth_id: id,
             },
             true_position: id.map(|_| DVec2::new(x + 0.1, 0.7)),
+            true_velocity: id.map(|_| DVec2::new(-13.25, 1.0 / 7.0)),
         }
     }
 
@@ -665,9 +701,10 @@ mod tests {
     fn round_trip_is_exact_including_empty_frames_and_gaps() {
         let sequence = sample();
         let text = to_text(&sequence);
-        assert!(text.starts_with(HEADER));
+        assert!(text.starts_with(WRITTEN_HEADER));
         // The empty frame is one row with empty measurement fields.
         assert!(text.lines().any(|l| l.starts_with("1,0.0213,,,,,,,,,1,")), "{text}");
+        assert!(text.lines().any(|l| l.ends_with(",-13.25,0.14285714285714285")), "{text}");
         let back = read_sequence(text.as_bytes(), "sample").unwrap();
         assert_eq!(back, sequence);
         assert!(back.frames[1].measurements.is_empty());
@@ -691,6 +728,32 @@ mod tests {
         assert_eq!(frame.measurements[0].true_position, None);
         assert_eq!(frame.measurements[1].measurement.class, ObjectClass::Pedestrian);
         assert_eq!(frame.measurements[1].true_position, Some(DVec2::new(3.1, 4.2)));
+    }
+
+    #[test]
+    fn true_velocity_columns_are_optional_and_read_in_any_order() {
+        // Files without the columns (older files, converted recordings) have no velocity.
+        let sequence = read_sequence(format!("{HEADER}0,0,3,car,1,2,3,4,5,6,,,,\n").as_bytes(), "x").unwrap();
+        assert_eq!(sequence.frames[0].measurements[0].true_velocity, None);
+        assert_eq!(sequence.frames[0].measurements[0].true_position, Some(DVec2::new(5.0, 6.0)));
+        // By name, in any order, empty for rows without truth.
+        let text = "true_vy,frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,true_vx\n\
+                    -0.5,0,0.1,3,car,1,2,3,4,5,6,8.25\n\
+                    ,0,0.1,-1,pedestrian,1,2,3,4,,,\n";
+        let sequence = read_sequence(text.as_bytes(), "x").unwrap();
+        let measurements = &sequence.frames[0].measurements;
+        assert_eq!(measurements[0].true_velocity, Some(DVec2::new(8.25, -0.5)));
+        assert_eq!(measurements[1].true_velocity, None);
+        // Both or neither.
+        let err = read_err(&format!("{}0,0,3,car,1,2,3,4,5,6,,,,,1.5,\n", WRITTEN_HEADER));
+        assert!(matches!(err.kind, CsvErrorKind::IncompleteGroup(_)));
+        assert_eq!(err.column.as_deref(), Some("true_vy"));
+        let err = read_err(&format!("{}0,0,3,car,1,2,3,4,5,6,,,,,abc,1\n", WRITTEN_HEADER));
+        assert!(matches!(err.kind, CsvErrorKind::BadNumber(_)));
+        assert_eq!(err.column.as_deref(), Some("true_vx"));
+        // An empty-frame row leaves them empty too.
+        let err = read_err(&format!("{}0,0,,,,,,,,,,,,,1,2\n", WRITTEN_HEADER));
+        assert_eq!(err.column.as_deref(), Some("class"));
     }
 
     #[test]

@@ -10,13 +10,18 @@ use primm_core::measurement::{Frame, Measurement, ObjectClass, MAX_MEASUREMENTS_
 /// fixed world frame (defined in primm-core, which transforms measurements with it).
 pub use primm_core::pose::EgoPose;
 
-/// One object-level measurement of a recorded frame, with its true position where known.
+/// One object-level measurement of a recorded frame, with its true position and velocity where
+/// known.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RecordedMeasurement {
     /// The measurement as the tracker receives it.
     pub measurement: Measurement,
     /// True centre of the object in the car frame, metres (simulated data only).
     pub true_position: Option<DVec2>,
+    /// True velocity over ground of the object's centre in the car frame's axes (x forward,
+    /// y left), m/s (simulated data only).
+    #[serde(default)]
+    pub true_velocity: Option<DVec2>,
 }
 
 /// One radar scan: its index in the sequence, time, sensor, ego pose and measurements.
@@ -45,8 +50,10 @@ impl RecordedFrame {
             class: m.measurement.class,
             measured: m.measurement.position(),
             true_position: m.true_position,
+            true_velocity: m.true_velocity,
             track_id: None,
             prior: None,
+            velocity: None,
             mode_probabilities: None,
             track_confirmed: Some(false),
         }
@@ -70,7 +77,8 @@ impl RecordedFrame {
     }
 
     /// Converts into the library's fixed-capacity [`Frame`]. Ground-truth ids, classes and
-    /// sensor ids and the ego pose are carried through unchanged; true positions are dropped.
+    /// sensor ids and the ego pose are carried through unchanged; true positions and
+    /// velocities are dropped.
     pub fn to_frame(&self) -> Result<Frame, TooManyMeasurements> {
         if self.measurements.len() > MAX_MEASUREMENTS_PER_FRAME {
             return Err(TooManyMeasurements { frame: self.index, count: self.measurements.len() });

@@ -108,6 +108,7 @@ fn false_detection(
             ground_truth_id: None,
         },
         true_position: None,
+        true_velocity: None,
     }
 }
 
@@ -206,6 +207,7 @@ mod tests {
                 ground_truth_id: Some(id),
             },
             true_position: Some(position),
+            true_velocity: Some(DVec2::ZERO),
         }
     }
 

@@ -66,6 +66,9 @@ pub struct ScenarioConfig {
     pub pedestrian_reflection: ReflectionConfig,
     /// False detections: clutter and multipath ghosts (off by default).
     pub clutter: ClutterConfig,
+    /// Extended-object reflections of cars and two-wheelers: separate detections on the
+    /// visible contour of the box instead of one averaged measurement (off by default).
+    pub extended_objects: ExtendedObjectConfig,
 }
 
 /// Sequence length and simulation stepping.
@@ -410,6 +413,39 @@ pub struct ClutterConfig {
     pub ghost_rcs_drop_db: f64,
 }
 
+/// Extended-object reflections of vehicles (cars, large vehicles and two-wheelers; pedestrians
+/// keep the averaged point model of [`ReflectionConfig`]).
+///
+/// When enabled, a vehicle in view yields one or more separate detections per scan instead of
+/// the mean of its reflection points. Each detection is one reflection centre on the visible
+/// contour of the vehicle's box (the faces turned towards the sensor, oriented along the
+/// vehicle's heading): with `corner_probability` a visible corner, chosen uniformly; otherwise
+/// a point at arc length `s_near + contour_spread_m · N(0, 1)` along the visible contour,
+/// where `s_near` is the point of the contour nearest to the sensor, clamped to the contour's
+/// ends. The number of detections of a scan is drawn from `detection_count_probabilities`. The
+/// range, azimuth and Doppler noise, misalignment, occlusion, range fading, random misses,
+/// RCS and micro-Doppler are those of the point model (`radar` and `car_reflection`); every
+/// draw comes from a random stream of its own.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExtendedObjectConfig {
+    /// Whether vehicles are measured as extended objects.
+    pub enabled: bool,
+    /// Probability that a vehicle in view yields 1, 2, 3, … detections in one scan (before
+    /// occlusion, fading and random misses); entry `k` is the probability of `k + 1`
+    /// detections. The entries must sum to 1; at most [`MAX_DETECTIONS_PER_OBJECT`] entries.
+    pub detection_count_probabilities: Vec<f64>,
+    /// Probability that a detection sits on a visible corner of the box (strong corner
+    /// reflectors: bumper corners, wheel arches seen at an angle).
+    pub corner_probability: f64,
+    /// Standard deviation of a detection's position along the visible contour around the
+    /// contour point nearest to the sensor, metres.
+    pub contour_spread_m: f64,
+}
+
+/// Largest number of detections one vehicle may yield in one scan.
+pub const MAX_DETECTIONS_PER_OBJECT: usize = 8;
+
 // ------------------------------------------------------------------------------------------------
 // Defaults
 
@@ -427,6 +463,7 @@ impl Default for ScenarioConfig {
             car_reflection: ReflectionConfig::car(),
             pedestrian_reflection: ReflectionConfig::pedestrian(),
             clutter: ClutterConfig::default(),
+            extended_objects: ExtendedObjectConfig::default(),
         }
     }
 }
@@ -659,6 +696,31 @@ impl Default for ClutterConfig {
     }
 }
 
+impl Default for ExtendedObjectConfig {
+    /// Switched off; the other values describe the model once it is switched on.
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            detection_count_probabilities: vec![0.8, 0.15, 0.05],
+            corner_probability: 0.3,
+            contour_spread_m: 0.8,
+        }
+    }
+}
+
+impl ExtendedObjectConfig {
+    /// The model of the `extended` presets: switched on with the default values.
+    pub fn vehicles() -> Self {
+        Self { enabled: true, ..Self::default() }
+    }
+
+    /// Mean number of detections per vehicle and scan before losses, from
+    /// `detection_count_probabilities`.
+    pub fn mean_detection_count(&self) -> f64 {
+        self.detection_count_probabilities.iter().enumerate().map(|(k, p)| (k + 1) as f64 * p).sum()
+    }
+}
+
 impl ClutterConfig {
     /// The clutter of the `clutter` and `clutter_turning` presets: 1.5 false detections per
     /// scan, mostly static, 15 % moving-looking, and a ghost behind 3 % of the object
@@ -694,14 +756,34 @@ pub enum Preset {
     Clutter,
     /// The [`Preset::Turning`] scene with the false detections of [`Preset::Clutter`].
     ClutterTurning,
+    /// The default scene with vehicles measured as extended objects
+    /// ([`ExtendedObjectConfig::vehicles`]): detections from the visible contour and corners of
+    /// each vehicle's box, now and then several per vehicle and scan.
+    Extended,
+    /// The [`Preset::Turning`] scene with the extended vehicles of [`Preset::Extended`].
+    ExtendedTurning,
+    /// The [`Preset::Clutter`] scene with the extended vehicles of [`Preset::Extended`].
+    ExtendedClutter,
+    /// The [`Preset::ClutterTurning`] scene with the extended vehicles of [`Preset::Extended`].
+    ExtendedClutterTurning,
 }
 
 impl Preset {
     /// All presets.
-    pub const ALL: [Preset; 5] =
-        [Preset::Default, Preset::Robustness, Preset::Turning, Preset::Clutter, Preset::ClutterTurning];
+    pub const ALL: [Preset; 9] = [
+        Preset::Default,
+        Preset::Robustness,
+        Preset::Turning,
+        Preset::Clutter,
+        Preset::ClutterTurning,
+        Preset::Extended,
+        Preset::ExtendedTurning,
+        Preset::ExtendedClutter,
+        Preset::ExtendedClutterTurning,
+    ];
 
-    /// The preset's name (`default`, `robustness`, `turning`, `clutter`, `clutter_turning`).
+    /// The preset's name (`default`, `robustness`, `turning`, `clutter`, `clutter_turning`,
+    /// `extended`, `extended_turning`, `extended_clutter`, `extended_clutter_turning`).
     pub fn name(self) -> &'static str {
         match self {
             Preset::Default => "default",
@@ -709,6 +791,10 @@ impl Preset {
             Preset::Turning => "turning",
             Preset::Clutter => "clutter",
             Preset::ClutterTurning => "clutter_turning",
+            Preset::Extended => "extended",
+            Preset::ExtendedTurning => "extended_turning",
+            Preset::ExtendedClutter => "extended_clutter",
+            Preset::ExtendedClutterTurning => "extended_clutter_turning",
         }
     }
 
@@ -725,6 +811,10 @@ impl Preset {
             Preset::Turning => ScenarioConfig::turning(),
             Preset::Clutter => ScenarioConfig::clutter(),
             Preset::ClutterTurning => ScenarioConfig::clutter_turning(),
+            Preset::Extended => ScenarioConfig::extended(Preset::Default),
+            Preset::ExtendedTurning => ScenarioConfig::extended(Preset::Turning),
+            Preset::ExtendedClutter => ScenarioConfig::extended(Preset::Clutter),
+            Preset::ExtendedClutterTurning => ScenarioConfig::extended(Preset::ClutterTurning),
         }
     }
 }
@@ -771,6 +861,18 @@ impl ScenarioConfig {
         let mut config = Self::turning();
         config.splits.seed_base = 0x434c_5455_524e;
         config.clutter = ClutterConfig::urban();
+        config
+    }
+
+    /// The `base` preset's scene with vehicles measured as extended objects
+    /// ([`ExtendedObjectConfig::vehicles`]) and a seed base of its own (see
+    /// [`Preset::Extended`]). With the same seed, traffic, scan timing and the ego vehicle are
+    /// those of `base`; the clutter presets' false detections come from their own stream too.
+    pub fn extended(base: Preset) -> Self {
+        let mut config = base.config();
+        // A seed base per extended preset: "EXT" and the base preset's own seed base.
+        config.splits.seed_base = config.splits.seed_base.wrapping_add(0x4558_5400_0000_0000);
+        config.extended_objects = ExtendedObjectConfig::vehicles();
         config
     }
 
@@ -862,7 +964,8 @@ impl ScenarioConfig {
         self.validate_pedestrian()?;
         self.validate_radar()?;
         self.validate_reflections()?;
-        self.validate_clutter()
+        self.validate_clutter()?;
+        self.validate_extended_objects()
     }
 
     /// `sequence.*`.
@@ -1170,6 +1273,31 @@ impl ScenarioConfig {
         Ok(())
     }
 
+    /// `extended_objects.*`: a count distribution that sums to 1.
+    fn validate_extended_objects(&self) -> Result<(), ConfigError> {
+        let e = &self.extended_objects;
+        let counts = &e.detection_count_probabilities;
+        if counts.is_empty() || counts.len() > MAX_DETECTIONS_PER_OBJECT {
+            return Err(ConfigError::new(
+                "extended_objects.detection_count_probabilities",
+                format!("must list between 1 and {MAX_DETECTIONS_PER_OBJECT} probabilities"),
+            ));
+        }
+        for (k, &p) in counts.iter().enumerate() {
+            probability(&format!("extended_objects.detection_count_probabilities[{k}]"), p)?;
+        }
+        let total: f64 = counts.iter().sum();
+        if (total - 1.0).abs() > 1e-9 {
+            return Err(ConfigError::new(
+                "extended_objects.detection_count_probabilities",
+                format!("must sum to 1 (got {})", readable(total)),
+            ));
+        }
+        probability("extended_objects.corner_probability", e.corner_probability)?;
+        non_negative("extended_objects.contour_spread_m", e.contour_spread_m)?;
+        Ok(())
+    }
+
     /// Width of one side of the carriageway (all lanes of one direction), metres.
     pub fn half_road_width_m(&self) -> f64 {
         self.road.lane_width_m * f64::from(self.road.lanes_per_direction)
@@ -1282,12 +1410,74 @@ mod tests {
     fn only_the_clutter_and_robustness_presets_add_false_detections() {
         for preset in Preset::ALL {
             let clutter = preset.config().clutter;
-            let expected = matches!(preset, Preset::Clutter | Preset::ClutterTurning | Preset::Robustness);
+            let expected = matches!(
+                preset,
+                Preset::Clutter
+                    | Preset::ClutterTurning
+                    | Preset::Robustness
+                    | Preset::ExtendedClutter
+                    | Preset::ExtendedClutterTurning
+            );
             assert_eq!(clutter.is_enabled(), expected, "{preset}");
         }
         assert_eq!(ScenarioConfig::default().clutter, ClutterConfig::default());
         let robust = Preset::Robustness.config().clutter.mean_false_detections_per_scan;
         assert!(robust > Preset::Clutter.config().clutter.mean_false_detections_per_scan);
+    }
+
+    #[test]
+    fn the_extended_presets_are_their_base_presets_with_extended_vehicles() {
+        let pairs = [
+            (Preset::Extended, Preset::Default),
+            (Preset::ExtendedTurning, Preset::Turning),
+            (Preset::ExtendedClutter, Preset::Clutter),
+            (Preset::ExtendedClutterTurning, Preset::ClutterTurning),
+        ];
+        for preset in Preset::ALL {
+            let extended = pairs.iter().any(|(p, _)| *p == preset);
+            assert_eq!(preset.config().extended_objects.enabled, extended, "{preset}");
+        }
+        for (extended, base) in pairs {
+            let mut config = extended.config();
+            assert_eq!(config.extended_objects, ExtendedObjectConfig::vehicles());
+            assert_ne!(config.splits.seed_base, base.config().splits.seed_base);
+            config.extended_objects = ExtendedObjectConfig::default();
+            config.splits.seed_base = base.config().splits.seed_base;
+            assert_eq!(config, base.config(), "{extended} against {base}");
+        }
+        assert!((ExtendedObjectConfig::vehicles().mean_detection_count() - 1.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn extended_object_validation_names_the_offending_field() {
+        /// Makes one field of a valid extended-object section invalid.
+        type Spoil = fn(&mut ExtendedObjectConfig);
+        let cases: [(&str, Spoil); 7] = [
+            ("extended_objects.detection_count_probabilities", |e| e.detection_count_probabilities.clear()),
+            ("extended_objects.detection_count_probabilities", |e| {
+                e.detection_count_probabilities = vec![0.1; MAX_DETECTIONS_PER_OBJECT + 2]
+            }),
+            ("extended_objects.detection_count_probabilities", |e| {
+                e.detection_count_probabilities = vec![0.5, 0.4]
+            }),
+            ("extended_objects.detection_count_probabilities[0]", |e| {
+                e.detection_count_probabilities = vec![1.5, -0.5]
+            }),
+            ("extended_objects.corner_probability", |e| e.corner_probability = 1.5),
+            ("extended_objects.contour_spread_m", |e| e.contour_spread_m = -0.1),
+            ("extended_objects.contour_spread_m", |e| e.contour_spread_m = f64::NAN),
+        ];
+        for (field, spoil) in cases {
+            let mut config = ScenarioConfig::extended(Preset::Default);
+            spoil(&mut config.extended_objects);
+            assert_eq!(config.validate().unwrap_err().field, field);
+        }
+        let parsed =
+            ScenarioConfig::from_toml_str("[extended_objects]\nenabled = true\n").expect("a partial section");
+        assert_eq!(parsed.extended_objects, ExtendedObjectConfig::vehicles());
+        let error =
+            ScenarioConfig::from_toml_str("[extended_objects]\ncorner_probability = 2.0\n").unwrap_err();
+        assert!(error.to_string().contains("extended_objects.corner_probability"), "{error}");
     }
 
     #[test]

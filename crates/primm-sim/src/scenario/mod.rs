@@ -15,7 +15,10 @@
 //!   the average of reflection points drawn on the visible outline of the object, with
 //!   ego-motion compensated radial velocity and RCS, plus occlusion and random misses;
 //! * optionally, false detections: clutter over the field of view and multipath ghosts behind
-//!   objects (see [`ClutterConfig`]).
+//!   objects (see [`ClutterConfig`]);
+//! * optionally, vehicles measured as extended objects: separate detections from the visible
+//!   contour and corners of each vehicle's box, sometimes several per scan (see
+//!   [`ExtendedObjectConfig`]).
 //!
 //! Everything is deterministic given the configuration and a seed. See `docs/scenario.md` for
 //! the full model description, its limits, and every parameter.
@@ -33,6 +36,8 @@
 mod clutter;
 mod config;
 mod events;
+#[cfg(test)]
+mod extended_tests;
 mod kinematics;
 mod path;
 mod radar;
@@ -46,9 +51,9 @@ use rand_chacha::ChaCha12Rng;
 use serde::{Deserialize, Serialize};
 
 pub use config::{
-    CarConfig, ClutterConfig, ConfigError, EgoConfig, Interval, PedestrianConfig, Preset, RadarConfig,
-    RadarMount, ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig,
-    TrafficConfig,
+    CarConfig, ClutterConfig, ConfigError, EgoConfig, ExtendedObjectConfig, Interval, PedestrianConfig,
+    Preset, RadarConfig, RadarMount, ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError,
+    SequenceConfig, SplitConfig, TrafficConfig, MAX_DETECTIONS_PER_OBJECT,
 };
 pub use events::{
     count_events, EventCounts, CLOSE_PROXIMITY_DISTANCE_M, CROSSING_DISTANCE_M,
@@ -68,6 +73,9 @@ const STREAM_SENSOR: u64 = 3;
 /// Random stream of the false detections, so that clutter leaves every real measurement as it
 /// is without clutter.
 const STREAM_CLUTTER: u64 = 4;
+/// Random stream of the extended-object detections of vehicles, so that the point model's
+/// stream, and with it every preset without extended objects, stays as it was.
+const STREAM_EXTENDED: u64 = 5;
 
 /// True state of one object at one frame (world frame).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -214,12 +222,13 @@ impl ScenarioGenerator {
         let scans = radar::schedule(&cfg.radar, cfg.sequence.duration_s, &mut rng_for(STREAM_SCHEDULE));
         let mut sensor_rng = rng_for(STREAM_SENSOR);
         let mut clutter_rng = rng_for(STREAM_CLUTTER);
+        let mut extended_rng = rng_for(STREAM_EXTENDED);
         let warmup = cfg.sequence.warmup_s;
         let mut sequence = Sequence::new(name);
         let mut truth = Vec::with_capacity(scans.len());
         for (index, scan) in scans.iter().enumerate() {
             world.advance_to(warmup + scan.t);
-            let mut scanned = radar::scan(&world, cfg, scan.sensor, &mut sensor_rng);
+            let mut scanned = radar::scan(&world, cfg, scan.sensor, &mut sensor_rng, &mut extended_rng);
             clutter::add_false_detections(
                 &cfg.clutter,
                 &cfg.radar,

@@ -9,6 +9,12 @@
 //! averaged. Points are drawn on the part of the object's box outline that faces the sensor,
 //! dropped when outside the field of view, beyond range, faded out at long range, or hidden
 //! behind another object, and perturbed by range, azimuth and Doppler noise.
+//!
+//! With extended objects switched on ([`ExtendedObjectConfig`]), vehicles are measured
+//! differently: each detection is one reflection centre on the visible contour of the box
+//! (near the point nearest to the sensor, or on a visible corner), reported on its own, and a
+//! vehicle sometimes yields several detections in one scan. Pedestrians keep the averaged
+//! point model.
 
 use glam::DVec2;
 use rand::seq::SliceRandom;
@@ -16,11 +22,11 @@ use rand::Rng;
 use rand_chacha::ChaCha12Rng;
 use rand_distr::{Distribution, Normal, Poisson};
 
-use super::config::{RadarConfig, RadarMount, ReflectionConfig, ScenarioConfig};
+use super::config::{ExtendedObjectConfig, RadarConfig, RadarMount, ReflectionConfig, ScenarioConfig};
 use super::kinematics::wrap_angle;
 use super::world::{Agent, World};
 use crate::io::{EgoPose, RecordedMeasurement};
-use primm_core::measurement::{Measurement, ObjectClass};
+use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 
 /// One scheduled scan: time since the start of recording and the index of the sensor in the
 /// configuration's sensor list.
@@ -140,12 +146,15 @@ pub(crate) struct ScanMeasurements {
     pub doppler_bias_mps: f64,
 }
 
-/// Produces the object measurements of one scan of sensor `sensor_index`.
+/// Produces the object measurements of one scan of sensor `sensor_index`. The point model draws
+/// from `rng`; the extended-object detections of vehicles, when switched on, from
+/// `extended_rng` alone.
 pub(crate) fn scan(
     world: &World<'_>,
     cfg: &ScenarioConfig,
     sensor_index: usize,
     rng: &mut ChaCha12Rng,
+    extended_rng: &mut ChaCha12Rng,
 ) -> ScanMeasurements {
     let radar = &cfg.radar;
     let mount = &radar.sensors[sensor_index];
@@ -173,6 +182,25 @@ pub(crate) fn scan(
         let max_range = mount.max_range_m.min(refl.detection_range_m);
         let Some(range) = range_if_in_view(&sensor, object, max_range) else { continue };
         let Some(faces) = visible_faces(object, origin) else { continue };
+        let truth = ObjectTruth {
+            position: ego.world_to_car(object.kin.position),
+            velocity: ego.rotate_to_car(object.kin.velocity()),
+        };
+        if cfg.extended_objects.enabled && object.class != ObjectClass::Pedestrian {
+            let target = ExtendedTarget { index, faces: &faces, truth, max_range };
+            extended_detections(
+                world,
+                &sensor,
+                refl,
+                &cfg.extended_objects,
+                &target,
+                &ego,
+                scan_bias,
+                &mut out,
+                extended_rng,
+            );
+            continue;
+        }
         let echo = object_echo(world, &sensor, refl, index, &faces, range, max_range, rng);
         if echo.count == 0 || rng.random_bool(radar.miss_probability) {
             continue;
@@ -189,12 +217,178 @@ pub(crate) fn scan(
                 sensor_id: Some(mount.id),
                 ground_truth_id: Some(object.id),
             },
-            true_position: Some(ego.world_to_car(object.kin.position)),
+            true_position: Some(truth.position),
+            true_velocity: Some(truth.velocity),
         });
     }
     // Detection lists carry no meaningful order.
     out.shuffle(rng);
     ScanMeasurements { measurements: out, doppler_bias_mps: scan_bias }
+}
+
+/// The true centre and velocity over ground of an object in the car frame of the scan.
+#[derive(Debug, Clone, Copy)]
+struct ObjectTruth {
+    /// Centre of the box, metres.
+    position: DVec2,
+    /// Velocity of the centre over ground, in the car's axes, m/s.
+    velocity: DVec2,
+}
+
+/// A vehicle measured as an extended object in one scan.
+struct ExtendedTarget<'a> {
+    /// Index of the vehicle in the world's agents.
+    index: usize,
+    /// Its faces turned towards the sensor.
+    faces: &'a VisibleFaces,
+    /// Its true centre and velocity.
+    truth: ObjectTruth,
+    /// Largest range at which it is detected, metres.
+    max_range: f64,
+}
+
+/// The part of a box outline that faces the sensor: a chain of one or two faces, as the
+/// corners along it (two or three) and the arc length of the outline point nearest to the
+/// sensor.
+#[derive(Debug, Clone, Copy)]
+struct VisibleContour {
+    corners: [DVec2; 3],
+    corner_count: usize,
+    /// Arc length from the first corner to each corner, metres.
+    arc: [f64; 3],
+    /// Arc length of the contour point nearest to the sensor, metres.
+    nearest_arc: f64,
+}
+
+impl VisibleContour {
+    /// The contour of the visible `faces` seen from `origin`; `None` when no face is visible.
+    fn new(faces: &VisibleFaces, origin: DVec2) -> Option<Self> {
+        let visible = |k: usize| faces.faces[k % 4].1 > 0.0;
+        // The visible faces of a box form one chain; it starts at the visible face whose
+        // predecessor is hidden.
+        let first = (0..4).find(|&k| visible(k) && !visible(k + 3))?;
+        let face_count = if visible(first + 1) { 2 } else { 1 };
+        let mut corners = [DVec2::ZERO; 3];
+        for (j, corner) in corners.iter_mut().enumerate().take(face_count + 1) {
+            *corner = faces.corners[(first + j) % 4];
+        }
+        let mut arc = [0.0; 3];
+        let mut nearest = (f64::INFINITY, 0.0);
+        for j in 0..face_count {
+            let (a, b) = (corners[j], corners[j + 1]);
+            let length = a.distance(b);
+            arc[j + 1] = arc[j] + length;
+            let along = if length > 0.0 {
+                ((origin - a).dot(b - a) / (length * length)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let distance = origin.distance(a + (b - a) * along);
+            if distance < nearest.0 {
+                nearest = (distance, arc[j] + along * length);
+            }
+        }
+        Some(Self { corners, corner_count: face_count + 1, arc, nearest_arc: nearest.1 })
+    }
+
+    /// Length of the contour, metres.
+    fn length(&self) -> f64 {
+        self.arc[self.corner_count - 1]
+    }
+
+    /// The contour point at arc length `s` (clamped to the contour).
+    fn point_at(&self, s: f64) -> DVec2 {
+        let s = s.clamp(0.0, self.length());
+        for j in 0..self.corner_count - 1 {
+            let length = self.arc[j + 1] - self.arc[j];
+            if s <= self.arc[j + 1] || j + 2 == self.corner_count {
+                let along = if length > 0.0 { ((s - self.arc[j]) / length).clamp(0.0, 1.0) } else { 0.0 };
+                return self.corners[j] + (self.corners[j + 1] - self.corners[j]) * along;
+            }
+        }
+        self.corners[0]
+    }
+
+    /// Draws one reflection centre: a visible corner with `corner_probability`, otherwise a
+    /// point `contour_spread_m · N(0, 1)` along the contour from the point nearest to the
+    /// sensor, clamped to the contour's ends.
+    fn reflection_centre(
+        &self,
+        extended: &ExtendedObjectConfig,
+        unit: &Normal<f64>,
+        rng: &mut ChaCha12Rng,
+    ) -> DVec2 {
+        if rng.random_bool(extended.corner_probability) {
+            self.corners[rng.random_range(0..self.corner_count)]
+        } else {
+            self.point_at(self.nearest_arc + extended.contour_spread_m * unit.sample(rng))
+        }
+    }
+}
+
+/// The number of detections of one vehicle in one scan, drawn from `probabilities` (entry `k`:
+/// probability of `k + 1` detections; they sum to 1).
+fn detection_count(probabilities: &[f64], rng: &mut ChaCha12Rng) -> usize {
+    let mut pick: f64 = rng.random();
+    for (k, p) in probabilities.iter().enumerate() {
+        if pick < *p {
+            return k + 1;
+        }
+        pick -= p;
+    }
+    probabilities.len()
+}
+
+/// Appends the detections of one vehicle measured as an extended object: the object is missed
+/// with `radar.miss_probability`; otherwise [`detection_count`] reflection centres are drawn on
+/// its visible contour, each kept when the sensor sees it ([`detected`]) and measured with the
+/// point noise ([`measure_point`]) as a measurement of its own. Detections beyond the frame
+/// capacity are dropped. Every draw comes from `rng`.
+#[allow(clippy::too_many_arguments)]
+fn extended_detections(
+    world: &World<'_>,
+    sensor: &ScanSensor<'_>,
+    refl: &ReflectionConfig,
+    extended: &ExtendedObjectConfig,
+    target: &ExtendedTarget<'_>,
+    ego: &EgoPose,
+    scan_bias: f64,
+    out: &mut Vec<RecordedMeasurement>,
+    rng: &mut ChaCha12Rng,
+) {
+    let count = detection_count(&extended.detection_count_probabilities, rng);
+    if rng.random_bool(sensor.radar.miss_probability) {
+        return;
+    }
+    let Some(contour) = VisibleContour::new(target.faces, sensor.origin) else { return };
+    let object = &world.agents[target.index];
+    for _ in 0..count {
+        let point = contour.reflection_centre(extended, &sensor.unit, rng);
+        let Some((point_rel, point_range, azimuth)) =
+            detected(world, sensor, target.index, point, target.max_range, rng)
+        else {
+            continue;
+        };
+        let (measured, vr, rcs) =
+            measure_point(sensor, object, refl, point, point_rel, point_range, azimuth, rng);
+        if out.len() >= MAX_MEASUREMENTS_PER_FRAME {
+            continue;
+        }
+        let position = ego.world_to_car(measured);
+        out.push(RecordedMeasurement {
+            measurement: Measurement {
+                x_m: position.x,
+                y_m: position.y,
+                radial_velocity_mps: vr + scan_bias,
+                rcs_dbsm: rcs,
+                class: object.class,
+                sensor_id: Some(sensor.mount.id),
+                ground_truth_id: Some(object.id),
+            },
+            true_position: Some(target.truth.position),
+            true_velocity: Some(target.truth.velocity),
+        });
+    }
 }
 
 /// The range to `object`'s centre when some of its box may lie within `max_range` and the field
