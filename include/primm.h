@@ -160,6 +160,16 @@ typedef struct PrimmStepSummary {
   size_t largest_solved_cluster_tracks;
   // Measurements of the largest cluster solved in this step (0 if none was).
   size_t largest_solved_cluster_measurements;
+  // Newer frames tracked again because this frame was late (0 for a frame in order).
+  size_t replayed_frames;
+  // Whether the frame was late (older than the newest frame tracked before it, within
+  // `tracker.max_frame_delay_s`) and was tracked in its place. The tracks are then those at
+  // the newest frame's time (`primm_tracker_newest_timestamp`), and their
+  // `measurement_index` refers to the newest frame's measurements.
+  bool late_frame;
+  // Whether the frame's ego pose jumped from the previous one (an odometry reset; the tracks
+  // kept their place around the vehicle).
+  bool odometry_reset;
 } PrimmStepSummary;
 
 // The ego vehicle's pose in the world (odometry) frame at a frame's time: the reference point
@@ -233,6 +243,15 @@ typedef struct PrimmTrack {
   double world_velocity_x_mps;
   // Fused velocity over ground in the world frame, y, m/s.
   double world_velocity_y_mps;
+  // Covariance of the fused `[x, y, vx, vy]`, row-major 4×4 (m², m²/s, m²/s²), in the frame
+  // of `x_m`, `y_m` and the velocity; its upper-left 2×2 block is the position covariance.
+  double state_covariance[16];
+  // Covariance of the world-frame `[x, y, vx, vy]`, row-major 4×4; NaN unless
+  // `has_world_estimate`.
+  double world_state_covariance[16];
+  // Time since the track's first measurement, s (at the step's newest frame, or at the
+  // requested time of `primm_tracker_predict_to`).
+  double age_s;
 } PrimmTrack;
 
 // The tracker's counters since it was built (`TrackerStats` of primm-core).
@@ -297,6 +316,14 @@ typedef struct PrimmStats {
   uint64_t frames_with_unknown_sensor;
   // Tracks merged into an older track of the same object.
   uint64_t duplicate_tracks_merged;
+  // Late frames tracked in their place.
+  uint64_t late_frames_tracked;
+  // Newer frames tracked again after a late frame.
+  uint64_t frames_replayed;
+  // Frames rejected for being older than the late-frame window reaches.
+  uint64_t frames_rejected_too_late;
+  // Ego poses that jumped (odometry resets).
+  uint64_t odometry_resets;
 } PrimmStats;
 
 // The modes the configuration names (`imm.modes`; PR, CV, CA and CT in the defaults).
@@ -411,7 +438,9 @@ enum PrimmStatus primm_tracker_step(struct PrimmTracker *tracker,
                                     struct PrimmStepSummary *out_summary);
 
 // Tracks one frame: `count` measurements at `measurements` (NULL allowed when `count` is 0),
-// taken at `timestamp_s` (seconds, strictly increasing from frame to frame), with the ego
+// taken at `timestamp_s` (seconds; a frame older than the newest tracked one by at most
+// `tracker.max_frame_delay_s` is tracked in its place, see `late_frame` of the summary; an older
+// one is rejected), with the ego
 // vehicle's pose `*ego_pose` at that time, or NULL when unknown. With a pose (and the
 // configuration's `frame.tracking_frame` "world", the default) the tracker keeps its tracks in
 // the world frame and reports them in the vehicle frame of this step with their world estimate
@@ -468,6 +497,38 @@ enum PrimmStatus primm_tracker_stats(struct PrimmTracker *tracker, struct PrimmS
 // # Safety
 // `tracker` is NULL or a live handle used by no other thread.
 enum PrimmStatus primm_tracker_reset(struct PrimmTracker *tracker);
+
+// Writes every live track's fused prediction to time `timestamp_s` (seconds, on the clock of
+// the frames; not before the newest tracked frame, at most `tracker.max_frame_interval_s`
+// after it) into `out`, which holds `capacity` entries, and their number to `*out_count`,
+// without changing any state: for a consumer that runs at its own cycle. The learned mode
+// sits the prediction out (it would need a model inference); the existence probability decays
+// over the interval. With `ego_pose` (the vehicle's pose at `timestamp_s`, NULL when unknown)
+// the vehicle-frame values of world-frame tracks are given in the vehicle frame of that pose;
+// without, in that of the newest frame's pose. Buffer rules as `primm_tracker_tracks`; a time
+// out of range is `PRIMM_STATUS_INVALID_ARGUMENT` with the reason in the last error. Before the
+// first frame, and after a reset, there is no track: `*out_count` is 0. Allocates nothing.
+//
+// # Safety
+// `tracker` is NULL or a live handle used by no other thread; `ego_pose` is NULL or readable;
+// `out` is NULL or points to `capacity` writable `PrimmTrack`s; `out_count` is NULL or
+// writable.
+enum PrimmStatus primm_tracker_predict_to(struct PrimmTracker *tracker,
+                                          double timestamp_s,
+                                          const struct PrimmEgoPose *ego_pose,
+                                          struct PrimmTrack *out,
+                                          size_t capacity,
+                                          size_t *out_count);
+
+// Writes the time of the newest tracked frame (the time of the tracks `primm_tracker_tracks`
+// copies, also after a late frame) to `*out_timestamp_s`, or NaN before the first frame and
+// after a reset.
+//
+// # Safety
+// `tracker` is NULL or a live handle used by no other thread; `out_timestamp_s` is NULL or
+// writable.
+enum PrimmStatus primm_tracker_newest_timestamp(struct PrimmTracker *tracker,
+                                                double *out_timestamp_s);
 
 // Destroys a tracker (stops its inference thread, if any). NULL is ignored.
 //

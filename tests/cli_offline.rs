@@ -49,12 +49,19 @@ fn track_writes_one_row_per_measurement_with_consistent_columns() {
     // Every measurement updated or started exactly one track.
     assert_eq!(rows.len(), sequence.measurement_count());
     for row in &rows {
-        assert_eq!(row.len(), 19);
+        assert_eq!(row.len(), 42);
         assert!(["tentative", "confirmed", "coasting"].contains(&row[13]), "status {}", row[13]);
         let existence: f64 = row[14].parse().unwrap();
         assert!(existence > 0.0 && existence < 1.0, "existence {existence}");
-        let world: Vec<f64> = row[15..19].iter().map(|v| v.parse::<f64>().unwrap()).collect();
-        assert!(world.iter().all(|v| v.is_finite()), "world columns {world:?}");
+        // vx, vy, age_s, then the upper triangle of the 4x4 covariance: its diagonal positive.
+        let numbers: Vec<f64> = row[15..42].iter().map(|v| v.parse::<f64>().unwrap()).collect();
+        assert!(numbers.iter().all(|v| v.is_finite()), "{numbers:?}");
+        assert!(numbers[2] >= 0.0, "age {}", numbers[2]);
+        for diagonal in [3, 7, 10, 12] {
+            assert!(numbers[diagonal] > 0.0, "covariance diagonal {diagonal}: {numbers:?}");
+        }
+        let world = &numbers[13..];
+        assert!(world[4] > 0.0 && world[13] > 0.0, "world covariance {world:?}");
         let mu: f64 = row[9..13].iter().map(|v| v.parse::<f64>().unwrap()).sum();
         assert!((mu - 1.0).abs() < 1e-9, "mode probabilities sum to {mu}");
         assert_eq!(row[9], "0", "the IMM method has no PR mode");

@@ -56,6 +56,7 @@ pub fn lane_scene(objects: usize, frames: usize, interval_s: f64, noise_m: f64, 
                             ground_truth_id: Some(i as u64 + 1),
                         },
                         true_position: None,
+                        true_velocity: None,
                     }
                 })
                 .collect();

@@ -14,8 +14,8 @@ use primm_service::catalog::SERVICE_PREFIX_ENV;
 use primm_service::latency_files::LatencyFilesError;
 use primm_service::realtime::{RealtimeRefused, RealtimeReport, RealtimeSettings, TrackerRealtimeArgs};
 use primm_service::{
-    ConnectError, PublishTime, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions, TrackingService,
-    WaitMode,
+    ConnectError, PublishTime, ServiceNames, ShutdownFlag, TrackingLoopError, TrackingOptions,
+    TrackingService, WaitMode,
 };
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -718,7 +718,10 @@ fn marginal4<const N: usize>(gaussian: &Gaussian<N>) -> PositionVelocityEstimate
             gaussian.covariance[(3, c)],
         )
     };
-    PositionVelocityEstimate { mean, covariance: DMat4::from_cols(column(0), column(1), column(2), column(3)) }
+    PositionVelocityEstimate {
+        mean,
+        covariance: DMat4::from_cols(column(0), column(1), column(2), column(3)),
+    }
 }
 
 /// The lower-right 2×2 block of a 4×4 matrix (the velocity block).

@@ -32,13 +32,16 @@ impl RecordedFrame {
         }
     }
 
-    /// Reads `frame` once: header, then every measurement up to the capacity.
+    /// Reads `frame` once: header, then every measurement. A frame claiming more than
+    /// [`MAX_MEASUREMENTS_PER_FRAME`] is not read further: validation rejects it by its count.
     pub(crate) fn read_from<F: FrameView + ?Sized>(&mut self, frame: &F) {
         self.timestamp_s = frame.timestamp_s();
         self.count = frame.len();
         self.ego_pose = frame.ego_pose();
-        let readable = self.count.min(MAX_MEASUREMENTS_PER_FRAME);
-        for (index, slot) in self.measurements[..readable].iter_mut().enumerate() {
+        if self.count > MAX_MEASUREMENTS_PER_FRAME {
+            return;
+        }
+        for (index, slot) in self.measurements[..self.count].iter_mut().enumerate() {
             *slot = frame.measurement(index);
         }
     }
@@ -54,7 +57,7 @@ impl FrameView for RecordedFrame {
     }
 
     /// Measurement `index` as it was read; an index past the capacity reads as an unknown
-    /// class (validation rejects such a frame before any measurement is asked for).
+    /// class (validation rejects a frame claiming more before any measurement is asked for).
     fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
         self.measurements.get(index).copied().unwrap_or(Err(UnknownClass { code: u8::MAX }))
     }

@@ -18,12 +18,12 @@
 //! is rejected as before.
 
 use crate::limits::{MAX_REPLAY_FRAMES, MAX_TRACKS};
+use crate::measurement::FrameView;
 use crate::pose::EgoPose;
 use crate::recorded_frame::RecordedFrame;
 use crate::track::Track;
 use crate::tracker::TrackerStats;
 use crate::tracking_frame::TrackingFrame;
-use crate::measurement::FrameView;
 use alloc::boxed::Box;
 use alloc::vec::Vec;
 use arrayvec::ArrayVec;
@@ -130,7 +130,10 @@ impl ReplayRing {
         if newest_s - timestamp_s > self.max_delay_s {
             return Placement::TooLate;
         }
-        let Some(position) = self.order.iter().position(|&slot| self.slots[usize::from(slot)].frame.timestamp_s() > timestamp_s)
+        let Some(position) = self
+            .order
+            .iter()
+            .position(|&slot| self.slots[usize::from(slot)].frame.timestamp_s() > timestamp_s)
         else {
             // Cannot happen (the newest frame is recorded and later); refuse rather than guess.
             return Placement::TooLate;

@@ -462,8 +462,10 @@ pub unsafe extern "C" fn primm_tracker_predict_to(
             yaw_rad: pose.yaw_rad,
         });
         let predicted = &mut handle.predicted[..];
-        let count =
-            handle.tracker.predict_to_with_pose(timestamp_s, ego_pose, predicted).map_err(Failure::Predict)?;
+        let count = handle
+            .tracker
+            .predict_to_with_pose(timestamp_s, ego_pose, predicted)
+            .map_err(Failure::Predict)?;
         for (index, output) in predicted[..count].iter().enumerate() {
             // SAFETY: `out` holds `capacity >= needed >= count` entries (caller contract).
             unsafe { out.add(index).write(PrimmTrack::from(output)) };

@@ -41,7 +41,10 @@ fn tracks(tracker: *mut PrimmTracker) -> Vec<PrimmTrack> {
     unsafe { primm_tracker_tracks(tracker, null_mut(), 0, &mut count) };
     let mut out = vec![tracks_filler(); count];
     // SAFETY: a buffer of `count` entries.
-    assert_eq!(unsafe { primm_tracker_tracks(tracker, out.as_mut_ptr(), count, &mut count) }, PrimmStatus::Ok);
+    assert_eq!(
+        unsafe { primm_tracker_tracks(tracker, out.as_mut_ptr(), count, &mut count) },
+        PrimmStatus::Ok
+    );
     out
 }
 
@@ -123,13 +126,16 @@ fn a_prediction_to_a_time_changes_nothing_and_refuses_a_time_out_of_range() {
     let mut out = vec![tracks_filler(); 8];
     let mut count = 0;
     // SAFETY: a live tracker, a buffer of 8, a writable count; NULL pose allowed.
-    let status =
-        unsafe { primm_tracker_predict_to(tracker, 0.95 + 0.2, null(), out.as_mut_ptr(), out.len(), &mut count) };
+    let status = unsafe {
+        primm_tracker_predict_to(tracker, 0.95 + 0.2, null(), out.as_mut_ptr(), out.len(), &mut count)
+    };
     assert_eq!(status, PrimmStatus::Ok);
     assert_eq!(count, 2);
     for (predicted, now) in out[..count].iter().zip(&before) {
         assert_eq!(predicted.id, now.id);
-        assert!(predicted.x_m > now.x_m - 3.0 && (predicted.x_m - now.x_m - 0.2 * now.velocity_x_mps).abs() < 0.2);
+        assert!(
+            predicted.x_m > now.x_m - 3.0 && (predicted.x_m - now.x_m - 0.2 * now.velocity_x_mps).abs() < 0.2
+        );
         assert!(predicted.position_covariance_xx_m2 > now.position_covariance_xx_m2);
         assert_eq!(predicted.measurement_index, PRIMM_NO_MEASUREMENT_INDEX);
     }
@@ -141,7 +147,8 @@ fn a_prediction_to_a_time_changes_nothing_and_refuses_a_time_out_of_range() {
     // Before the newest frame, or NaN: refused with a message.
     for bad in [0.5, f64::NAN, 10.0] {
         // SAFETY: as above.
-        let status = unsafe { primm_tracker_predict_to(tracker, bad, null(), out.as_mut_ptr(), 8, &mut count) };
+        let status =
+            unsafe { primm_tracker_predict_to(tracker, bad, null(), out.as_mut_ptr(), 8, &mut count) };
         assert_eq!(status, PrimmStatus::InvalidArgument, "{bad}");
     }
     // SAFETY: a live handle, not used again.

@@ -238,7 +238,11 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
     let mut written = std::collections::HashSet::new();
     for frame in &sequence.frames {
         if !written.insert(frame.index) {
-            return Err(CsvError::at(line + 1, Some("frame"), CsvErrorKind::FrameRepeated { frame: frame.index }));
+            return Err(CsvError::at(
+                line + 1,
+                Some("frame"),
+                CsvErrorKind::FrameRepeated { frame: frame.index },
+            ));
         }
         let fail = |line: u64, kind| CsvError::at(line, None, kind);
         let frame_fields =
@@ -561,7 +565,6 @@ impl OpenFrame {
             }
         }
     }
-
 }
 
 fn fmt_opt<T: std::fmt::Debug>(value: &Option<T>) -> String {

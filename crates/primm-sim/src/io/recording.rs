@@ -27,7 +27,8 @@ pub struct RecordedMeasurement {
 /// One radar scan: its index in the sequence, time, sensor, ego pose and measurements.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RecordedFrame {
-    /// 0-based frame index within its sequence; strictly increasing along a sequence.
+    /// 0-based frame index within its sequence; unique in it (frames are listed in arrival order,
+    /// so a late frame's index may be smaller than the one before).
     pub index: u64,
     /// Scan time, seconds since the start of the sequence.
     pub timestamp_s: f64,

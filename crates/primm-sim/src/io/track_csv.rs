@@ -158,7 +158,13 @@ impl<W: Write> TrackCsvWriter<W> {
         write!(
             self.out,
             "{},{},{},{},{x},{y},{prior_x},{prior_y},{gt},{mu_pr},{mu_cv},{mu_ca},{mu_ct},{},{},{vx},{vy},{}",
-            row.frame, row.timestamp_s, row.track_id, row.class, row.status, row.existence_probability, row.age_s
+            row.frame,
+            row.timestamp_s,
+            row.track_id,
+            row.class,
+            row.status,
+            row.existence_probability,
+            row.age_s
         )?;
         for value in upper_triangle(&row.state_covariance) {
             write!(self.out, ",{value}")?;
