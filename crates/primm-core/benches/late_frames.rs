@@ -13,10 +13,10 @@
 //!   late frames' steps are recorded.
 //!
 //! Prints a table (percentiles in µs and the ratio of each p50 to the `off` p50) and writes
-//! `benches/results/late_frames.md`. Nothing is asserted; timings vary on a shared machine, the
+//! `benches/results/late_frames.md` at the workspace root. Nothing is asserted; timings vary on a shared machine, the
 //! ratios less.
 //!
-//! `cargo bench --bench late_frames [-- --objects N] [-- --frames N] [-- --no-write]`
+//! `cargo bench -p primm-core --bench late_frames [-- --objects N] [-- --frames N] [-- --no-write]`
 
 use hdrhistogram::Histogram;
 use primm_core::config::Config;
@@ -131,8 +131,8 @@ fn main() {
     }
     print!("{table}");
     if write {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results/late_frames.md");
-        std::fs::write(&path, format!("# Late frames (cargo bench --bench late_frames)\n\n{table}"))
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/results/late_frames.md");
+        std::fs::write(&path, format!("# Late frames (cargo bench -p primm-core --bench late_frames)\n\n{table}"))
             .expect("write the results");
         println!("wrote {}", path.display());
     }
