@@ -131,9 +131,13 @@ fn main() {
     }
     print!("{table}");
     if write {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/results/late_frames.md");
-        std::fs::write(&path, format!("# Late frames (cargo bench -p primm-core --bench late_frames)\n\n{table}"))
-            .expect("write the results");
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../benches/results/late_frames.md");
+        std::fs::write(
+            &path,
+            format!("# Late frames (cargo bench -p primm-core --bench late_frames)\n\n{table}"),
+        )
+        .expect("write the results");
         println!("wrote {}", path.display());
     }
 }

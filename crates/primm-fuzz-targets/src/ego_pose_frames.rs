@@ -181,6 +181,7 @@ fn write_frame(
         source_frame: sequence,
         sensor_timestamp_s: timestamp_s,
         publish_time_ns: 0,
+        scheduled_time_ns: 0,
         flags,
         ego: reported.map(|pose| (pose.x_m, pose.y_m, pose.yaw_rad)),
     });
@@ -211,7 +212,9 @@ fn receive(
         input_sequence: frame.sequence,
         source_frame: frame.source_frame,
         sensor_timestamp_s: frame.sensor_timestamp_s,
+        tracks_timestamp_s: tracker.newest_timestamp_s().unwrap_or(frame.sensor_timestamp_s),
         input_publish_time_ns: 0,
+        input_scheduled_time_ns: 0,
         receive_time_ns: 0,
         publish_time_ns: 0,
         status,
