@@ -306,7 +306,7 @@ mod tests {
         data.extend(record(50, 1, 3, &[0x40, 0x42, 0x0f, 0x00, 0x00, 0x00, 0x00, 0x00])); // jump to 1 km
         let nan_pose: Vec<u8> = [f64::NAN, 0.0, 0.0].iter().flat_map(|v| v.to_le_bytes()).collect();
         data.extend(record(50, 3, 3, &nan_pose));
-        let far_pose: Vec<u8> = [2.0e7, 0.0, 0.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let far_pose: Vec<u8> = [2.0e7f64, 0.0, 0.0].iter().flat_map(|v| v.to_le_bytes()).collect();
         data.extend(record(50, 3, 3, &far_pose));
         data.extend(record(0, 0, 3, &drive)); // does not advance
         data.extend(record(50, 4, 3, &[])); // no pose
