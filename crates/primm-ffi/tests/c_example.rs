@@ -219,7 +219,7 @@ fn the_cpp_example_writes_the_same_track_file_as_primm_track_with_imm() {
     // Faults come out as the wrapper's exceptions, printed with the library's message.
     std::fs::write(
         dir.join("bad.csv"),
-        "frame,t,gt_id,class,x,y,vr,rcs\n0,0.1,,car,1,2,3,4\n1,0.05,,car,1,2,3,4\n",
+        "frame,t,gt_id,class,x,y,vr,rcs\n0,0.1,,car,1,2,3,4\n1,0.1,,car,1,2,3,4\n",
     )
     .unwrap();
     let run =
@@ -227,7 +227,7 @@ fn the_cpp_example_writes_the_same_track_file_as_primm_track_with_imm() {
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.starts_with("track_csv: frame 1: "), "{stderr}");
-    assert!(stderr.contains("frame timestamp 0.05 s does not advance"), "{stderr}");
+    assert!(stderr.contains("frame timestamp 0.1 s does not advance"), "{stderr}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
