@@ -111,11 +111,20 @@ fn bench_association(c: &mut Criterion) {
     for n in SIZES {
         let (tracks, priors, frame, accepted) = association_scene(n);
         let mut associator = Associator::new();
+        let sensors = vec![(glam::DVec2::ZERO, false); accepted.len()];
         let mut track_to_measurement = vec![None; n];
         group.bench_function(BenchmarkId::new("clustered", n), |bencher| {
             bencher.iter(|| {
                 associator
-                    .associate(&tracks, &priors, &frame, &accepted, &config, &mut track_to_measurement)
+                    .associate(
+                        &tracks,
+                        &priors,
+                        &frame,
+                        &accepted,
+                        &sensors,
+                        &config,
+                        &mut track_to_measurement,
+                    )
                     .expect("valid problem");
                 black_box(track_to_measurement[0])
             });

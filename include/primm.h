@@ -324,6 +324,17 @@ typedef struct PrimmStats {
   uint64_t frames_rejected_too_late;
   // Ego poses that jumped (odometry resets).
   uint64_t odometry_resets;
+  // Track updates with the measurement's radial velocity applied as a measurement of the
+  // velocity.
+  uint64_t radial_velocity_updates;
+  // Track updates whose radial-velocity row was gated out.
+  uint64_t radial_velocity_updates_gated;
+  // Updates and initiations of a class with a radial-velocity row or an extent whose
+  // measurement's sensor has no configured mount.
+  uint64_t updates_from_unknown_sensor;
+  // Unassigned measurements absorbed as extra detections of a confirmed extended track's
+  // object.
+  uint64_t detections_absorbed;
 } PrimmStats;
 
 // The modes the configuration names (`imm.modes`; PR, CV, CA and CT in the defaults).

@@ -146,6 +146,7 @@ fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
                 &scene.priors,
                 &scene.frame,
                 &scene.accepted,
+                &vec![(glam::DVec2::ZERO, false); scene.accepted.len()],
                 &config,
                 &mut track_to_measurement,
             )
@@ -201,7 +202,10 @@ fn tracks_far_apart_are_paired_without_the_solver() {
     let accepted = vec![true; 50];
     let mut associator = Associator::new();
     let mut track_to_measurement = vec![None; 50];
-    associator.associate(&tracks, &priors, &frame, &accepted, &config, &mut track_to_measurement).unwrap();
+    let sensors = vec![(glam::DVec2::ZERO, false); accepted.len()];
+    associator
+        .associate(&tracks, &priors, &frame, &accepted, &sensors, &config, &mut track_to_measurement)
+        .unwrap();
     for (i, assigned) in track_to_measurement.iter().enumerate() {
         assert_eq!(*assigned, Some(49 - i as u16), "track {i}");
     }

@@ -163,7 +163,15 @@ fn run_scenes(config: &Config, seed: u64) -> usize {
         let scene = scene(&mut rng, config);
         let mut answer = vec![Some(u16::MAX); scene.tracks.len()];
         associator
-            .associate(&scene.tracks, &scene.priors, &scene.frame, &scene.accepted, config, &mut answer)
+            .associate(
+                &scene.tracks,
+                &scene.priors,
+                &scene.frame,
+                &scene.accepted,
+                &sensors(&scene.accepted),
+                config,
+                &mut answer,
+            )
             .unwrap();
         let mut used = vec![false; scene.frame.measurements.len()];
         for j in answer.iter().flatten() {
@@ -259,7 +267,9 @@ fn a_tentative_track_cannot_take_the_measurement_a_confirmed_track_needs() {
         let mut staged = config.clone();
         staged.association.stages = stages;
         let mut answer = [None; 2];
-        associator.associate(&tracks, &priors, &frame, &accepted, &staged, &mut answer).unwrap();
+        associator
+            .associate(&tracks, &priors, &frame, &accepted, &sensors(&accepted), &staged, &mut answer)
+            .unwrap();
         assert_eq!(answer[winner], Some(0), "{stages:?}: {answer:?}");
         assert_eq!(answer[1 - winner], None, "{stages:?}: {answer:?}");
     }
@@ -307,4 +317,9 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
             }
         }
     }
+}
+
+/// Sensors at the reference point, without mounts (the costs here treat every class as a point).
+fn sensors(accepted: &[bool]) -> Vec<(glam::DVec2, bool)> {
+    vec![(glam::DVec2::ZERO, false); accepted.len()]
 }

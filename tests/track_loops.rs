@@ -14,7 +14,7 @@ use crate::common;
 use common::{lanes, measurement, scene_frames};
 use glam::DVec2;
 use primm_core::config::Config;
-use primm_core::gaussian::UpdateError;
+use primm_core::gaussian::{RadialVelocityOutcome, UpdateError};
 use primm_core::imm::ImmPrior;
 use primm_core::measurement::{Measurement, ObjectClass};
 use primm_core::mode::Method;
@@ -76,8 +76,13 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
         "track loops: compared the dispatched {selected:?} (AVX+AVX2+FMA) version with the Baseline build"
     );
     for method in [Method::Imm, Method::PrImm] {
-        let (config, tracks) = running_tracks(method, 40);
+        let (mut config, tracks) = running_tracks(method, 40);
         assert!(tracks.len() >= 20, "{method}: only {} tracks", tracks.len());
+        // The updates below take the radial-velocity row as well, and cars are extended objects.
+        for class in ObjectClass::ALL {
+            config.classes.get_mut(class).radial_velocity_update.enabled = true;
+        }
+        config.classes.car.extent.enabled = true;
         let imms = track_loops::class_imms(&config);
         let models = models(&config);
         let dt_s = 0.05;
@@ -123,6 +128,8 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
                 (i % 4 != 0).then(|| measurement(prior.fused.mean.x + 0.3, prior.fused.mean.y - 0.2, 1.0))
             })
             .collect();
+        let sensors: Vec<DVec2> =
+            (0..tracks.len()).map(|i| DVec2::new(3.7, -0.9 + 0.6 * (i % 4) as f64)).collect();
         let mut dispatched_tracks = tracks.clone();
         let mut outcomes = vec![Err(UpdateError); tracks.len()];
         track_loops::update(
@@ -131,18 +138,28 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             &mut dispatched_tracks,
             &dispatched,
             &measurements,
+            &sensors,
             &mut outcomes,
         );
         let mut plain_tracks = tracks.clone();
         for (i, track) in plain_tracks.iter_mut().enumerate() {
             let expected = match measurements[i] {
-                Some(z) => imms[track.class.index()].update_into(
-                    &models[track.class.index()],
-                    &plain[i],
-                    z.position(),
-                    &mut track.estimate,
-                ),
-                None => Ok(()),
+                Some(z) => {
+                    let models = &models[track.class.index()];
+                    let radial_velocity = models.radial_velocity_observation(&z, sensors[i]);
+                    assert!(radial_velocity.is_some());
+                    let reflection = models.expected_reflection(&plain[i].object_prior(), sensors[i]);
+                    assert_eq!(reflection.offset_m == DVec2::ZERO, track.class != ObjectClass::Car);
+                    imms[track.class.index()].update_with_radial_velocity_into(
+                        models,
+                        &plain[i],
+                        z.position() - reflection.offset_m,
+                        &primm_core::gaussian::to_nalgebra(&reflection.covariance_m2),
+                        radial_velocity.as_ref(),
+                        &mut track.estimate,
+                    )
+                }
+                None => Ok(None),
             };
             assert_eq!(outcomes[i], expected, "{method}: outcome of track {i}");
         }
@@ -156,6 +173,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             &mut baseline_tracks,
             &baseline,
             &measurements,
+            &sensors,
             &mut baseline_outcomes,
         );
         assert_eq!(baseline_outcomes, outcomes, "{method}: update outcomes, wide vs baseline");
@@ -165,5 +183,9 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             "{method}: update, wide vs baseline"
         );
         assert_ne!(estimates(&dispatched_tracks), estimates(&tracks), "{method}: the update changed nothing");
+        assert!(
+            outcomes.iter().any(|outcome| *outcome == Ok(Some(RadialVelocityOutcome::Applied))),
+            "{method}: no radial-velocity row was applied"
+        );
     }
 }

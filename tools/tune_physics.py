@@ -79,6 +79,17 @@ overrides where present, else from ``[imm]``:
     python3 tools/tune_physics.py --data out/tune/default/validation out/tune/robust/validation \\
         --parameters imm-class --rounds 1 --out out/tune/imm_class.toml
 
+``--parameters radial-velocity`` tunes the radial velocity's row in the physics modes' update
+(``classes.<class>.radial_velocity_update``: ``std_mps`` and ``gate_std`` of cars and
+pedestrians, for the classes whose row is ``enabled``), with the ``physics`` objective:
+
+    python3 tools/tune_physics.py --data out/tune/default/validation out/tune/clutter_turning/validation \
+        --parameters radial-velocity --rounds 1 --out out/tune/radial_velocity.toml
+
+``--parameters extent`` tunes the extended-object model of cars (``classes.car.extent``: the
+contour spread, the speed from which the heading counts, the nominal length and the margin of
+extra detections), with the ``physics`` objective.
+
 ``--parameters tracks`` tunes how tracks are kept (scored with ``--method imm`` by default) on
 what a user of the published tracks sees: the identity of confirmed tracks and how many of them
 are false. Its knobs are the existence model's per-class detection probabilities and clutter
@@ -174,13 +185,25 @@ LIKELIHOOD_PARAMETERS = [
     ("classes.car", "radial_velocity_residual_std_mps"),
     ("classes.pedestrian", "radial_velocity_residual_std_mps"),
 ]
+# The radial-velocity row of the physics modes' update, per class (scored like ``physics``).
+RADIAL_VELOCITY_PARAMETERS = [
+    (f"classes.{cls}.radial_velocity_update", key)
+    for cls in ("car", "pedestrian")
+    for key in ("std_mps", "gate_std")
+]
+# The extended-object model of cars (scored like ``physics``).
+EXTENT_PARAMETERS = [
+    ("classes.car.extent", key)
+    for key in ("contour_std_m", "min_heading_speed_mps", "length_m", "absorb_margin_m")
+]
 # Keys whose values are probabilities: they move through their odds, so they stay in (0, 1).
 PROBABILITY_KEYS = ("detection_probability", "initial_existence_probability",
                     "confirmation_existence_probability", "deletion_existence_probability")
 
 PARAMETER_SETS = {"physics": PARAMETERS, "learned": LEARNED_PARAMETERS, "imm": IMM_PARAMETERS,
                   "pr-noise": PR_NOISE_PARAMETERS, "imm-class": CLASS_IMM_PARAMETERS,
-                  "tracks": TRACK_PARAMETERS}
+                  "tracks": TRACK_PARAMETERS, "radial-velocity": RADIAL_VELOCITY_PARAMETERS,
+                  "extent": EXTENT_PARAMETERS}
 # Sets tuned with the wide factors and scored with pr-imm by default.
 WIDE_SETS = ("imm", "pr-noise", "imm-class")
 

@@ -6,6 +6,7 @@
 //! value and names the offending key.
 
 pub use crate::existence::{ExistenceConfig, Lifecycle};
+pub use crate::extent::ExtentConfig;
 use crate::measurement::{ClassSet, ObjectClass};
 use crate::mode::{ModeSet, MODE_COUNT};
 use crate::readable_number::readable;
@@ -402,6 +403,14 @@ pub struct ClassConfig {
     /// class, for the duplicate check, m/s (absent: 2 m/s).
     #[cfg_attr(feature = "serde", serde(default = "default_duplicate_speed_difference_mps"))]
     pub duplicate_speed_difference_mps: f64,
+    /// The radial velocity as a measurement of the velocity in the CV, CA and CT updates
+    /// (absent: off).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub radial_velocity_update: RadialVelocityUpdateConfig,
+    /// The object's extent: with `enabled`, the state is the object's centre and each
+    /// measurement the expected reflection on its outline (`crate::extent`; absent: a point).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub extent: ExtentConfig,
     /// Constant-velocity mode.
     pub constant_velocity: ConstantVelocityConfig,
     /// Constant-acceleration mode.
@@ -414,6 +423,32 @@ pub struct ClassConfig {
     /// the `imm` section's (absent: the `imm` section's).
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "ClassImmConfig::is_empty"))]
     pub imm: ClassImmConfig,
+}
+
+/// The section `classes.<class>.radial_velocity_update`: each assigned measurement's radial
+/// velocity as an extended Kalman row `h(x) = û·v` of the CV, CA and CT modes (after the
+/// position rows; ARCHITECTURE.md, "Radial velocity in the update").
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct RadialVelocityUpdateConfig {
+    /// Whether the row is applied.
+    pub enabled: bool,
+    /// Standard deviation of a measured radial velocity as a measurement of the object's
+    /// velocity along the line of sight, m/s: the sensor's noise plus what the reflection
+    /// point adds (an extended, turning object's points move differently), so at least the
+    /// sensor's own `radial_velocity_std_mps`.
+    pub std_mps: f64,
+    /// Residuals beyond this many standard deviations of their innovation are not applied
+    /// (counted): a radial velocity the track cannot explain, dimensionless.
+    pub gate_std: f64,
+}
+
+impl Default for RadialVelocityUpdateConfig {
+    /// Off; 0.5 m/s and a gate of 4 standard deviations when switched on.
+    fn default() -> Self {
+        RadialVelocityUpdateConfig { enabled: false, std_mps: 0.5, gate_std: 4.0 }
+    }
 }
 
 /// Per-class overrides of the `imm` section (`classes.<class>.imm`): each key absent takes the
@@ -592,6 +627,8 @@ impl Default for Config {
                     existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
                     duplicate_distance_m: 3.0,
                     duplicate_speed_difference_mps: 2.0,
+                    radial_velocity_update: RadialVelocityUpdateConfig::default(),
+                    extent: ExtentConfig::default(),
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 5.0,
@@ -630,6 +667,8 @@ impl Default for Config {
                     },
                     duplicate_distance_m: 1.0,
                     duplicate_speed_difference_mps: 1.0,
+                    radial_velocity_update: RadialVelocityUpdateConfig::default(),
+                    extent: ExtentConfig::default(),
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 1.75,
@@ -665,6 +704,13 @@ impl Default for Config {
                     existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
                     duplicate_distance_m: 1.5,
                     duplicate_speed_difference_mps: 2.0,
+                    radial_velocity_update: RadialVelocityUpdateConfig::default(),
+                    extent: ExtentConfig {
+                        length_m: 2.0,
+                        width_m: 0.8,
+                        contour_std_m: 0.3,
+                        ..ExtentConfig::default()
+                    },
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 3.0 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 15.0,
@@ -929,6 +975,29 @@ fn validate_class(class: ObjectClass, section: &ClassConfig) -> Result<(), Confi
     positive(&key("radial_velocity_residual_std_mps"), section.radial_velocity_residual_std_mps)?;
     positive(&key("duplicate_distance_m"), section.duplicate_distance_m)?;
     positive(&key("duplicate_speed_difference_mps"), section.duplicate_speed_difference_mps)?;
+    positive(&key("radial_velocity_update.std_mps"), section.radial_velocity_update.std_mps)?;
+    positive(&key("radial_velocity_update.gate_std"), section.radial_velocity_update.gate_std)?;
+    let extent = &section.extent;
+    positive(&key("extent.length_m"), extent.length_m)?;
+    positive(&key("extent.width_m"), extent.width_m)?;
+    if extent.width_m > extent.length_m || extent.length_m > 50.0 {
+        return Err(invalid(
+            key("extent.width_m"),
+            format!(
+                "must be at most extent.length_m, itself at most 50 m; got {} x {} m",
+                readable(extent.length_m),
+                readable(extent.width_m)
+            ),
+        ));
+    }
+    positive(&key("extent.contour_std_m"), extent.contour_std_m)?;
+    positive(&key("extent.min_heading_speed_mps"), extent.min_heading_speed_mps)?;
+    if !(extent.absorb_margin_m >= 0.0 && extent.absorb_margin_m <= 10.0) {
+        return Err(invalid(
+            key("extent.absorb_margin_m"),
+            format!("must be in [0, 10] m, got {}", readable(extent.absorb_margin_m)),
+        ));
+    }
     open_probability(&key("existence.detection_probability"), section.existence.detection_probability)?;
     let clutter = section.existence.clutter_density_per_m2;
     if !(clutter.is_finite() && clutter >= 0.0) {

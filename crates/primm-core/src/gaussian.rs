@@ -310,6 +310,121 @@ pub fn kalman_update_into<const N: usize>(
     Ok(UpdateTerms { innovation, innovation_covariance: Matrix2::new(s00, s01, s01, s11), log_likelihood })
 }
 
+/// A radial velocity measured along the line of sight from a sensor, for the extended Kalman
+/// row `h(x) = û·v` of [`radial_velocity_update_in_place`] (ARCHITECTURE.md, "Radial velocity
+/// in the update").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadialVelocityObservation {
+    /// The measured radial velocity over ground (ego-motion compensated), m/s; positive away
+    /// from the sensor.
+    pub radial_velocity_mps: f64,
+    /// Where the sensor that measured it is, in the frame of the state, m.
+    pub sensor_position_m: DVec2,
+    /// Variance of the radial velocity as a measurement of the object's velocity, (m/s)².
+    pub variance_mps2: f64,
+    /// Largest normalised residual `|ν|/√S` for which the row is applied; larger ones are
+    /// skipped (a radial velocity that the track cannot explain), dimensionless.
+    pub gate_std: f64,
+}
+
+/// What [`radial_velocity_update_in_place`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RadialVelocityOutcome {
+    /// The row was applied.
+    Applied,
+    /// The residual lay beyond the gate; the estimate is unchanged.
+    Gated,
+    /// The predicted position is (almost) at the sensor, where the line of sight is undefined;
+    /// the estimate is unchanged.
+    NoLineOfSight,
+}
+
+/// Ranges below this leave the line of sight undefined, m.
+pub const MIN_LINE_OF_SIGHT_RANGE_M: f64 = 0.1;
+
+/// The predicted radial velocity `h(x) = û·v` of a state whose velocity sits at elements
+/// `velocity..velocity + 2`, with `û = (p − s)/‖p − s‖`, and its Jacobian with respect to
+/// `[x, y, vx, vy]`: `∂h/∂p = (v − (û·v)û)/‖p − s‖`, `∂h/∂v = û`. `None` within
+/// [`MIN_LINE_OF_SIGHT_RANGE_M`] of the sensor.
+pub fn radial_velocity_and_jacobian<const N: usize>(
+    mean: &SVector<f64, N>,
+    velocity: usize,
+    sensor_position_m: DVec2,
+) -> Option<(f64, [f64; 4])> {
+    let offset = DVec2::new(mean[X] - sensor_position_m.x, mean[Y] - sensor_position_m.y);
+    let range = offset.length();
+    if !(range >= MIN_LINE_OF_SIGHT_RANGE_M) {
+        return None;
+    }
+    let along = offset / range;
+    let v = DVec2::new(mean[velocity], mean[velocity + 1]);
+    let radial = along.dot(v);
+    let across = (v - radial * along) / range;
+    Some((radial, [across.x, across.y, along.x, along.y]))
+}
+
+/// One extended Kalman row of a radial velocity (`h(x) = û·v`, linearised at the current
+/// estimate) applied to `gaussian` in place, with the Joseph-form covariance
+/// `(I − kh)P(I − kh)ᵀ + k σ² kᵀ`, in `O(N²)` and without allocation. The velocity sits at
+/// elements `velocity..velocity + 2`. Gated and degenerate rows leave the estimate as it was;
+/// on [`UpdateError`] (a non-positive `S` or a non-finite result) it is unchanged as well.
+pub fn radial_velocity_update_in_place<const N: usize>(
+    gaussian: &mut Gaussian<N>,
+    velocity: usize,
+    observation: &RadialVelocityObservation,
+) -> Result<RadialVelocityOutcome, UpdateError> {
+    let Some((predicted, jacobian)) =
+        radial_velocity_and_jacobian(&gaussian.mean, velocity, observation.sensor_position_m)
+    else {
+        return Ok(RadialVelocityOutcome::NoLineOfSight);
+    };
+    let columns = [X, Y, velocity, velocity + 1];
+    let p = &gaussian.covariance;
+    // c = P hᵀ, S = h c + σ².
+    let mut c = [0.0; N];
+    for (row, value) in c.iter_mut().enumerate() {
+        *value = columns.iter().zip(&jacobian).map(|(&column, h)| p[(row, column)] * h).sum();
+    }
+    let s = columns.iter().zip(&jacobian).map(|(&column, h)| c[column] * h).sum::<f64>()
+        + observation.variance_mps2;
+    if !(s > 0.0 && s.is_finite()) {
+        return Err(UpdateError);
+    }
+    let residual = observation.radial_velocity_mps - predicted;
+    if !(residual * residual <= observation.gate_std * observation.gate_std * s) {
+        return Ok(RadialVelocityOutcome::Gated);
+    }
+    let mut gain = [0.0; N];
+    for (k, c) in gain.iter_mut().zip(&c) {
+        *k = c / s;
+    }
+    // A = (I − k h) P = P − k cᵀ; a = A hᵀ; P' = A(I − k h)ᵀ + σ² k kᵀ = A − a kᵀ + σ² k kᵀ.
+    let mut a_h = [0.0; N];
+    for row in 0..N {
+        a_h[row] = columns
+            .iter()
+            .zip(&jacobian)
+            .map(|(&column, h)| (p[(row, column)] - gain[row] * c[column]) * h)
+            .sum();
+    }
+    let mut updated = *gaussian;
+    for row in 0..N {
+        for column in row..N {
+            let a = p[(row, column)] - gain[row] * c[column];
+            let value = a - a_h[row] * gain[column] + observation.variance_mps2 * gain[row] * gain[column];
+            // Upper triangle of A − a kᵀ + σ² k kᵀ, mirrored (the Joseph product is symmetric).
+            updated.covariance[(row, column)] = value;
+            updated.covariance[(column, row)] = value;
+        }
+        updated.mean[row] += gain[row] * residual;
+    }
+    if !(updated.mean.iter().all(|v| v.is_finite()) && updated.covariance.iter().all(|v| v.is_finite())) {
+        return Err(UpdateError);
+    }
+    *gaussian = updated;
+    Ok(RadialVelocityOutcome::Applied)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -464,5 +579,101 @@ mod tests {
             assert!((g.covariance - reference).abs().max() < 1e-9 * reference.abs().max(), "case {i}");
             assert_eq!((g.mean[X], g.mean[Y], g.mean[OTHERS]), (mixed.mean.x, mixed.mean.y, 3.0));
         }
+    }
+
+    fn observation(radial_velocity_mps: f64, sensor: DVec2) -> RadialVelocityObservation {
+        RadialVelocityObservation {
+            radial_velocity_mps,
+            sensor_position_m: sensor,
+            variance_mps2: 0.09,
+            gate_std: 1e9,
+        }
+    }
+
+    #[test]
+    fn the_radial_velocity_jacobian_matches_central_finite_differences() {
+        for i in 0..60 {
+            let angle = f64::from(i) * 0.53;
+            let mean = nalgebra::Vector5::new(
+                12.0 * angle.cos(),
+                7.0 * angle.sin() + 1.0,
+                3.0 * (1.3 * angle).sin(),
+                -2.0 + (0.7 * angle).cos(),
+                0.2,
+            );
+            let sensor = DVec2::new(3.7, -0.8 + 0.1 * f64::from(i % 3));
+            let (_, jacobian) = radial_velocity_and_jacobian(&mean, 2, sensor).unwrap();
+            for (element, analytic) in jacobian.iter().enumerate() {
+                let step = 1e-6;
+                let (mut plus, mut minus) = (mean, mean);
+                plus[element] += step;
+                minus[element] -= step;
+                let numeric = (radial_velocity_and_jacobian(&plus, 2, sensor).unwrap().0
+                    - radial_velocity_and_jacobian(&minus, 2, sensor).unwrap().0)
+                    / (2.0 * step);
+                assert!(
+                    (numeric - analytic).abs() < 1e-7,
+                    "case {i}, element {element}: {numeric} vs {analytic}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_radial_velocity_row_matches_the_textbook_joseph_update_with_full_matrices() {
+        for i in 0..40 {
+            let angle = f64::from(i) * 0.37;
+            let prior = Gaussian::new(
+                Vector4::new(10.0 * angle.cos(), 10.0 * angle.sin(), 2.0 * angle.sin(), -1.0),
+                spd4() * (0.5 + f64::from(i % 4)),
+            );
+            let sensor = DVec2::new(1.0, -0.5);
+            let z = 1.5 * angle.cos();
+            let (predicted, jacobian) = radial_velocity_and_jacobian(&prior.mean, 2, sensor).unwrap();
+            let h = nalgebra::RowVector4::new(jacobian[0], jacobian[1], jacobian[2], jacobian[3]);
+            let s = (h * prior.covariance * h.transpose())[(0, 0)] + 0.09;
+            let k = prior.covariance * h.transpose() / s;
+            let i_kh = Matrix4::identity() - k * h;
+            let covariance = i_kh * prior.covariance * i_kh.transpose() + k * 0.09 * k.transpose();
+            let mean = prior.mean + k * (z - predicted);
+            let mut ours = prior;
+            let outcome = radial_velocity_update_in_place(&mut ours, 2, &observation(z, sensor)).unwrap();
+            assert_eq!(outcome, RadialVelocityOutcome::Applied);
+            assert!((ours.mean - mean).abs().max() < 1e-12, "case {i}");
+            assert!((ours.covariance - covariance).abs().max() < 1e-12 * covariance.abs().max(), "case {i}");
+            assert_eq!(ours.covariance, ours.covariance.transpose());
+        }
+    }
+
+    #[test]
+    fn a_radial_velocity_row_narrows_the_velocity_along_the_line_of_sight_only() {
+        // An object 10 m ahead of the sensor on the x axis: the row observes vx, not vy.
+        let prior = Gaussian::new(Vector4::new(10.0, 0.0, 0.0, 0.0), Matrix4::identity() * 4.0);
+        let mut posterior = prior;
+        radial_velocity_update_in_place(&mut posterior, 2, &observation(2.0, DVec2::ZERO)).unwrap();
+        assert!(posterior.covariance[(2, 2)] < 0.1, "vx variance {}", posterior.covariance[(2, 2)]);
+        assert!((posterior.mean[2] - 2.0 * 4.0 / 4.09).abs() < 1e-12);
+        assert!((posterior.covariance[(3, 3)] - 4.0).abs() < 1e-12, "vy is not observed here");
+        assert_eq!(posterior.mean[3], 0.0);
+    }
+
+    #[test]
+    fn gated_and_degenerate_radial_velocity_rows_leave_the_estimate_unchanged() {
+        let prior = Gaussian::new(Vector4::new(10.0, 0.0, 0.0, 0.0), Matrix4::identity());
+        let mut gated = prior;
+        let tight = RadialVelocityObservation { gate_std: 3.0, ..observation(30.0, DVec2::ZERO) };
+        assert_eq!(radial_velocity_update_in_place(&mut gated, 2, &tight), Ok(RadialVelocityOutcome::Gated));
+        assert_eq!(gated, prior);
+        let mut at_sensor = prior;
+        let on_top = observation(1.0, DVec2::new(10.0, 0.0));
+        assert_eq!(
+            radial_velocity_update_in_place(&mut at_sensor, 2, &on_top),
+            Ok(RadialVelocityOutcome::NoLineOfSight)
+        );
+        assert_eq!(at_sensor, prior);
+        let mut broken = prior;
+        let negative = RadialVelocityObservation { variance_mps2: -10.0, ..observation(1.0, DVec2::ZERO) };
+        assert_eq!(radial_velocity_update_in_place(&mut broken, 2, &negative), Err(UpdateError));
+        assert_eq!(broken, prior);
     }
 }

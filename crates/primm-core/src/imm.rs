@@ -20,8 +20,10 @@
 //! way), the others sharing `1 − c_PR`.
 
 use crate::config::ImmConfig;
+use crate::extent::ObjectPrior;
 use crate::gaussian::{
-    kalman_update_into, replace_position, to_glam, to_nalgebra, Gaussian, PositionEstimate, UpdateError,
+    kalman_update_into, radial_velocity_update_in_place, replace_position, to_glam, to_nalgebra, Gaussian,
+    PositionEstimate, RadialVelocityObservation, RadialVelocityOutcome, UpdateError,
 };
 use crate::measurement::Measurement;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
@@ -35,6 +37,7 @@ use crate::motion::{
 use crate::pose::RigidTransform;
 use crate::predictor::Displacement;
 use glam::{DMat2, DMat4, DVec2, DVec4};
+use nalgebra::Matrix2;
 
 /// Mode probabilities in primm's mode order (PR, CV, CA, CT); inactive modes hold 0.
 pub type ModeProbabilities = [f64; MODE_COUNT];
@@ -68,6 +71,19 @@ impl ImmState {
         for_mode(mode, Velocity(self))
     }
 
+    /// Adds `covariance_m2` to every mode's position covariance (the cross terms unchanged):
+    /// a new extended object's reflection spread.
+    pub fn add_position_covariance(&mut self, covariance_m2: &Matrix2<f64>) {
+        fn add<const N: usize>(gaussian: &mut Gaussian<N>, covariance_m2: &Matrix2<f64>) {
+            let mut block = gaussian.covariance.fixed_view_mut::<2, 2>(0, 0);
+            block += covariance_m2;
+        }
+        add(&mut self.learned, covariance_m2);
+        add(&mut self.constant_velocity, covariance_m2);
+        add(&mut self.constant_acceleration, covariance_m2);
+        add(&mut self.coordinated_turn, covariance_m2);
+    }
+
     /// This state in another frame (see [`Gaussian::transformed`]): positions mapped,
     /// velocities and accelerations rotated, turn rate and mode probabilities unchanged.
     pub fn transformed(&self, transform: &RigidTransform) -> Self {
@@ -98,18 +114,21 @@ trait ModeSlot<const N: usize> {
     fn gaussian_mut(state: &mut ImmState) -> &mut Gaussian<N>;
     /// The mode's velocity estimate in `state`, m/s.
     fn velocity(state: &ImmState) -> DVec2;
+    /// Where the mode's state holds its velocity `[vx, vy]` (`None`: it has none).
+    const VELOCITY_INDEX: Option<usize>;
 }
 
 /// Declares a mode's [`ModeSlot`]: `slot: mode, field (of ImmState and ModeModels), N, model,
 /// |state| velocity`.
 macro_rules! mode_slot {
-    ($(#[$doc:meta])* $slot:ident: $mode:ident, $field:ident, $n:literal, $model:ty,
+    ($(#[$doc:meta])* $slot:ident: $mode:ident, $field:ident, $n:literal, $model:ty, $velocity_index:expr,
      |$state:ident| $velocity:expr) => {
         $(#[$doc])*
         struct $slot;
 
         impl ModeSlot<$n> for $slot {
             const MODE: Mode = Mode::$mode;
+            const VELOCITY_INDEX: Option<usize> = $velocity_index;
             type Model = $model;
             #[inline(always)]
             fn model(models: &ModeModels) -> &$model {
@@ -133,21 +152,21 @@ macro_rules! mode_slot {
 
 mode_slot!(
     /// PR, whose state has no velocity: the velocity of its last displacement.
-    LearnedSlot: Learned, learned, 2, LearnedDisplacement, |state| state.learned_velocity_mps
+    LearnedSlot: Learned, learned, 2, LearnedDisplacement, None, |state| state.learned_velocity_mps
 );
 mode_slot!(
     /// CV.
-    ConstantVelocitySlot: ConstantVelocity, constant_velocity, 4, ConstantVelocity,
+    ConstantVelocitySlot: ConstantVelocity, constant_velocity, 4, ConstantVelocity, Some(cv::VX),
     |state| DVec2::new(state.constant_velocity.mean[cv::VX], state.constant_velocity.mean[cv::VY])
 );
 mode_slot!(
     /// CA.
-    ConstantAccelerationSlot: ConstantAcceleration, constant_acceleration, 6, ConstantAcceleration,
+    ConstantAccelerationSlot: ConstantAcceleration, constant_acceleration, 6, ConstantAcceleration, Some(ca::VX),
     |state| DVec2::new(state.constant_acceleration.mean[ca::VX], state.constant_acceleration.mean[ca::VY])
 );
 mode_slot!(
     /// CT.
-    CoordinatedTurnSlot: CoordinatedTurn, coordinated_turn, 5, CoordinatedTurn,
+    CoordinatedTurnSlot: CoordinatedTurn, coordinated_turn, 5, CoordinatedTurn, Some(ct::VX),
     |state| DVec2::new(state.coordinated_turn.mean[ct::VX], state.coordinated_turn.mean[ct::VY])
 );
 
@@ -218,6 +237,49 @@ pub struct ImmPrior {
     pub fused: PositionEstimate,
 }
 
+impl ImmPrior {
+    /// The fused prior velocity over the available modes, weights `c` renormalised over them,
+    /// m/s (PR: its last displacement over the step), as [`Imm::fuse_velocity`] fuses a
+    /// posterior's.
+    pub fn fused_velocity_mps(&self) -> DVec2 {
+        let weights = renormalised(&self.state.probabilities, self.available);
+        self.available.iter().map(|mode| weights[mode.index()] * self.state.velocity(mode)).sum()
+    }
+
+    /// The fused prior as an extended object's prior (`crate::extent`): position and its
+    /// covariance, [`fused_velocity_mps`](Self::fused_velocity_mps), and the velocity
+    /// covariance of the available physics modes (weights renormalised over them, with the
+    /// spread of their means; PR has none of its own).
+    pub fn object_prior(&self) -> ObjectPrior {
+        let physics = self.available.without(Mode::Learned);
+        let weights = renormalised(&self.state.probabilities, physics);
+        let mean: DVec2 = physics.iter().map(|mode| weights[mode.index()] * self.state.velocity(mode)).sum();
+        let mut velocity_covariance_m2 = DMat2::ZERO;
+        for mode in physics.iter() {
+            let block = match mode {
+                Mode::ConstantVelocity => velocity_block(&self.state.constant_velocity),
+                Mode::ConstantAcceleration => velocity_block(&self.state.constant_acceleration),
+                Mode::CoordinatedTurn => velocity_block(&self.state.coordinated_turn),
+                Mode::Learned => continue,
+            };
+            let spread = self.state.velocity(mode) - mean;
+            velocity_covariance_m2 += (block + outer(spread, spread)) * weights[mode.index()];
+        }
+        ObjectPrior {
+            centre_m: self.fused.mean,
+            centre_covariance_m2: self.fused.covariance,
+            velocity_mps: self.fused_velocity_mps(),
+            velocity_covariance_m2,
+        }
+    }
+}
+
+/// The velocity block `[vx, vy]` (elements 2 and 3) of a mode's covariance.
+fn velocity_block<const N: usize>(gaussian: &Gaussian<N>) -> DMat2 {
+    let p = &gaussian.covariance;
+    DMat2::from_cols(DVec2::new(p[(2, 2)], p[(3, 2)]), DVec2::new(p[(2, 3)], p[(3, 3)]))
+}
+
 /// The IMM's configuration, prepared once: stateless and shared by all tracks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Imm {
@@ -276,8 +338,12 @@ struct UpdateMode<'a> {
     prior: &'a ImmState,
     posterior: &'a mut ImmState,
     z: DVec2,
+    /// Added to each mode's measurement noise (an extended object's reflection spread), m².
+    extra_noise_m2: &'a Matrix2<f64>,
+    radial_velocity: Option<&'a RadialVelocityObservation>,
     active: bool,
     log_likelihood: &'a mut f64,
+    radial_velocity_outcome: &'a mut Option<RadialVelocityOutcome>,
 }
 
 impl ModeOperation for UpdateMode<'_> {
@@ -289,8 +355,15 @@ impl ModeOperation for UpdateMode<'_> {
             *posterior = *prior;
             return Ok(());
         }
-        let noise = S::model(self.models).measurement_noise();
+        let noise = S::model(self.models).measurement_noise() + self.extra_noise_m2;
         *self.log_likelihood = kalman_update_into(prior, self.z, &noise, posterior)?.log_likelihood;
+        // The radial-velocity row follows the position rows in the modes that carry a velocity
+        // (PR's state is the position alone). The mode's likelihood stays that of the position
+        // rows, so that all modes, PR included, are compared on the same evidence.
+        if let (Some(observation), Some(velocity)) = (self.radial_velocity, S::VELOCITY_INDEX) {
+            *self.radial_velocity_outcome =
+                Some(radial_velocity_update_in_place(posterior, velocity, observation)?);
+        }
         Ok(())
     }
 }
@@ -522,12 +595,40 @@ impl Imm {
         z: DVec2,
         posterior: &mut ImmState,
     ) -> Result<(), UpdateError> {
-        match self.update_modes(models, prior, z, posterior) {
-            Ok(log_likelihood) => {
+        self.update_with_radial_velocity_into(models, prior, z, &Matrix2::zeros(), None, posterior)
+            .map(|_| ())
+    }
+
+    /// [`update_into`](Self::update_into) with `extra_noise_m2` added to every mode's
+    /// measurement noise (the reflection spread of an extended object, `crate::extent`; zero
+    /// for a point), followed, in every active mode with a velocity (CV,
+    /// CA, CT), by the extended Kalman row of the measurement's radial velocity
+    /// ([`radial_velocity_update_in_place`]) when `radial_velocity` is given. Returns what the
+    /// row did: `Applied` if it was applied in any mode, else `Gated` if any mode gated it, else
+    /// `NoLineOfSight`; `None` without a row (or without an active mode with a velocity).
+    #[inline(always)]
+    pub fn update_with_radial_velocity_into(
+        &self,
+        models: &ModeModels,
+        prior: &ImmPrior,
+        z: DVec2,
+        extra_noise_m2: &Matrix2<f64>,
+        radial_velocity: Option<&RadialVelocityObservation>,
+        posterior: &mut ImmState,
+    ) -> Result<Option<RadialVelocityOutcome>, UpdateError> {
+        match self.update_modes(models, prior, z, extra_noise_m2, radial_velocity, posterior) {
+            Ok((log_likelihood, outcomes)) => {
                 posterior.probabilities =
                     self.updated_probabilities(&prior.state.probabilities, prior.available, &log_likelihood);
                 posterior.learned_velocity_mps = prior.state.learned_velocity_mps;
-                Ok(())
+                let outcome = [
+                    RadialVelocityOutcome::Applied,
+                    RadialVelocityOutcome::Gated,
+                    RadialVelocityOutcome::NoLineOfSight,
+                ]
+                .into_iter()
+                .find(|wanted| outcomes.contains(&Some(*wanted)));
+                Ok(outcome)
             }
             Err(error) => {
                 *posterior = prior.state;
@@ -539,14 +640,18 @@ impl Imm {
     /// Each mode's Kalman update from `prior` into `posterior` (inactive modes are copied);
     /// the log-likelihoods. Stops at the first failing mode.
     #[inline(always)]
+    #[allow(clippy::type_complexity)]
     fn update_modes(
         &self,
         models: &ModeModels,
         prior: &ImmPrior,
         z: DVec2,
+        extra_noise_m2: &Matrix2<f64>,
+        radial_velocity: Option<&RadialVelocityObservation>,
         posterior: &mut ImmState,
-    ) -> Result<ModeProbabilities, UpdateError> {
+    ) -> Result<(ModeProbabilities, [Option<RadialVelocityOutcome>; MODE_COUNT]), UpdateError> {
         let mut log_likelihood = [f64::NEG_INFINITY; MODE_COUNT];
+        let mut outcomes = [None; MODE_COUNT];
         for mode in ModeSet::ALL.iter() {
             for_mode(
                 mode,
@@ -555,12 +660,15 @@ impl Imm {
                     prior: &prior.state,
                     posterior: &mut *posterior,
                     z,
+                    extra_noise_m2,
+                    radial_velocity,
                     active: self.modes.contains(mode),
                     log_likelihood: &mut log_likelihood[mode.index()],
+                    radial_velocity_outcome: &mut outcomes[mode.index()],
                 },
             )?;
         }
-        Ok(log_likelihood)
+        Ok((log_likelihood, outcomes))
     }
 
     /// `μ_i ∝ Λ_i^τ c_i` over the available modes (`eq:mode_update`), in log space; a mode that

@@ -56,6 +56,7 @@ pub mod config;
 pub mod displacement_check;
 pub mod duplicates;
 pub mod existence;
+pub mod extent;
 pub mod gaussian;
 pub mod imm;
 pub mod invariants;

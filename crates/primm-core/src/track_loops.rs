@@ -13,12 +13,14 @@
 //! holds the same loops compiled for the baseline only, never dispatched, so that a test can
 //! compare the two versions and know that it compared two different builds.
 
-use crate::gaussian::UpdateError;
+use crate::extent::ExpectedReflection;
+use crate::gaussian::{to_nalgebra, RadialVelocityOutcome, UpdateError};
 use crate::imm::{Imm, ImmPrior};
 use crate::measurement::{Measurement, ObjectClass};
 use crate::motion::ModeModels;
 use crate::predictor::Displacement;
 use crate::track::Track;
+use glam::DVec2;
 #[cfg(feature = "std")]
 use multiversion::multiversion;
 
@@ -89,9 +91,16 @@ fn complete_priors_loop(
     }
 }
 
+/// What the update of one track did: `Err` when it was refused for numerical reasons, else
+/// what the radial-velocity row did (`None`: no row, or no measurement).
+pub type UpdateOutcome = Result<Option<RadialVelocityOutcome>, UpdateError>;
+
 /// The IMM update of every track that has a measurement in `measurements` (same order as
-/// `tracks`); `outcomes[i]` is the result for track `i` (`Ok` for tracks without measurement,
-/// which are left untouched). A failed update leaves the track at its prior.
+/// `tracks`), of the centre through the expected reflection for a class tracked as an extended
+/// object (`crate::extent`), with the radial-velocity row where the class asks for it, seen from
+/// `sensor_positions_m[i]` (the tracking frame); `outcomes[i]` is the result for track `i`
+/// (`Ok(None)` for tracks without measurement, which are left untouched). A failed update
+/// leaves the track at its prior.
 #[cfg_attr(feature = "std", multiversion(targets("x86_64+avx+avx2+fma")))]
 pub fn update(
     imms: &ClassImms,
@@ -99,9 +108,10 @@ pub fn update(
     tracks: &mut [Track],
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
-    outcomes: &mut [Result<(), UpdateError>],
+    sensor_positions_m: &[DVec2],
+    outcomes: &mut [UpdateOutcome],
 ) {
-    update_loop(imms, models, tracks, priors, measurements, outcomes);
+    update_loop(imms, models, tracks, priors, measurements, sensor_positions_m, outcomes);
 }
 
 #[inline(always)]
@@ -111,17 +121,31 @@ fn update_loop(
     tracks: &mut [Track],
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
-    outcomes: &mut [Result<(), UpdateError>],
+    sensor_positions_m: &[DVec2],
+    outcomes: &mut [UpdateOutcome],
 ) {
-    for (((track, prior), measurement), outcome) in
-        tracks.iter_mut().zip(priors).zip(measurements).zip(outcomes.iter_mut())
+    for ((((track, prior), measurement), sensor_position_m), outcome) in
+        tracks.iter_mut().zip(priors).zip(measurements).zip(sensor_positions_m).zip(outcomes.iter_mut())
     {
         *outcome = match measurement {
             Some(z) => {
                 let class = track.class.index();
-                imms[class].update_into(&models[class], prior, z.position(), &mut track.estimate)
+                let models = &models[class];
+                let reflection = match models.extent {
+                    Some(_) => models.expected_reflection(&prior.object_prior(), *sensor_position_m),
+                    None => ExpectedReflection::POINT,
+                };
+                let radial_velocity = models.radial_velocity_observation(z, *sensor_position_m);
+                imms[class].update_with_radial_velocity_into(
+                    models,
+                    prior,
+                    z.position() - reflection.offset_m,
+                    &to_nalgebra(&reflection.covariance_m2),
+                    radial_velocity.as_ref(),
+                    &mut track.estimate,
+                )
             }
-            None => Ok(()),
+            None => Ok(None),
         };
     }
 }
@@ -196,8 +220,9 @@ pub mod baseline {
         tracks: &mut [Track],
         priors: &[ImmPrior],
         measurements: &[Option<Measurement>],
-        outcomes: &mut [Result<(), UpdateError>],
+        sensor_positions_m: &[DVec2],
+        outcomes: &mut [UpdateOutcome],
     ) {
-        update_loop(imms, models, tracks, priors, measurements, outcomes);
+        update_loop(imms, models, tracks, priors, measurements, sensor_positions_m, outcomes);
     }
 }

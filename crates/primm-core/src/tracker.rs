@@ -14,7 +14,8 @@ use crate::config::{Config, ConfigError, LearnedProcessNoise};
 use crate::displacement_check::{check_answer, DisplacementRejection};
 use crate::duplicates::{self, DuplicateView};
 use crate::existence::{self, Evidence, FieldOfView, Lifecycle};
-use crate::gaussian::UpdateError;
+use crate::extent::ExpectedReflection;
+use crate::gaussian::RadialVelocityOutcome;
 use crate::imm::ImmPrior;
 use crate::limits::MAX_SENSORS;
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
@@ -132,6 +133,18 @@ pub struct TrackerStats {
     /// `tracker.max_ego_yaw_rate_radps` allow since the previous frame: odometry resets, across
     /// which the tracks kept their place around the vehicle.
     pub odometry_resets: u64,
+    /// Track updates in which the measurement's radial velocity was applied as a measurement of
+    /// the velocity (`classes.<class>.radial_velocity_update`).
+    pub radial_velocity_updates: u64,
+    /// Track updates whose radial-velocity row lay beyond `radial_velocity_update.gate_std` in
+    /// every mode and was left out.
+    pub radial_velocity_updates_gated: u64,
+    /// Updates and initiations of a class with a radial-velocity row or an extent whose
+    /// measurement's sensor has no configured mount: seen from the vehicle's reference point.
+    pub updates_from_unknown_sensor: u64,
+    /// Unassigned measurements absorbed as extra detections of a confirmed track's extended
+    /// object (`classes.<class>.extent.absorb_extra_detections`): they started no track.
+    pub detections_absorbed: u64,
 }
 
 /// What one step did: the per-frame counterpart of [`TrackerStats`]. Returned by
@@ -194,6 +207,16 @@ pub struct StepSummary {
     pub replayed_frames: usize,
     /// Whether the frame's ego pose jumped from the previous one (an odometry reset).
     pub odometry_reset: bool,
+    /// Track updates with the radial-velocity row applied.
+    pub radial_velocity_rows_applied: usize,
+    /// Track updates whose radial-velocity row was gated out.
+    pub radial_velocity_rows_gated: usize,
+    /// Updates and initiations seen from the vehicle's reference point (no configured mount)
+    /// by a class with a radial-velocity row or an extent.
+    pub updates_from_unknown_sensor: usize,
+    /// Unassigned measurements absorbed as extra detections of a confirmed extended track's
+    /// object (they started no track).
+    pub detections_absorbed: usize,
 }
 
 impl TrackerStats {
@@ -218,6 +241,10 @@ impl TrackerStats {
         self.frames_with_unknown_sensor += u64::from(step.unknown_sensor);
         self.duplicate_tracks_merged += count(step.duplicates_merged);
         self.odometry_resets += u64::from(step.odometry_reset);
+        self.radial_velocity_updates += count(step.radial_velocity_rows_applied);
+        self.radial_velocity_updates_gated += count(step.radial_velocity_rows_gated);
+        self.updates_from_unknown_sensor += count(step.updates_from_unknown_sensor);
+        self.detections_absorbed += count(step.detections_absorbed);
     }
 
     /// Goes back to `before` for everything a tracked frame changes, keeping what happened
@@ -307,8 +334,13 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     track_to_measurement: Box<[Option<u16>; MAX_TRACKS]>,
     /// Each track's assigned measurement of the current frame (`None`: none).
     assigned_measurements: Box<[Option<Measurement>; MAX_TRACKS]>,
+    /// Where the radar of each track's assigned measurement is, in the tracking frame.
+    assigned_sensor_positions: Box<[DVec2; MAX_TRACKS]>,
+    /// Where the radar of each measurement of the current frame is, in the tracking frame (its
+    /// mount; the vehicle's reference point when it has none), and whether it had a mount.
+    measurement_sensors: Box<[(DVec2, bool); MAX_MEASUREMENTS_PER_FRAME]>,
     /// Each track's update outcome of the current frame.
-    update_outcomes: Box<[Result<(), UpdateError>; MAX_TRACKS]>,
+    update_outcomes: Box<[track_loops::UpdateOutcome; MAX_TRACKS]>,
     rows: Box<[RowRecord; MAX_TRACKS]>,
     fates: Box<[MeasurementFate; MAX_MEASUREMENTS_PER_FRAME]>,
     accepted: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
@@ -361,7 +393,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
             dt_s: 0.0,
             track_to_measurement: Box::new([None; MAX_TRACKS]),
             assigned_measurements: Box::new([None; MAX_TRACKS]),
-            update_outcomes: Box::new([Ok(()); MAX_TRACKS]),
+            assigned_sensor_positions: Box::new([DVec2::ZERO; MAX_TRACKS]),
+            measurement_sensors: Box::new([(DVec2::ZERO, false); MAX_MEASUREMENTS_PER_FRAME]),
+            update_outcomes: Box::new([Ok(None); MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
             accepted: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
@@ -834,15 +868,68 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Per-class gated optimal assignment (`eq:association_cost`).
     fn associate(&mut self) -> Result<(), StepError> {
+        self.locate_measurement_sensors();
         self.associator.associate(
             self.table.tracks(),
             &self.priors[..self.table.len()],
             &*self.validated,
             &self.accepted[..self.validated.len()],
+            &self.measurement_sensors[..self.validated.len()],
             &self.config,
             &mut self.track_to_measurement[..],
         )?;
         Ok(())
+    }
+
+    /// Where the radar of every accepted measurement is, in the tracking frame: its mount,
+    /// mapped into the world in a world-frame step; without a configured mount the vehicle's
+    /// reference point (flagged, and counted where a row or an extent uses it).
+    fn locate_measurement_sensors(&mut self) {
+        for index in 0..self.validated.len() {
+            let Some(measurement) = self.validated.accepted(index) else { continue };
+            let mount =
+                measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)).map(|m| m.position());
+            let in_vehicle = mount.unwrap_or(DVec2::ZERO);
+            let position = match self.step_pose {
+                Some(pose) => pose.car_to_world(in_vehicle),
+                None => in_vehicle,
+            };
+            self.measurement_sensors[index] = (position, mount.is_some());
+        }
+    }
+
+    /// Whether a confirmed track among the first `tracks` (those with a prior this frame) of the
+    /// measurement's class, tracked as an extended object that absorbs extra detections, has
+    /// `measurement` on its object ([`crate::extent::lies_on_object`], at the track's prior).
+    fn absorbed_by_a_track(&self, measurement: &Measurement, tracks: usize) -> bool {
+        let extent = &self.config.classes.get(measurement.class).extent;
+        if !(extent.enabled && extent.absorb_extra_detections) {
+            return false;
+        }
+        self.table.tracks()[..tracks].iter().zip(&self.priors[..tracks]).any(|(track, prior)| {
+            track.class == measurement.class
+                && track.status.is_confirmed()
+                && crate::extent::lies_on_object(
+                    extent,
+                    prior.fused.mean,
+                    prior.fused_velocity_mps(),
+                    measurement.position(),
+                )
+        })
+    }
+
+    /// The expected reflection of track `i`'s object for a sensor at `sensor_m` (a point class:
+    /// none).
+    fn expected_reflection(&self, i: usize, sensor_m: DVec2) -> ExpectedReflection {
+        let class = self.table.tracks()[i].class;
+        let models = &self.models[class.index()];
+        match models.extent {
+            Some(_) => {
+                let prior = &self.priors[i];
+                models.expected_reflection(&prior.object_prior(), sensor_m)
+            }
+            None => ExpectedReflection::POINT,
+        }
     }
 
     /// Kalman and mode-probability update of every assigned track.
@@ -853,8 +940,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
             // than keep a stale state.
             self.assigned_measurements[i] =
                 self.track_to_measurement[i].and_then(|index| self.validated.accepted(usize::from(index)));
-            if self.assigned_measurements[i].is_none() {
+            let (Some(index), Some(measurement)) =
+                (self.track_to_measurement[i], self.assigned_measurements[i])
+            else {
                 self.track_to_measurement[i] = None;
+                continue;
+            };
+            let (sensor_m, mounted) = self.measurement_sensors[usize::from(index)];
+            self.assigned_sensor_positions[i] = sensor_m;
+            let models = &self.models[measurement.class.index()];
+            if !mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
+                self.last_step.updates_from_unknown_sensor += 1;
             }
         }
         track_loops::update(
@@ -863,6 +959,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.table.tracks_mut(),
             &self.priors[..count],
             &self.assigned_measurements[..count],
+            &self.assigned_sensor_positions[..count],
             &mut self.update_outcomes[..count],
         );
         for i in 0..count {
@@ -871,14 +968,21 @@ impl<P: DisplacementPredictor> Tracker<P> {
             else {
                 continue;
             };
-            if self.update_outcomes[i].is_ok() {
+            if let Ok(radial_velocity) = self.update_outcomes[i] {
+                match radial_velocity {
+                    Some(RadialVelocityOutcome::Applied) => self.last_step.radial_velocity_rows_applied += 1,
+                    Some(RadialVelocityOutcome::Gated) => self.last_step.radial_velocity_rows_gated += 1,
+                    Some(RadialVelocityOutcome::NoLineOfSight) | None => {}
+                }
                 let class = self.table.tracks()[i].class;
                 let (detection, clutter) = self.detection_and_clutter(class, measurement.sensor_id);
+                let reflection = self.expected_reflection(i, self.assigned_sensor_positions[i]);
                 let prior = &self.priors[i].fused;
                 let likelihood = existence::gaussian_density_per_m2(
-                    measurement.position() - prior.mean,
+                    measurement.position() - reflection.offset_m - prior.mean,
                     prior.covariance
-                        + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2),
+                        + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2)
+                        + reflection.covariance_m2,
                 );
                 let tracker = &self.config.tracker;
                 let track = &mut self.table.tracks_mut()[i];
@@ -954,20 +1058,42 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Every accepted, unassigned measurement starts a tentative track.
+    /// Every accepted, unassigned measurement starts a tentative track, except one that a
+    /// confirmed track of an extended class absorbs as a second detection of its object.
     fn initiate(&mut self, t: f64) {
         let initial_existence = self.config.tracker.initial_existence_probability;
+        let tracks_before = self.table.len();
         for index in 0..self.validated.len() {
             if self.fates[index] != MeasurementFate::Unassigned {
                 continue;
             }
             let Some(measurement) = self.validated.accepted(index) else { continue };
+            if self.absorbed_by_a_track(&measurement, tracks_before) {
+                self.last_step.detections_absorbed += 1;
+                continue;
+            }
             let sensor_position_m = self.sensor_position(&measurement);
-            let estimate = self.imms[measurement.class.index()].initiate_seen_from(
+            let models = &self.models[measurement.class.index()];
+            // An extended object starts at the centre behind its reflection (no heading yet:
+            // the disc model of `crate::extent`), its position spread by the reflection's.
+            let (mut centre, mut reflection) = (measurement, ExpectedReflection::POINT);
+            if models.extent.is_some() {
+                let (sensor_m, mounted) = self.measurement_sensors[index];
+                let standing =
+                    crate::extent::ObjectPrior { centre_m: measurement.position(), ..Default::default() };
+                reflection = models.expected_reflection(&standing, sensor_m);
+                (centre.x_m, centre.y_m) =
+                    (measurement.x_m - reflection.offset_m.x, measurement.y_m - reflection.offset_m.y);
+                if !mounted {
+                    self.last_step.updates_from_unknown_sensor += 1;
+                }
+            }
+            let mut estimate = self.imms[measurement.class.index()].initiate_seen_from(
                 &self.models[measurement.class.index()],
-                &measurement,
+                &centre,
                 sensor_position_m,
             );
+            estimate.add_position_covariance(&crate::gaussian::to_nalgebra(&reflection.covariance_m2));
             let tracker = &self.config.tracker;
             match self.table.insert(|id| Track::new(id, &measurement, t, estimate, initial_existence)) {
                 Ok(track) => {

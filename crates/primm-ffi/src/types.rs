@@ -453,6 +453,17 @@ pub struct PrimmStats {
     pub frames_rejected_too_late: u64,
     /// Ego poses that jumped (odometry resets).
     pub odometry_resets: u64,
+    /// Track updates with the measurement's radial velocity applied as a measurement of the
+    /// velocity.
+    pub radial_velocity_updates: u64,
+    /// Track updates whose radial-velocity row was gated out.
+    pub radial_velocity_updates_gated: u64,
+    /// Updates and initiations of a class with a radial-velocity row or an extent whose
+    /// measurement's sensor has no configured mount.
+    pub updates_from_unknown_sensor: u64,
+    /// Unassigned measurements absorbed as extra detections of a confirmed extended track's
+    /// object.
+    pub detections_absorbed: u64,
 }
 
 impl From<&TrackerStats> for PrimmStats {
@@ -490,6 +501,10 @@ impl From<&TrackerStats> for PrimmStats {
             frames_replayed,
             frames_rejected_too_late,
             odometry_resets,
+            radial_velocity_updates,
+            radial_velocity_updates_gated,
+            updates_from_unknown_sensor,
+            detections_absorbed,
         } = *stats;
         PrimmStats {
             frames_tracked,
@@ -523,6 +538,10 @@ impl From<&TrackerStats> for PrimmStats {
             frames_replayed,
             frames_rejected_too_late,
             odometry_resets,
+            radial_velocity_updates,
+            radial_velocity_updates_gated,
+            updates_from_unknown_sensor,
+            detections_absorbed,
         }
     }
 }

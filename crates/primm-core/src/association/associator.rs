@@ -42,6 +42,7 @@
 use super::assignment::{AssignmentError, AssignmentSolver};
 use super::cost::{association_cost, LikelihoodPrior};
 use crate::config::{AssociationCost, AssociationStages, Config};
+use crate::extent::{expected_reflection, ExtentConfig};
 use crate::imm::ImmPrior;
 use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::track::Track;
@@ -49,6 +50,7 @@ use crate::track_table::MAX_TRACKS;
 use alloc::boxed::Box;
 use alloc::vec;
 use arrayvec::ArrayVec;
+use glam::DVec2;
 
 /// Most allowed pairs of one class in one frame: every track with every measurement.
 const MAX_PAIRS: usize = crate::limits::MAX_ASSOCIATION_PAIRS;
@@ -166,6 +168,7 @@ impl Associator {
         priors: &[ImmPrior],
         frame: &F,
         accepted: &[bool],
+        sensors: &[(DVec2, bool)],
         config: &Config,
         track_to_measurement: &mut [Option<u16>],
     ) -> Result<(), AssignmentError> {
@@ -183,6 +186,7 @@ impl Associator {
                     priors,
                     frame,
                     accepted,
+                    sensors,
                     config,
                     class,
                     stage,
@@ -201,6 +205,7 @@ impl Associator {
         priors: &[ImmPrior],
         frame: &F,
         accepted: &[bool],
+        sensors: &[(DVec2, bool)],
         config: &Config,
         class: ObjectClass,
         stage: Stage,
@@ -230,8 +235,10 @@ impl Associator {
         }
         self.sorted_x.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         match config.association.cost {
-            AssociationCost::Paper => self.gate_paper(tracks, priors, frame, config, class),
-            AssociationCost::Likelihood => self.gate_likelihood(tracks, priors, frame, config, class),
+            AssociationCost::Paper => self.gate_paper(tracks, priors, frame, sensors, config, class),
+            AssociationCost::Likelihood => {
+                self.gate_likelihood(tracks, priors, frame, sensors, config, class)
+            }
         }
         self.cluster();
         self.solve_clusters(track_to_measurement)?;
@@ -255,26 +262,38 @@ impl Associator {
         tracks: &[Track],
         priors: &[ImmPrior],
         frame: &F,
+        sensors: &[(DVec2, bool)],
         config: &Config,
         class: ObjectClass,
     ) {
         let gate = config.classes.get(class).gate_m;
+        let extent = extent_of(config, class);
+        // An expected reflection moves the compared point by at most the extent's half diagonal.
+        let window = gate + extent.map_or(0.0, |extent| extent.max_offset_m());
         let mut count = 0usize;
         for (r, &track_index) in self.rows.iter().enumerate() {
             self.row_start[r] = count as u32;
             let track = &tracks[usize::from(track_index)];
-            let prior = priors[usize::from(track_index)].fused.mean;
-            let first = self.sorted_x.partition_point(|&(x, _)| x < prior.x - gate);
+            let prior = &priors[usize::from(track_index)];
+            let centre = prior.fused.mean;
+            let object = extent.map(|_| prior.object_prior());
+            let first = self.sorted_x.partition_point(|&(x, _)| x < centre.x - window);
             for &(x, column) in &self.sorted_x[first..] {
-                if x > prior.x + gate {
+                if x > centre.x + window {
                     break;
                 }
-                let Ok(measurement) = frame.measurement(usize::from(self.columns[usize::from(column)]))
-                else {
+                let index = usize::from(self.columns[usize::from(column)]);
+                let Ok(measurement) = frame.measurement(index) else {
                     continue;
                 };
+                let expected = match (extent, &object) {
+                    (Some(extent), Some(object)) => {
+                        centre + expected_reflection(extent, object, sensors[index].0).offset_m
+                    }
+                    _ => centre,
+                };
                 let cost = association_cost(
-                    prior,
+                    expected,
                     track.last_radial_velocity_mps,
                     &measurement,
                     &config.association,
@@ -296,10 +315,12 @@ impl Associator {
         tracks: &[Track],
         priors: &[ImmPrior],
         frame: &F,
+        sensors: &[(DVec2, bool)],
         config: &Config,
         class: ObjectClass,
     ) {
         let section = config.classes.get(class);
+        let extent = extent_of(config, class);
         let [[xx, xy], [yx, yy]] = section.measurement_noise_covariance_m2;
         let noise = glam::DMat2::from_cols(glam::DVec2::new(xx, yx), glam::DVec2::new(xy, yy));
         let mut count = 0usize;
@@ -314,17 +335,33 @@ impl Associator {
                 config.association.likelihood_gate_chi2,
             );
             let Some(prepared) = prepared else { continue };
-            let (x, half) = (prepared.mean_m().x, prepared.x_half_window_m());
+            let object = extent.map(|_| priors[usize::from(track_index)].object_prior());
+            let (x, half) = (
+                prepared.mean_m().x,
+                match extent {
+                    Some(extent) => {
+                        prepared.x_half_window_with_spread_m(extent.max_spread_m2()) + extent.max_offset_m()
+                    }
+                    None => prepared.x_half_window_m(),
+                },
+            );
             let first = self.sorted_x.partition_point(|&(mx, _)| mx < x - half);
             for &(mx, column) in &self.sorted_x[first..] {
                 if mx > x + half {
                     break;
                 }
-                let Ok(measurement) = frame.measurement(usize::from(self.columns[usize::from(column)]))
-                else {
+                let index = usize::from(self.columns[usize::from(column)]);
+                let Ok(measurement) = frame.measurement(index) else {
                     continue;
                 };
-                if let Some(cost) = prepared.cost(&measurement) {
+                let cost = match (extent, &object) {
+                    (Some(extent), Some(object)) => {
+                        let reflection = expected_reflection(extent, object, sensors[index].0);
+                        prepared.cost_of_reflection(&measurement, &reflection)
+                    }
+                    _ => prepared.cost(&measurement),
+                };
+                if let Some(cost) = cost {
                     self.pairs[count] = Pair { row: r as u16, column, cost };
                     count += 1;
                 }
@@ -440,4 +477,10 @@ fn union(parent: &mut [u16], a: usize, b: usize) {
         let (low, high) = (root_a.min(root_b), root_a.max(root_b));
         parent[high] = low as u16;
     }
+}
+
+/// The extent of `class` when it is tracked as an extended object.
+fn extent_of(config: &Config, class: ObjectClass) -> Option<&ExtentConfig> {
+    let extent = &config.classes.get(class).extent;
+    extent.enabled.then_some(extent)
 }

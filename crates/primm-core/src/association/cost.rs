@@ -2,6 +2,7 @@
 //! a χ² gate.
 
 use crate::config::AssociationConfig;
+use crate::extent::ExpectedReflection;
 use crate::gaussian::PositionEstimate;
 use crate::math;
 use crate::measurement::Measurement;
@@ -26,6 +27,7 @@ pub fn association_cost(
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LikelihoodPrior {
     mean_m: DVec2,
+    innovation_covariance_m2: DMat2,
     inverse_m2: DMat2,
     log_determinant: f64,
     last_radial_velocity_mps: f64,
@@ -53,6 +55,7 @@ impl LikelihoodPrior {
         }
         Some(LikelihoodPrior {
             mean_m: prior.mean,
+            innovation_covariance_m2: innovation_covariance,
             inverse_m2: innovation_covariance.inverse(),
             log_determinant: math::ln(determinant),
             last_radial_velocity_mps,
@@ -73,14 +76,43 @@ impl LikelihoodPrior {
         self.x_half_window_m
     }
 
+    /// Half width of the x-window holding every measurement the gate can let through when up
+    /// to `spread_m2` is added to `S_xx`, m.
+    pub fn x_half_window_with_spread_m(&self, spread_m2: f64) -> f64 {
+        math::sqrt(self.gate_chi2 * (self.innovation_covariance_m2.x_axis.x + spread_m2))
+    }
+
     /// `νᵀS⁻¹ν + (Δv_r)²/σ_v² + ln det S` for a measurement inside the gate (the first two
     /// terms at most `likelihood_gate_chi2`), `None` beyond it.
     pub fn cost(&self, measurement: &Measurement) -> Option<f64> {
         let innovation = measurement.position() - self.mean_m;
+        self.gated(measurement, innovation.dot(self.inverse_m2 * innovation), self.log_determinant)
+    }
+
+    /// [`cost`](Self::cost) of an extended object whose reflection is expected at
+    /// `reflection.offset_m` from the prior and spread by `reflection.covariance_m2`: the
+    /// innovation `z − (p⁻ + o)` with covariance `S + C`. `None` also when `S + C` is not
+    /// positive definite.
+    pub fn cost_of_reflection(
+        &self,
+        measurement: &Measurement,
+        reflection: &ExpectedReflection,
+    ) -> Option<f64> {
+        let covariance = self.innovation_covariance_m2 + reflection.covariance_m2;
+        let determinant = covariance.determinant();
+        if !(determinant > 0.0 && determinant.is_finite()) {
+            return None;
+        }
+        let innovation = measurement.position() - self.mean_m - reflection.offset_m;
+        self.gated(measurement, innovation.dot(covariance.inverse() * innovation), math::ln(determinant))
+    }
+
+    /// The cost from the squared position distance: the radial-velocity term added, gated.
+    fn gated(&self, measurement: &Measurement, position_distance: f64, log_determinant: f64) -> Option<f64> {
         let velocity_difference = measurement.radial_velocity_mps - self.last_radial_velocity_mps;
-        let squared_distance = innovation.dot(self.inverse_m2 * innovation)
-            + math::square(velocity_difference) * self.inverse_velocity_variance;
-        (squared_distance <= self.gate_chi2).then_some(squared_distance + self.log_determinant)
+        let squared_distance =
+            position_distance + math::square(velocity_difference) * self.inverse_velocity_variance;
+        (squared_distance <= self.gate_chi2).then_some(squared_distance + log_determinant)
     }
 }
 
@@ -157,5 +189,25 @@ mod tests {
         assert!(LikelihoodPrior::new(&prior(DMat2::ZERO), DMat2::ZERO, 0.0, 1.0, 9.0).is_none());
         let nan = DMat2::from_diagonal(DVec2::new(f64::NAN, 1.0));
         assert!(LikelihoodPrior::new(&prior(nan), DMat2::ZERO, 0.0, 1.0, 9.0).is_none());
+    }
+
+    #[test]
+    fn the_cost_of_a_reflection_scores_the_offset_point_with_the_spread_added() {
+        let p = DMat2::from_cols(DVec2::new(0.5, 0.1), DVec2::new(0.1, 0.3));
+        let r = DMat2::from_diagonal(DVec2::new(0.2, 0.2));
+        let prepared = LikelihoodPrior::new(&prior(p), r, 3.0, 0.5, 16.27).unwrap();
+        let reflection = ExpectedReflection {
+            offset_m: DVec2::new(-1.5, 0.4),
+            covariance_m2: DMat2::from_diagonal(DVec2::new(0.0, 0.25)),
+        };
+        let m = measurement(9.1, -1.7, 3.4);
+        let s = p + r + reflection.covariance_m2;
+        let nu = DVec2::new(9.1 - 8.5, -1.7 + 1.6);
+        let expected = nu.dot(s.inverse() * nu) + (0.4f64 / 0.5).powi(2) + s.determinant().ln();
+        assert!((prepared.cost_of_reflection(&m, &reflection).unwrap() - expected).abs() < 1e-12);
+        // A point reflection is the plain cost.
+        let point = prepared.cost_of_reflection(&m, &ExpectedReflection::POINT).unwrap();
+        assert!((point - prepared.cost(&m).unwrap()).abs() < 1e-12);
+        assert!(prepared.x_half_window_with_spread_m(0.0) == prepared.x_half_window_m());
     }
 }

@@ -25,8 +25,9 @@ pub use constant_velocity::ConstantVelocity;
 pub use coordinated_turn::CoordinatedTurn;
 pub use learned::LearnedDisplacement;
 
-use crate::config::ClassConfig;
-use crate::gaussian::Gaussian;
+use crate::config::{ClassConfig, RadialVelocityUpdateConfig};
+use crate::extent::{ExpectedReflection, ExtentConfig, ObjectPrior};
+use crate::gaussian::{Gaussian, RadialVelocityObservation};
 use crate::measurement::Measurement;
 use glam::DVec2;
 use index::{VX, VY, X, Y};
@@ -87,6 +88,10 @@ pub struct ModeModels {
     pub constant_acceleration: ConstantAcceleration,
     /// CT.
     pub coordinated_turn: CoordinatedTurn,
+    /// The radial velocity as a measurement of the CV, CA and CT velocities.
+    pub radial_velocity_update: RadialVelocityUpdateConfig,
+    /// The class's extent, when it is tracked as an extended object (`None`: a point).
+    pub extent: Option<ExtentConfig>,
 }
 
 impl ModeModels {
@@ -121,7 +126,34 @@ impl ModeModels {
                 initial_velocity,
             )
             .with_max_turn_rate(class.coordinated_turn.max_turn_rate_radps),
+            radial_velocity_update: class.radial_velocity_update,
+            extent: class.extent.enabled.then_some(class.extent),
         }
+    }
+
+    /// Where the reflection of a track of this class is expected (a point class: no offset, no
+    /// spread), for its fused prior `object` and a sensor at `sensor_position_m`.
+    pub fn expected_reflection(&self, object: &ObjectPrior, sensor_position_m: DVec2) -> ExpectedReflection {
+        match &self.extent {
+            Some(extent) => crate::extent::expected_reflection(extent, object, sensor_position_m),
+            None => ExpectedReflection::POINT,
+        }
+    }
+
+    /// The radial-velocity row for `measurement` seen by a radar at `sensor_position_m` (the
+    /// frame of the state), or `None` when this class's `radial_velocity_update` is off.
+    pub fn radial_velocity_observation(
+        &self,
+        measurement: &Measurement,
+        sensor_position_m: DVec2,
+    ) -> Option<RadialVelocityObservation> {
+        let update = &self.radial_velocity_update;
+        update.enabled.then(|| RadialVelocityObservation {
+            radial_velocity_mps: measurement.radial_velocity_mps,
+            sensor_position_m,
+            variance_mps2: crate::math::square(update.std_mps),
+            gate_std: update.gate_std,
+        })
     }
 }
 
