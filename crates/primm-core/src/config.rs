@@ -627,8 +627,16 @@ impl Default for Config {
                     existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
                     duplicate_distance_m: 3.0,
                     duplicate_speed_difference_mps: 2.0,
-                    radial_velocity_update: RadialVelocityUpdateConfig::default(),
-                    extent: ExtentConfig::default(),
+                    radial_velocity_update: RadialVelocityUpdateConfig {
+                        enabled: true,
+                        ..RadialVelocityUpdateConfig::default()
+                    },
+                    extent: ExtentConfig {
+                        enabled: true,
+                        offset_scale: 0.5,
+                        absorb_extra_detections: true,
+                        ..ExtentConfig::default()
+                    },
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
                     constant_acceleration: ConstantAccelerationConfig {
                         jerk_psd_m2_per_s5: 5.0,
@@ -667,7 +675,10 @@ impl Default for Config {
                     },
                     duplicate_distance_m: 1.0,
                     duplicate_speed_difference_mps: 1.0,
-                    radial_velocity_update: RadialVelocityUpdateConfig::default(),
+                    radial_velocity_update: RadialVelocityUpdateConfig {
+                        enabled: true,
+                        ..RadialVelocityUpdateConfig::default()
+                    },
                     extent: ExtentConfig::default(),
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
                     constant_acceleration: ConstantAccelerationConfig {
@@ -704,11 +715,17 @@ impl Default for Config {
                     existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
                     duplicate_distance_m: 1.5,
                     duplicate_speed_difference_mps: 2.0,
-                    radial_velocity_update: RadialVelocityUpdateConfig::default(),
+                    radial_velocity_update: RadialVelocityUpdateConfig {
+                        enabled: true,
+                        ..RadialVelocityUpdateConfig::default()
+                    },
                     extent: ExtentConfig {
+                        enabled: true,
                         length_m: 2.0,
                         width_m: 0.8,
                         contour_std_m: 0.3,
+                        offset_scale: 0.5,
+                        absorb_extra_detections: true,
                         ..ExtentConfig::default()
                     },
                     constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 3.0 },
@@ -992,6 +1009,12 @@ fn validate_class(class: ObjectClass, section: &ClassConfig) -> Result<(), Confi
     }
     positive(&key("extent.contour_std_m"), extent.contour_std_m)?;
     positive(&key("extent.min_heading_speed_mps"), extent.min_heading_speed_mps)?;
+    if !(extent.offset_scale > 0.0 && extent.offset_scale <= 1.0) {
+        return Err(invalid(
+            key("extent.offset_scale"),
+            format!("must be in (0, 1], got {}", readable(extent.offset_scale)),
+        ));
+    }
     if !(extent.absorb_margin_m >= 0.0 && extent.absorb_margin_m <= 10.0) {
         return Err(invalid(
             key("extent.absorb_margin_m"),

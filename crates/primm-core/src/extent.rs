@@ -50,6 +50,12 @@ pub struct ExtentConfig {
     /// Speed below which the velocity gives no heading (the disc model), m/s; the box model
     /// takes over fully at twice this speed.
     pub min_heading_speed_mps: f64,
+    /// How far toward the nearest point of the outline a reported detection lies, from the
+    /// centre (0) to the point itself (1), dimensionless in (0, 1]: a single strongest
+    /// reflection sits on the outline, a detection that a radar's clustering averaged over the
+    /// visible faces lies further in. Scales the offset, and the spread's standard deviations.
+    #[cfg_attr(feature = "serde", serde(default = "default_offset_scale"))]
+    pub offset_scale: f64,
     /// Whether a measurement left unassigned that lies on a confirmed track's object (its box,
     /// grown by `absorb_margin_m`) is taken as a second detection of that object rather than
     /// the start of a new track (counted; it updates nothing).
@@ -58,6 +64,11 @@ pub struct ExtentConfig {
     /// How far outside a track's box an extra detection may lie and still be absorbed, m.
     #[cfg_attr(feature = "serde", serde(default = "default_absorb_margin_m"))]
     pub absorb_margin_m: f64,
+}
+
+#[cfg(feature = "serde")]
+fn default_offset_scale() -> f64 {
+    1.0
 }
 
 #[cfg(feature = "serde")]
@@ -75,6 +86,7 @@ impl Default for ExtentConfig {
             width_m: 1.8,
             contour_std_m: 0.5,
             min_heading_speed_mps: 1.0,
+            offset_scale: 1.0,
             absorb_extra_detections: false,
             absorb_margin_m: 1.0,
         }
@@ -138,6 +150,16 @@ pub fn expected_reflection(
     object: &ObjectPrior,
     sensor_m: DVec2,
 ) -> ExpectedReflection {
+    let reflection = on_the_outline(extent, object, sensor_m);
+    let scale = extent.offset_scale;
+    ExpectedReflection {
+        offset_m: reflection.offset_m * scale,
+        covariance_m2: reflection.covariance_m2 * (scale * scale),
+    }
+}
+
+/// [`expected_reflection`] on the outline itself (`offset_scale` 1).
+fn on_the_outline(extent: &ExtentConfig, object: &ObjectPrior, sensor_m: DVec2) -> ExpectedReflection {
     let to_sensor = sensor_m - object.centre_m;
     let range = to_sensor.length();
     if !(range > 1e-6) {
