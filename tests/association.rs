@@ -131,7 +131,7 @@ fn dense_optimum(scene: &Scene, config: &Config, class: ObjectClass) -> (usize, 
 #[test]
 fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
     // The paper's cost in one stage (tests/staged_association.rs covers the other settings).
-    let mut config = Config::default();
+    let mut config = Config::default().with_point_objects();
     config.association.cost = primm_core::config::AssociationCost::Paper;
     config.association.stages = primm_core::config::AssociationStages::Joint;
     let mut rng = ChaCha8Rng::seed_from_u64(2024);
@@ -172,7 +172,7 @@ fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
 
 #[test]
 fn tracks_far_apart_are_paired_without_the_solver() {
-    let config = Config::default();
+    let config = Config::default().with_point_objects();
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let imm = Imm::new(&config.imm);
     let models = ModeModels::from_config(&config.classes.car);

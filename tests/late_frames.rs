@@ -13,7 +13,8 @@ use primm_core::validation::FrameError;
 use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
 
 fn imm_config() -> Config {
-    Config::default().with_modes(Method::Imm.modes())
+    // The scene's measurements are its objects' centres.
+    Config::default().with_modes(Method::Imm.modes()).with_point_objects()
 }
 
 /// The first `count` frames of a generated four-radar sequence (one sensor per frame, every

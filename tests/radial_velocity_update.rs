@@ -15,7 +15,8 @@ const DT_S: f64 = 0.05;
 const SENSOR_3_M: DVec2 = DVec2::new(3.86, 0.70);
 
 fn config(radial_velocity_update: bool) -> Config {
-    let mut config = Config::default().with_modes(Method::Imm.modes());
+    // Point objects: the scene measures the cars' centres.
+    let mut config = Config::default().with_modes(Method::Imm.modes()).with_point_objects();
     for class in ObjectClass::ALL {
         config.classes.get_mut(class).radial_velocity_update.enabled = radial_velocity_update;
     }
@@ -159,4 +160,16 @@ fn measurements_of_a_sensor_without_mount_are_seen_from_the_reference_point_and_
     let stats = tracker.stats();
     assert!(stats.radial_velocity_updates > 50, "{stats:?}");
     assert_eq!(stats.updates_from_unknown_sensor, stats.radial_velocity_updates);
+}
+
+#[test]
+fn without_a_pose_the_row_is_left_out_since_the_ego_motion_is_unknown() {
+    let mut frames = frames(30, Some(3), 15);
+    let mut tracker = Tracker::new(config(true)).unwrap();
+    for (frame, _) in frames.iter_mut() {
+        frame.ego_pose = None;
+        tracker.step(frame).unwrap();
+    }
+    assert_eq!(tracker.stats().radial_velocity_updates, 0);
+    assert!(tracker.stats().measurements_accepted > 100);
 }

@@ -222,7 +222,7 @@ fn run_scenes(config: &Config, seed: u64) -> usize {
 
 #[test]
 fn the_confirmed_stage_is_optimal_and_the_tentative_stage_is_optimal_over_what_it_left() {
-    let mut config = Config::default();
+    let mut config = Config::default().with_point_objects();
     config.association.stages = AssociationStages::ConfirmedFirst;
     let tentative_pairs = run_scenes(&config, 11);
     assert!(tentative_pairs > 100, "the scenes must pair tentative tracks too, got {tentative_pairs}");
@@ -232,7 +232,7 @@ fn the_confirmed_stage_is_optimal_and_the_tentative_stage_is_optimal_over_what_i
 
 #[test]
 fn the_likelihood_cost_association_matches_a_dense_solve() {
-    let mut config = Config::default();
+    let mut config = Config::default().with_point_objects();
     config.association.cost = AssociationCost::Likelihood;
     config.association.stages = AssociationStages::Joint;
     run_scenes(&config, 13);
@@ -243,7 +243,7 @@ fn a_tentative_track_cannot_take_the_measurement_a_confirmed_track_needs() {
     // A confirmed track at the origin and a tentative one 0.3 m away; one measurement between
     // them, nearer the tentative track. Jointly the tentative track wins it (lower cost, same
     // number of pairs); in stages the confirmed track keeps it.
-    let config = Config::default();
+    let config = Config::default().with_point_objects();
     let imm = Imm::new(&config.imm);
     let models = ModeModels::from_config(&config.classes.car);
     let context = PredictContext { dt_s: 0.05, displacement_m: None, displacement_covariance_m2: None };
@@ -289,7 +289,7 @@ fn common_measurement() -> Measurement {
 
 #[test]
 fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
-    let config = Config::default();
+    let config = Config::default().with_point_objects();
     let mut rng = ChaCha8Rng::seed_from_u64(99);
     let mut likelihood = config.clone();
     likelihood.association.cost = AssociationCost::Likelihood;

@@ -139,6 +139,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             &dispatched,
             &measurements,
             &sensors,
+            true,
             &mut outcomes,
         );
         let mut plain_tracks = tracks.clone();
@@ -174,6 +175,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             &baseline,
             &measurements,
             &sensors,
+            true,
             &mut baseline_outcomes,
         );
         assert_eq!(baseline_outcomes, outcomes, "{method}: update outcomes, wide vs baseline");

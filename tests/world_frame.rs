@@ -13,7 +13,8 @@ use primm_core::validation::FrameError;
 const DT_S: f64 = 0.05;
 
 fn config(tracking_frame: TrackingFrame) -> Config {
-    let mut config = Config::default().with_modes(Method::Imm.modes());
+    // The scene measures its objects' centres: point objects.
+    let mut config = Config::default().with_modes(Method::Imm.modes()).with_point_objects();
     config.frame.tracking_frame = tracking_frame;
     config
 }

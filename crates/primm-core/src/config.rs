@@ -805,6 +805,15 @@ impl Config {
         self
     }
 
+    /// This configuration with every class tracked as a point (`classes.<class>.extent` off):
+    /// for detections that are already object centres (or a scene built of points).
+    pub fn with_point_objects(mut self) -> Self {
+        for class in ObjectClass::ALL {
+            self.classes.get_mut(class).extent.enabled = false;
+        }
+        self
+    }
+
     /// The IMM settings of `class`: the `imm` section with `classes.<class>.imm` applied.
     pub fn imm_for(&self, class: ObjectClass) -> ImmConfig {
         self.imm.with_overrides(&self.classes.get(class).imm)

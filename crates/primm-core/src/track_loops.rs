@@ -98,7 +98,8 @@ pub type UpdateOutcome = Result<Option<RadialVelocityOutcome>, UpdateError>;
 /// The IMM update of every track that has a measurement in `measurements` (same order as
 /// `tracks`), of the centre through the expected reflection for a class tracked as an extended
 /// object (`crate::extent`), with the radial-velocity row where the class asks for it, seen from
-/// `sensor_positions_m[i]` (the tracking frame); `outcomes[i]` is the result for track `i`
+/// `sensor_positions_m[i]` (the tracking frame) and only with `radial_velocity_rows` (the
+/// tracker passes whether the step tracks in the world frame); `outcomes[i]` is the result for track `i`
 /// (`Ok(None)` for tracks without measurement, which are left untouched). A failed update
 /// leaves the track at its prior.
 #[cfg_attr(feature = "std", multiversion(targets("x86_64+avx+avx2+fma")))]
@@ -109,9 +110,19 @@ pub fn update(
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
     sensor_positions_m: &[DVec2],
+    radial_velocity_rows: bool,
     outcomes: &mut [UpdateOutcome],
 ) {
-    update_loop(imms, models, tracks, priors, measurements, sensor_positions_m, outcomes);
+    update_loop(
+        imms,
+        models,
+        tracks,
+        priors,
+        measurements,
+        sensor_positions_m,
+        radial_velocity_rows,
+        outcomes,
+    );
 }
 
 #[inline(always)]
@@ -122,6 +133,7 @@ fn update_loop(
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
     sensor_positions_m: &[DVec2],
+    radial_velocity_rows: bool,
     outcomes: &mut [UpdateOutcome],
 ) {
     for ((((track, prior), measurement), sensor_position_m), outcome) in
@@ -135,7 +147,9 @@ fn update_loop(
                     Some(_) => models.expected_reflection(&prior.object_prior(), *sensor_position_m),
                     None => ExpectedReflection::POINT,
                 };
-                let radial_velocity = models.radial_velocity_observation(z, *sensor_position_m);
+                let radial_velocity = models
+                    .radial_velocity_observation(z, *sensor_position_m)
+                    .filter(|_| radial_velocity_rows);
                 imms[class].update_with_radial_velocity_into(
                     models,
                     prior,
@@ -221,8 +235,18 @@ pub mod baseline {
         priors: &[ImmPrior],
         measurements: &[Option<Measurement>],
         sensor_positions_m: &[DVec2],
+        radial_velocity_rows: bool,
         outcomes: &mut [UpdateOutcome],
     ) {
-        update_loop(imms, models, tracks, priors, measurements, sensor_positions_m, outcomes);
+        update_loop(
+            imms,
+            models,
+            tracks,
+            priors,
+            measurements,
+            sensor_positions_m,
+            radial_velocity_rows,
+            outcomes,
+        );
     }
 }

@@ -960,6 +960,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
             &self.priors[..count],
             &self.assigned_measurements[..count],
             &self.assigned_sensor_positions[..count],
+            // Radial velocities are over ground: they measure the velocity of world-frame
+            // tracks, not of vehicle-frame tracks of an ego whose motion is unknown.
+            self.step_pose.is_some(),
             &mut self.update_outcomes[..count],
         );
         for i in 0..count {

@@ -29,11 +29,12 @@
 //! for k in 0..3 {
 //!     let mut frame = Frame::new(0.05 * k as f64);
 //!     frame.measurements.push(Measurement {
-//!         x_m: 20.0 + 0.5 * k as f64,
+//!         x_m: 20.0 + 0.07 * k as f64,
 //!         y_m: 1.5,
-//!         radial_velocity_mps: 10.0,
-//!         rcs_dbsm: 8.0,
-//!         class: ObjectClass::Car,
+//!         radial_velocity_mps: 1.4,
+//!         rcs_dbsm: -5.0,
+//!         // `predictor.classes`: the model predicts pedestrians and two-wheelers by default.
+//!         class: ObjectClass::Pedestrian,
 //!         sensor_id: Some(0),
 //!         ground_truth_id: None,
 //!     });
