@@ -242,8 +242,7 @@ impl ImmPrior {
     /// m/s (PR: its last displacement over the step), as [`Imm::fuse_velocity`] fuses a
     /// posterior's.
     pub fn fused_velocity_mps(&self) -> DVec2 {
-        let weights = renormalised(&self.state.probabilities, self.available);
-        self.available.iter().map(|mode| weights[mode.index()] * self.state.velocity(mode)).sum()
+        fused_velocity(&self.state, self.available)
     }
 
     /// The fused prior as an extended object's prior (`crate::extent`): position and its
@@ -253,15 +252,16 @@ impl ImmPrior {
     pub fn object_prior(&self) -> ObjectPrior {
         let physics = self.available.without(Mode::Learned);
         let weights = renormalised(&self.state.probabilities, physics);
-        let mean: DVec2 = physics.iter().map(|mode| weights[mode.index()] * self.state.velocity(mode)).sum();
+        let mean = fused_velocity(&self.state, physics);
         let mut velocity_covariance_m2 = DMat2::ZERO;
         for mode in physics.iter() {
-            let block = match mode {
-                Mode::ConstantVelocity => velocity_block(&self.state.constant_velocity),
-                Mode::ConstantAcceleration => velocity_block(&self.state.constant_acceleration),
-                Mode::CoordinatedTurn => velocity_block(&self.state.coordinated_turn),
+            let marginal = match mode {
+                Mode::ConstantVelocity => marginal4(&self.state.constant_velocity),
+                Mode::ConstantAcceleration => marginal4(&self.state.constant_acceleration),
+                Mode::CoordinatedTurn => marginal4(&self.state.coordinated_turn),
                 Mode::Learned => continue,
             };
+            let block = lower_right(&marginal.covariance);
             let spread = self.state.velocity(mode) - mean;
             velocity_covariance_m2 += (block + outer(spread, spread)) * weights[mode.index()];
         }
@@ -274,10 +274,10 @@ impl ImmPrior {
     }
 }
 
-/// The velocity block `[vx, vy]` (elements 2 and 3) of a mode's covariance.
-fn velocity_block<const N: usize>(gaussian: &Gaussian<N>) -> DMat2 {
-    let p = &gaussian.covariance;
-    DMat2::from_cols(DVec2::new(p[(2, 2)], p[(3, 2)]), DVec2::new(p[(2, 3)], p[(3, 3)]))
+/// The velocity over `modes`, weights `μ` (or `c`) renormalised over them, m/s.
+fn fused_velocity(state: &ImmState, modes: ModeSet) -> DVec2 {
+    let weights = renormalised(&state.probabilities, modes);
+    modes.iter().map(|mode| weights[mode.index()] * state.velocity(mode)).sum()
 }
 
 /// The IMM's configuration, prepared once: stateless and shared by all tracks.
@@ -723,8 +723,7 @@ impl Imm {
     /// The fused velocity over `modes`, m/s, weights `μ` renormalised over them; PR's velocity is
     /// its last displacement divided by the step.
     pub fn fuse_velocity(&self, state: &ImmState, modes: ModeSet) -> DVec2 {
-        let weights = renormalised(&state.probabilities, modes);
-        modes.iter().map(|mode| weights[mode.index()] * state.velocity(mode)).sum()
+        fused_velocity(state, modes)
     }
 
     /// The fused position and velocity `[x, y, vx, vy]` of a posterior over `modes` and their
