@@ -19,7 +19,7 @@ Same weights and function as the shipped model (parity printed against ``models/
     python3 benches/pr_graph_variant.py /tmp/pr_batch_folded.onnx [batch-folded|transposed-heads]
     cargo bench --bench inference_profile -- /tmp/pr_batch_folded.onnx 64
 
-Needs numpy, onnx and onnxruntime (``training/requirements.txt``). BENCHMARKS.md section 1
+Needs numpy, onnx and onnxruntime (``training/requirements.txt``). docs/BENCHMARKS.md section 1
 has the results: both are slower in tract than the shipped form.
 """
 

@@ -109,7 +109,8 @@ typedef struct PrimmTrackerOptions {
   // sharing each frame's batch) with the configuration's
   // `predictor.deadline_ms`: `primm_tracker_step` then allocates nothing with any method, but
   // whether a frame gets its learned predictions depends on timing. If false, the model runs
-  // inside `primm_tracker_step` (deterministic; tract allocates during the run).
+  // inside `primm_tracker_step` (deterministic; the native forward pass, the default engine
+  // for the shipped model, allocates nothing per batch, tract allocates during the run).
   bool inference_thread;
 } PrimmTrackerOptions;
 
@@ -460,8 +461,10 @@ enum PrimmStatus primm_tracker_step(struct PrimmTracker *tracker,
 // the call. Writes what the step did to `*out_summary` unless it is
 // NULL (zeroed on failure).
 //
-// Allocates nothing, unless the PR model runs inside the step (`inference_thread` false),
-// where tract allocates during inference.
+// Allocates nothing, unless the PR model runs inside the step (`inference_thread` false) on
+// tract (`predictor.engine = "tract"`, or a model the native forward pass does not cover),
+// which allocates during inference; the native forward pass, the default engine for the
+// shipped model, allocates nothing per batch.
 //
 // A rejected frame (`PRIMM_STATUS_INVALID_FRAME`: timestamp not finite or not advancing,
 // interval too long, more than `PRIMM_MAX_MEASUREMENTS_PER_FRAME` measurements) leaves the

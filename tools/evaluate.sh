@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reproduces EVALUATION.md: generates the evaluation split (default preset) and the robustness
+# Reproduces docs/EVALUATION.md: generates the evaluation split (default preset) and the robustness
 # split (a second generator configuration), then runs `primm eval` on both.
 #   tools/evaluate.sh [OUT_DIR]      (default: out/evaluation)
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# What a learned predictor of a given accuracy could give PR-IMM (EVALUATION.md, "How much room
+# What a learned predictor of a given accuracy could give PR-IMM (docs/EVALUATION.md, "How much room
 # there is"): for each noise level, PR gets each object's true displacement plus that much
 # Gaussian noise per axis (`primm eval --displacement-oracle --displacement-oracle-noise-m`), the
 # PR mode's noises and the IMM side are tuned for it on the validation splits only

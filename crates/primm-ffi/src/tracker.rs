@@ -292,8 +292,10 @@ pub unsafe extern "C" fn primm_tracker_step(
 /// the call. Writes what the step did to `*out_summary` unless it is
 /// NULL (zeroed on failure).
 ///
-/// Allocates nothing, unless the PR model runs inside the step (`inference_thread` false),
-/// where tract allocates during inference.
+/// Allocates nothing, unless the PR model runs inside the step (`inference_thread` false) on
+/// tract (`predictor.engine = "tract"`, or a model the native forward pass does not cover),
+/// which allocates during inference; the native forward pass, the default engine for the
+/// shipped model, allocates nothing per batch.
 ///
 /// A rejected frame (`PRIMM_STATUS_INVALID_FRAME`: timestamp not finite or not advancing,
 /// interval too long, more than `PRIMM_MAX_MEASUREMENTS_PER_FRAME` measurements) leaves the

@@ -113,7 +113,8 @@ pub struct PrimmTrackerOptions {
     /// sharing each frame's batch) with the configuration's
     /// `predictor.deadline_ms`: `primm_tracker_step` then allocates nothing with any method, but
     /// whether a frame gets its learned predictions depends on timing. If false, the model runs
-    /// inside `primm_tracker_step` (deterministic; tract allocates during the run).
+    /// inside `primm_tracker_step` (deterministic; the native forward pass, the default engine
+    /// for the shipped model, allocates nothing per batch, tract allocates during the run).
     pub inference_thread: bool,
 }
 

@@ -3,7 +3,7 @@
 //! tract runs any ONNX graph, but for a model this small (two encoder layers of width 32, seven
 //! tokens) most of its time goes to the work around the matrix products: ~40 small products
 //! packed one at a time, element-wise operators run one element or row at a time
-//! (`BENCHMARKS.md`, section 1). [`NativeModel`] computes the same function directly: one
+//! (`docs/BENCHMARKS.md`, section 1). [`NativeModel`] computes the same function directly: one
 //! sample at a time, every tensor a stack array whose size is a constant, the linear layers as
 //! fixed-size loops the compiler vectorises (dispatched at run time to AVX2 or AVX-512 where
 //! the CPU has them, with the portable build as the fallback), and no allocation at all.

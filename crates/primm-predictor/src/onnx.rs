@@ -5,7 +5,7 @@
 //! chunks of the largest size, the rest padded up to the next planned size. tract runs a plan
 //! whose batch is a constant in about a quarter less time than the same graph with a symbolic
 //! batch (it then fuses more operations into the matrix products and fixes shapes and packing
-//! when the plan is made), which is more than padding to the next size costs (`BENCHMARKS.md`). [`OnnxPredictor`] is a synchronous
+//! when the plan is made), which is more than padding to the next size costs (`docs/BENCHMARKS.md`). [`OnnxPredictor`] is a synchronous
 //! [`DisplacementPredictor`] on top of it: `submit` runs the batch at once, `collect` hands the
 //! results out. It is deterministic (no clock, no thread), which is what offline tracking and
 //! evaluation want; [`ThreadedPredictor`](crate::threaded::ThreadedPredictor) moves it onto an
