@@ -89,19 +89,6 @@ pub fn association_records(
     }
 }
 
-/// Tracks `sequence` and returns its evaluation rows.
-pub fn evaluate_sequence<P: DisplacementPredictor>(
-    tracker: &mut Tracker<P>,
-    sequence: &Sequence,
-    method: Method,
-) -> Result<Vec<AssociationRecord>, OfflineError> {
-    let mut records = Vec::with_capacity(sequence.measurement_count());
-    track_sequence(tracker, sequence, |recorded, outputs| {
-        association_records(recorded, outputs, method, &mut records)
-    })?;
-    Ok(records)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -135,7 +122,11 @@ mod tests {
         let hits = config.tracker.confirmation_hits as usize;
         assert_eq!(hits, 3);
         let mut tracker = Tracker::new(config).unwrap();
-        let records = evaluate_sequence(&mut tracker, &sequence, Method::Imm).unwrap();
+        let mut records = Vec::new();
+        track_sequence(&mut tracker, &sequence, |recorded, outputs| {
+            association_records(recorded, outputs, Method::Imm, &mut records)
+        })
+        .unwrap();
         let track = records[0].track_id;
         assert!(track.is_some() && records.iter().all(|r| r.track_id == track), "{records:?}");
         let confirmed: Vec<Option<bool>> = records.iter().map(|r| r.track_confirmed).collect();

@@ -22,7 +22,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::Value;
 
 use super::identity::{identity_counts, IdentityCounts};
 use super::record::{time_order, AssociationRecord};
@@ -77,23 +77,8 @@ impl ConfirmedTrackCounts {
     /// The counts as the JSON object `primm eval` and `primm score` write under
     /// `confirmed_tracks`.
     pub fn to_json(&self) -> Value {
-        json!({
-            "sequences": self.sequences,
-            "idf1": self.idf1(),
-            "idsw": self.identity.idsw,
-            "idtp": self.identity.idtp,
-            "idfp": self.identity.idfp,
-            "idfn": self.identity.idfn,
-            "gt_object_frames": self.identity.gt_object_frames,
-            "estimated_object_frames": self.identity.estimated_object_frames,
-            "tracks": self.confirmed_tracks,
-            "false_tracks": self.false_tracks,
-            "false_tracks_per_minute": self.false_tracks_per_minute(),
-            "fragmentations": self.fragmentations,
-            "clutter_rows": self.clutter_rows,
-            "clutter_rows_in_confirmed_tracks": self.clutter_rows_in_confirmed_tracks,
-            "duration_s": self.duration_s,
-        })
+        serde_json::to_value(super::document::ConfirmedTracksDocument::from(self))
+            .expect("the confirmed-track document serialises")
     }
 }
 
@@ -231,6 +216,7 @@ fn duration_s(records: &[AssociationRecord]) -> f64 {
 mod tests {
     use super::*;
     use crate::eval::record::test_support::identity_row;
+    use serde_json::json;
 
     /// A row of object `gt` (or clutter) taken by `track` (or no track), confirmed or not.
     fn row(frame: u64, gt: Option<u64>, track: Option<u64>, confirmed: bool) -> AssociationRecord {

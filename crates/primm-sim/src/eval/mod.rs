@@ -19,14 +19,17 @@
 //! * velocity RMSE of the tracks and speed and heading errors of confirmed tracks, where the
 //!   data carry true velocities ([`velocity`]),
 //!
-//! and assembles them into plain-text tables and JSON ([`report`]) and SVG figures ([`plots`]).
+//! and assembles them into plain-text tables ([`report`]), a typed JSON document ([`document`])
+//! and SVG figures ([`plots`]). [`evaluate()`] runs every method on a data set ([`evaluate`]).
 //! The exact definitions, thresholds and units are documented in `docs/evaluation-metrics.md`.
 //!
 //! Nothing here is on the tracker's real-time path; clarity wins over speed.
 
 pub mod confirmed;
+pub mod document;
 pub mod dropout;
 pub mod ego_motion;
+pub mod evaluate;
 pub mod identity;
 pub mod interaction;
 pub mod modes;
@@ -40,7 +43,12 @@ pub mod velocity;
 pub use confirmed::{
     confirmed_track_counts, tracks_born_of_clutter, ConfirmedTrackCounts, UnknownTrackStatus,
 };
+pub use document::ReportDocument;
 pub use dropout::{sequence_seed, DropoutMask};
+pub use evaluate::{
+    evaluate, EvaluateError, Evaluation, EvaluationDocument, EvaluationSettings, Progress, Truth,
+    DEFAULT_MISS_SEED,
+};
 pub use identity::{
     id_switch_rows, id_switches, identity_counts, identity_counts_subset, max_total_overlap, IdentityCounts,
 };

@@ -69,16 +69,6 @@ impl AssociationRecord {
         self.true_position.unwrap_or(self.measured)
     }
 
-    /// Whether this row is a ground-truth object frame.
-    pub fn is_ground_truth_frame(&self) -> bool {
-        self.ground_truth_id.is_some()
-    }
-
-    /// Whether this row is an estimated object frame (a track consumed the measurement).
-    pub fn is_estimated_frame(&self) -> bool {
-        self.track_id.is_some()
-    }
-
     /// Whether a confirmed track took this measurement: a track id and `track_confirmed ==
     /// Some(true)`.
     pub fn is_confirmed_track_frame(&self) -> bool {

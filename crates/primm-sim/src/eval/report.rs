@@ -23,9 +23,10 @@ use std::path::Path;
 
 use primm_core::measurement::ObjectClass;
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Map, Value};
+use serde_json::Value;
 
 use super::confirmed::{confirmed_track_counts, ConfirmedTrackCounts};
+use super::document::ReportDocument;
 use super::ego_motion::EgoMotion;
 use super::identity::{identity_counts, identity_counts_subset, IdentityCounts};
 use super::interaction::{interaction_flags, InteractionRules};
@@ -191,17 +192,6 @@ impl MethodEvaluator {
             interaction_rules: InteractionRules::default(),
             result: MethodResult::new(method),
         }
-    }
-
-    /// An evaluator with custom rules.
-    pub fn with_rules(
-        method: Method,
-        scenario_rules: ScenarioRules,
-        interaction_rules: InteractionRules,
-    ) -> Result<Self, EvalError> {
-        scenario_rules.validate()?;
-        interaction_rules.validate()?;
-        Ok(Self { scenario_rules, interaction_rules, result: MethodResult::new(method) })
     }
 
     /// Adds the rows of one nominal sequence (all of its measurements).
@@ -755,47 +745,10 @@ impl EvaluationReport {
         .join("\n")
     }
 
-    /// The report as JSON:
-    /// `{"methods": {"<key>": {"available", "rmse_x", "rmse_y", "rmse_xy", "idsw", "idf1",
-    /// "counts": {…}, "scenarios": {…}}}, "mode_probabilities": {…}}`.
-    ///
-    /// `scenarios` holds the Table III entries (`straight`, `accel_decel`, `left_right_turn`,
-    /// `nonlinear`: RMSE values, `rmse_samples`, `gt_object_frames`) and the Table V entries
-    /// (`close_proximity`, `crossing_motion`, `miss_<percent>`: `idsw`, `idf1`, IDTP/IDFP/IDFN and
-    /// frame counts). Unavailable methods have `"available": false`, a `reason`, `null` metrics and
-    /// empty `scenarios`. `mode_probabilities` holds PR-IMM's mean probabilities per mode and the
-    /// number of updates (`null` values without updates), and `by_class` the same per object
-    /// class that has updates (`{"car": {"samples", "pr", "cv", "ca", "ct"}, …}`).
-    /// `confirmed_tracks` holds the counts on confirmed tracks
-    /// ([`ConfirmedTrackCounts::to_json`]), `null` when unavailable or unknown.
+    /// The report as JSON: [`ReportDocument`] (its module documents the schema) as a
+    /// [`serde_json::Value`].
     pub fn to_json(&self) -> Value {
-        let mut methods = Map::new();
-        for method in Method::ALL {
-            let value = match self.result(method) {
-                Some(result) => self.method_json(result),
-                None => json!({
-                    "available": false,
-                    "reason": self.unavailable_reason(method).unwrap_or("not evaluated"),
-                    "rmse_x": null, "rmse_y": null, "rmse_xy": null,
-                    "idsw": null, "idf1": null,
-                    "counts": null,
-                    "scenarios": {},
-                    "confirmed_tracks": null,
-                    "velocity": null,
-                }),
-            };
-            methods.insert(method.key().to_string(), value);
-        }
-        let pr_imm = self.result(Method::PrImm);
-        let mut mode_probabilities = mode_means_json(&pr_imm.map(|r| r.modes).unwrap_or_default());
-        mode_probabilities.insert("method".into(), json!(Method::PrImm.key()));
-        let by_class: Map<String, Value> = pr_imm
-            .into_iter()
-            .flat_map(|result| &result.class_modes)
-            .map(|(class, acc)| (class.name().to_string(), Value::Object(mode_means_json(acc))))
-            .collect();
-        mode_probabilities.insert("by_class".into(), Value::Object(by_class));
-        json!({ "methods": methods, "mode_probabilities": mode_probabilities })
+        serde_json::to_value(ReportDocument::of(self)).expect("the report document serialises")
     }
 
     /// Writes [`EvaluationReport::to_json`] pretty-printed to `path`.
@@ -803,70 +756,6 @@ impl EvaluationReport {
         let text = serde_json::to_string_pretty(&self.to_json())?;
         std::fs::write(path, text + "\n")?;
         Ok(())
-    }
-
-    fn method_json(&self, result: &MethodResult) -> Value {
-        let mut scenarios = Map::new();
-        for category in MotionCategory::ALL {
-            let acc = result.scenario(category);
-            scenarios.insert(
-                category.key().to_string(),
-                json!({
-                    "rmse_x": acc.rmse_x(),
-                    "rmse_y": acc.rmse_y(),
-                    "rmse_xy": acc.rmse_xy(),
-                    "rmse_samples": acc.count(),
-                    "gt_object_frames": result.scenario_frames(category),
-                }),
-            );
-        }
-        for (key, counts) in
-            [("close_proximity", result.close_proximity), ("crossing_motion", result.crossing)]
-        {
-            scenarios.insert(key.to_string(), identity_json(&counts));
-        }
-        for (percent, counts) in &result.missed_detection {
-            scenarios.insert(format!("miss_{percent}"), identity_json(counts));
-        }
-        for (class, acc) in &result.class_rmse {
-            scenarios.insert(
-                format!("class_{}", class.name()),
-                json!({ "rmse_xy": acc.rmse_xy(), "rmse_samples": acc.count() }),
-            );
-        }
-        for (motion, counts) in &result.ego_identity {
-            let key = match motion {
-                EgoMotion::Straight => "ego_straight",
-                EgoMotion::Turning => "ego_turning",
-            };
-            let mut value = identity_json(counts);
-            if let (Some(object), Some(acc)) = (value.as_object_mut(), result.ego_rmse.get(motion)) {
-                object.insert("rmse_xy".into(), json!(acc.rmse_xy()));
-                object.insert("rmse_samples".into(), json!(acc.count()));
-            }
-            scenarios.insert(key.to_string(), value);
-        }
-        json!({
-            "available": true,
-            "rmse_x": result.rmse.rmse_x(),
-            "rmse_y": result.rmse.rmse_y(),
-            "rmse_xy": result.rmse.rmse_xy(),
-            "idsw": result.identity.idsw,
-            "idf1": result.identity.idf1(),
-            "counts": {
-                "sequences": result.sequences,
-                "rmse_samples": result.rmse.count(),
-                "gt_object_frames": result.identity.gt_object_frames,
-                "estimated_object_frames": result.identity.estimated_object_frames,
-                "idtp": result.identity.idtp,
-                "idfp": result.identity.idfp,
-                "idfn": result.identity.idfn,
-                "mode_probability_samples": result.modes.count(),
-            },
-            "scenarios": scenarios,
-            "confirmed_tracks": result.confirmed.as_ref().map(ConfirmedTrackCounts::to_json),
-            "velocity": velocity_json(result),
-        })
     }
 
     /// Table V scenarios: label and how to pick the counts from a result.
@@ -913,59 +802,6 @@ fn metric_row(
     let mut line = vec![first, metric.to_string()];
     line.extend(mark_best(values, better, digits).iter().map(Cell::to_string));
     line
-}
-
-/// The `velocity` entry of a method: the velocity RMSE overall and per class, and the speed and
-/// heading errors of confirmed tracks, overall and per class.
-fn velocity_json(result: &MethodResult) -> Value {
-    let rmse = |acc: &VelocityRmseAccumulator| {
-        json!({
-            "rmse_mps": acc.rmse_mps(),
-            "rmse_x_mps": acc.rmse_x_mps(),
-            "rmse_y_mps": acc.rmse_y_mps(),
-            "samples": acc.count(),
-        })
-    };
-    let motion = |acc: &SpeedHeadingAccumulator| {
-        json!({
-            "speed_rmse_mps": acc.speed_rmse_mps(),
-            "speed_mean_error_mps": acc.speed_mean_error_mps(),
-            "speed_samples": acc.speed_count(),
-            "heading_rmse_deg": acc.heading_rmse_deg(),
-            "heading_mean_abs_error_deg": acc.heading_mean_abs_deg(),
-            "heading_samples": acc.heading_count(),
-        })
-    };
-    let mut value = rmse(&result.velocity);
-    let by_class: Map<String, Value> =
-        result.class_velocity.iter().map(|(class, acc)| (class.name().to_string(), rmse(acc))).collect();
-    let mut confirmed = motion(&result.confirmed_motion);
-    let confirmed_by_class: Map<String, Value> = result
-        .class_confirmed_motion
-        .iter()
-        .map(|(class, acc)| (class.name().to_string(), motion(acc)))
-        .collect();
-    if let Some(object) = confirmed.as_object_mut() {
-        object.insert("by_class".into(), Value::Object(confirmed_by_class));
-    }
-    if let Some(object) = value.as_object_mut() {
-        object.insert("by_class".into(), Value::Object(by_class));
-        object.insert("confirmed_tracks".into(), confirmed);
-        object.insert("heading_min_true_speed_mps".into(), json!(HEADING_MIN_TRUE_SPEED_MPS));
-    }
-    value
-}
-
-fn identity_json(counts: &IdentityCounts) -> Value {
-    json!({
-        "idsw": counts.idsw,
-        "idf1": counts.idf1(),
-        "idtp": counts.idtp,
-        "idfp": counts.idfp,
-        "idfn": counts.idfn,
-        "gt_object_frames": counts.gt_object_frames,
-        "estimated_object_frames": counts.estimated_object_frames,
-    })
 }
 
 /// Reads one RMSE value from an accumulator.
@@ -1062,17 +898,6 @@ fn count_text(values: &[u64]) -> String {
 }
 
 /// Renders a title, a header and rows; the first column is left-aligned, the others right-aligned.
-/// `{"samples", "pr", "cv", "ca", "ct"}` of one accumulator (`null` means without samples).
-fn mode_means_json(acc: &ModeProbabilityAccumulator) -> Map<String, Value> {
-    let mean = acc.mean();
-    let mut entry = Map::new();
-    entry.insert("samples".into(), json!(acc.count()));
-    for (index, name) in MODE_NAMES.iter().enumerate() {
-        entry.insert(name.to_ascii_lowercase(), json!(mean.map(|m| m[index])));
-    }
-    entry
-}
-
 fn render_table(title: &str, header: &[String], rows: &[Vec<String>]) -> String {
     render_table_aligned(title, header, rows, 1)
 }
@@ -1123,6 +948,7 @@ mod tests {
     use super::*;
     use crate::eval::record::test_support::position_row;
     use glam::DVec2;
+    use serde_json::json;
 
     /// One sequence: object 1 drives straight along +x at 10 m/s for 12 frames (0.1 s apart);
     /// object 2 drives parallel 3 m to the left. The tracker of `method` gives object 1 track 1
