@@ -105,10 +105,10 @@ pub enum DemoError {
     #[cfg_attr(feature = "tunnel", allow(dead_code))]
     #[error("--hosts 2 needs the tunnel, which this primm was built without; build it with `cargo build --release --features tunnel`")]
     TunnelNotBuilt,
-    /// No free TCP port on the loopback interface for the tunnels.
+    /// The listening tunnel named no TCP endpoint on 127.0.0.1 in its listening file.
     #[cfg_attr(not(feature = "tunnel"), allow(dead_code))]
-    #[error("cannot find a free TCP port on 127.0.0.1 for the tunnel: {0}")]
-    Port(std::io::Error),
+    #[error("the tunnel of host A did not say where it listens ({0})")]
+    ListeningEndpoint(String),
 }
 
 /// How long a child asked to stop (SIGINT) may take before it is killed.

@@ -45,6 +45,12 @@ pub struct Args {
     /// the tunnel stops.
     #[arg(long, value_name = "FILE")]
     pub ready_file: Option<PathBuf>,
+    /// Write this file once the tunnel listens: one zenoh locator per line, e.g.
+    /// `tcp/127.0.0.1:40123`, with the port the operating system chose for a `--listen`
+    /// endpoint of port 0 (so that a script or a test needs no free port of its own); removed
+    /// again when the tunnel stops.
+    #[arg(long, value_name = "FILE")]
+    pub listening_file: Option<PathBuf>,
     /// Print the counters to stderr this often (0: only at the end).
     #[arg(long, default_value_t = 0.0, value_name = "SECONDS")]
     pub stats_every_s: f64,
@@ -68,8 +74,8 @@ pub enum TunnelError {
     /// The tunnel stopped with an error.
     #[error(transparent)]
     Run(#[from] TunnelRunError),
-    /// The ready file could not be written.
-    #[error("cannot write the ready file {path}: {source}")]
+    /// The ready file or the listening file could not be written.
+    #[error("cannot write {path}: {source}")]
     ReadyFile {
         /// The file.
         path: PathBuf,
@@ -116,6 +122,16 @@ pub fn run(args: &Args) -> Result<(), TunnelError> {
         names.latency()
     );
 
+    if let Some(path) = &args.listening_file {
+        // Written whole, then renamed: a reader never sees half of it.
+        let mut text = tunnel.listening_on().join("\n");
+        text.push('\n');
+        let partial = PathBuf::from(format!("{}.partial", path.display()));
+        std::fs::write(&partial, text)
+            .and_then(|()| std::fs::rename(&partial, path))
+            .map_err(|source| TunnelError::ReadyFile { path: path.clone(), source })?;
+    }
+
     let started = Instant::now();
     let stats_every = (args.stats_every_s > 0.0).then(|| Duration::from_secs_f64(args.stats_every_s));
     let mut next_stats = stats_every.map(|every| started + every);
@@ -145,7 +161,7 @@ pub fn run(args: &Args) -> Result<(), TunnelError> {
             shutdown.request();
         }
     });
-    if let Some(path) = &args.ready_file {
+    for path in [&args.ready_file, &args.listening_file].into_iter().flatten() {
         let _ = std::fs::remove_file(path);
     }
     if let Some(error) = ready_error {

@@ -34,18 +34,26 @@ impl TwoHosts {
         let host_a = Iceoryx2Domain::new(&format!("{test}_a"));
         let host_b = Iceoryx2Domain::new(&format!("{test}_b"));
         let prefix = unique_prefix(test);
-        let port = std::net::TcpListener::bind(("127.0.0.1", 0)).unwrap().local_addr().unwrap().port();
-        let endpoint = format!("tcp/127.0.0.1:{port}");
+        // Host A's tunnel listens on a port the operating system picks (port 0) and names it
+        // in its listening file; host B's connects there. No port is chosen by the test, so
+        // none can be taken by another process in between.
+        let listening = std::env::temp_dir().join(format!("{}tunnel.listening", host_a.name()));
+        let _ = std::fs::remove_file(&listening);
+        let mut endpoint = String::from("tcp/127.0.0.1:0");
         let mut tunnels = Vec::new();
         for (host, option, mode) in [(&host_a, "--listen", mode_a), (&host_b, "--connect", mode_b)] {
             let ready = std::env::temp_dir().join(format!("{}tunnel.ready", host.name()));
             let _ = std::fs::remove_file(&ready);
-            let child = host
-                .primm("warn")
+            let mut command = host.primm("warn");
+            command
                 .args(["tunnel", "--service-prefix", &prefix, "--mode", mode, "--multicast-scouting", "off"])
                 .args([option, &endpoint])
                 .arg("--ready-file")
-                .arg(&ready)
+                .arg(&ready);
+            if option == "--listen" {
+                command.arg("--listening-file").arg(&listening);
+            }
+            let child = command
                 .stdout(Stdio::piped())
                 .stderr(Stdio::null())
                 .spawn()
@@ -53,15 +61,25 @@ impl TwoHosts {
             tunnels.push((ChildGuard(child), ready));
             if option == "--listen" {
                 // zenoh in client mode gives up at once when nothing listens yet: start the
-                // connecting side once the listening side accepts connections.
+                // connecting side once the listening side says where it listens.
                 let deadline = Instant::now() + HANG_GUARD;
-                while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+                endpoint = loop {
+                    if let Ok(text) = std::fs::read_to_string(&listening) {
+                        break text
+                            .lines()
+                            .find(|line| line.starts_with("tcp/127.0.0.1:"))
+                            .unwrap_or_else(|| {
+                                panic!("no TCP endpoint on 127.0.0.1 in the listening file:\n{text}")
+                            })
+                            .to_owned();
+                    }
+                    assert!(tunnels[0].0.is_running(), "the listening tunnel exited before it listened");
                     assert!(
                         Instant::now() < deadline,
                         "the listening tunnel did not listen within {HANG_GUARD:?}"
                     );
                     std::thread::sleep(Duration::from_millis(20));
-                }
+                };
             }
         }
         let deadline = Instant::now() + HANG_GUARD;

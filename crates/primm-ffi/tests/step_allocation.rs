@@ -5,55 +5,16 @@
 
 use primm_ffi::*;
 use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::ptr::{null, null_mut};
 
-thread_local! {
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-/// Counts `alloc`, `alloc_zeroed` and `realloc` calls per thread and forwards them to the system
-/// allocator.
-struct CountingAllocator;
-
-fn record_allocation() {
-    // `try_with`: the allocator may run while the thread's locals are being torn down.
-    let _ = ALLOCATIONS.try_with(|count| count.set(count.get() + 1));
-}
-
-// SAFETY: every method forwards to `System` with the caller's arguments unchanged; the counter is
-// a const-initialised thread-local `Cell`, which never allocates.
-unsafe impl GlobalAlloc for CountingAllocator {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        record_allocation();
-        // SAFETY: forwarded.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        record_allocation();
-        // SAFETY: forwarded.
-        unsafe { System.alloc_zeroed(layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        record_allocation();
-        // SAFETY: forwarded.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
+// The workspace's one counting allocator, shared with the integration tests.
+#[path = "../../../tests/common/counting_allocator.rs"]
+#[allow(dead_code)] // `allocations` is not used here
+mod counting_allocator;
+use counting_allocator::{count_allocations, CountingAllocator};
 
 #[global_allocator]
 static GLOBAL: CountingAllocator = CountingAllocator;
-
-fn count_allocations(work: impl FnOnce()) -> u64 {
-    let before = ALLOCATIONS.with(Cell::get);
-    work();
-    ALLOCATIONS.with(Cell::get) - before
-}
 
 /// The frames of a generated 5 s scenario as C measurement arrays, with their timestamps.
 fn scenario_frames() -> Vec<(f64, Vec<PrimmMeasurement>)> {

@@ -2,7 +2,7 @@
 //! that the PR model runs on several inference threads at once.
 //!
 //! The PR model's cost grows with the batch (about 15 µs per model row through tract, plus
-//! ~55 µs per run; `BENCHMARKS.md`, section 1), and while it runs the tracking thread only
+//! ~55 µs per run; `docs/BENCHMARKS.md`, section 1), and while it runs the tracking thread only
 //! waits. With two cores, two [`ThreadedPredictor`]s that each take half of the batch finish
 //! in about half the time. [`SplitPredictor`] does the sharing for any predictor type:
 //!
@@ -27,9 +27,8 @@ use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionReque
 use std::ops::Range;
 use std::time::Duration;
 
-/// Fewest requests a part gets before the batch is split further, unless
-/// [`SplitPredictor::with_min_requests_per_part`] says otherwise. Below ~16 rows the fixed cost of
-/// a tract run and of waking another thread outweighs what the split saves (`BENCHMARKS.md`).
+/// Fewest requests a part gets before the batch is split further. Below ~16 rows the fixed cost of
+/// a tract run and of waking another thread outweighs what the split saves (`docs/BENCHMARKS.md`).
 pub const DEFAULT_MIN_REQUESTS_PER_PART: usize = 16;
 
 /// Why [`SplitPredictor::new`] refused its predictors.
@@ -81,12 +80,6 @@ impl<P: DisplacementPredictor> SplitPredictor<P> {
         Ok(SplitPredictor { parts, min_requests_per_part: DEFAULT_MIN_REQUESTS_PER_PART, submitted: 0 })
     }
 
-    /// Changes the fewest requests per part (at least 1).
-    pub fn with_min_requests_per_part(mut self, min_requests_per_part: usize) -> Self {
-        self.min_requests_per_part = min_requests_per_part.max(1);
-        self
-    }
-
     /// The fewest requests a part gets before a batch is split further.
     pub fn min_requests_per_part(&self) -> usize {
         self.min_requests_per_part
@@ -95,11 +88,6 @@ impl<P: DisplacementPredictor> SplitPredictor<P> {
     /// The predictors, in the order of the parts they take.
     pub fn parts(&self) -> &[P] {
         &self.parts
-    }
-
-    /// The predictors, mutably (e.g. to change a deadline).
-    pub fn parts_mut(&mut self) -> &mut [P] {
-        &mut self.parts
     }
 
     /// How many predictors a batch of `requests` requests is shared among.

@@ -156,11 +156,6 @@ impl ServiceNames {
         Self { prefix: prefix.trim_matches('/').to_owned() }
     }
 
-    /// The prefix from [`SERVICE_PREFIX_ENV`], or none.
-    pub fn from_env() -> Self {
-        Self::new(&std::env::var(SERVICE_PREFIX_ENV).unwrap_or_default())
-    }
-
     /// The prefix.
     pub fn prefix(&self) -> &str {
         &self.prefix

@@ -166,6 +166,12 @@ impl StreamTunnel {
         self.session.zid().to_string()
     }
 
+    /// The endpoints this session listens on, as zenoh locators (`tcp/127.0.0.1:40123`): a
+    /// listen endpoint with port 0 shows here with the port the operating system chose.
+    pub fn listening_on(&self) -> Vec<String> {
+        self.session.info().locators().wait().iter().map(ToString::to_string).collect()
+    }
+
     /// zenoh sessions (peers, routers or clients) this one is connected to right now.
     pub fn peers(&self) -> usize {
         // `transports` lists every connected session whatever its role; the stable

@@ -30,7 +30,6 @@ pub(super) fn run(args: Args) -> Result<(), DemoError> {
     // the demo in a domain of its own finds the hosts' files under it too.
     let base = std::env::var(catalog::ICEORYX2_DOMAIN_ENV).unwrap_or_else(|_| format!("primm_demo_{pid}_"));
     let (domain_a, domain_b) = (format!("{base}host_a_"), format!("{base}host_b_"));
-    let port = free_loopback_port().map_err(DemoError::Port)?;
     let files = std::env::temp_dir();
     let file = |what: &str| files.join(format!("{prefix}-{what}"));
     let summary_path = file("summary.json");
@@ -39,7 +38,7 @@ pub(super) fn run(args: Args) -> Result<(), DemoError> {
         "primm demo: {:.0} s scenario (seed {}) replayed at {}x; tracker method {}; services under '{prefix}/'",
         args.duration_s, args.seed, args.speed, args.method
     );
-    println!("  host A (iceoryx2 domain '{domain_a}'): publisher, tracker, tunnel listening on tcp/127.0.0.1:{port}");
+    println!("  host A (iceoryx2 domain '{domain_a}'): publisher, tracker, tunnel listening on 127.0.0.1");
     println!("  host B (iceoryx2 domain '{domain_b}'): subscriber, tunnel connecting to host A; zenoh multicast scouting off");
 
     let mut tracker = spawn_tracker(&exe, &prefix, Some(&domain_a), &args, file("tracker.log"))?;
@@ -52,16 +51,23 @@ pub(super) fn run(args: Args) -> Result<(), DemoError> {
     wait_for_ports(&tracks_a, &tracks_b, &mut tracker, &mut subscriber)?;
 
     let (ready_a, ready_b) = (file("tunnel-a.ready"), file("tunnel-b.ready"));
-    let listen = format!("tcp/127.0.0.1:{port}");
+    let listening_a = file("tunnel-a.listening");
+    let _ = std::fs::remove_file(&listening_a);
+    // Port 0: the operating system picks a free port for host A's tunnel, which names it in
+    // its listening file; host B connects there (no port is chosen here, so none can be taken
+    // by someone else in between).
+    let listening_option = listening_a.to_string_lossy().into_owned();
     let mut tunnel_a = spawn_tunnel(
         &exe,
         &prefix,
         &domain_a,
-        &["--listen", &listen],
+        &["--listen", "tcp/127.0.0.1:0", "--listening-file", &listening_option],
         &ready_a,
         "the tunnel of host A",
         file("tunnel-a.log"),
     )?;
+    let listen = wait_for_listening(&mut tunnel_a, &listening_a)?;
+    println!("  host A's tunnel listens on {listen}");
     let mut tunnel_b = spawn_tunnel(
         &exe,
         &prefix,
@@ -108,9 +114,32 @@ pub(super) fn run(args: Args) -> Result<(), DemoError> {
     Ok(())
 }
 
-/// A TCP port on 127.0.0.1 that nothing listens on right now.
-fn free_loopback_port() -> std::io::Result<u16> {
-    Ok(std::net::TcpListener::bind(("127.0.0.1", 0))?.local_addr()?.port())
+/// Waits up to [`READY_TIMEOUT`] until `tunnel` has written its listening file, and returns
+/// its TCP endpoint on 127.0.0.1; fails at once if the tunnel exits.
+fn wait_for_listening(tunnel: &mut Managed, path: &Path) -> Result<String, DemoError> {
+    let deadline = Instant::now() + READY_TIMEOUT;
+    loop {
+        if let Some(status) = tunnel.exited()? {
+            return Err(tunnel.exited_error(status));
+        }
+        if let Ok(text) = std::fs::read_to_string(path) {
+            return loopback_tcp_endpoint(&text)
+                .ok_or_else(|| DemoError::ListeningEndpoint(text.trim().replace('\n', ", ")));
+        }
+        if Instant::now() >= deadline {
+            return Err(DemoError::Timeout {
+                what: tunnel.what,
+                event: "listen",
+                seconds: READY_TIMEOUT.as_secs(),
+            });
+        }
+        std::thread::sleep(POLL_INTERVAL);
+    }
+}
+
+/// The first `tcp/127.0.0.1:PORT` line of a tunnel's listening file.
+pub(crate) fn loopback_tcp_endpoint(listening: &str) -> Option<String> {
+    listening.lines().map(str::trim).find(|line| line.starts_with("tcp/127.0.0.1:")).map(str::to_owned)
 }
 
 /// Starts `primm tunnel` for `prefix` in `domain`, with the zenoh endpoint options `endpoints`,

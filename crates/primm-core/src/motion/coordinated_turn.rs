@@ -49,17 +49,8 @@ pub struct CoordinatedTurn {
     pub max_turn_rate_radps: f64,
 }
 
-/// `s(φ) = sin φ/φ`, `g(φ) = (1 − cos φ)/φ` and their derivatives `s'`, `g'`, choosing the
-/// series below [`TAYLOR_THRESHOLD`] and the closed forms above it.
-pub fn turn_functions(phi: f64) -> (f64, f64, f64, f64) {
-    if phi.abs() < TAYLOR_THRESHOLD {
-        turn_functions_series(phi)
-    } else {
-        turn_functions_closed_form(phi)
-    }
-}
-
-/// Taylor series of [`turn_functions`] around `φ = 0` (exact to `O(φ⁶)`).
+/// `s(φ) = sin φ/φ`, `g(φ) = (1 − cos φ)/φ` and their derivatives `s'`, `g'` as Taylor series
+/// around `φ = 0` (exact to `O(φ⁶)`), used below [`TAYLOR_THRESHOLD`].
 #[inline]
 pub fn turn_functions_series(phi: f64) -> (f64, f64, f64, f64) {
     let p2 = phi * phi;
@@ -70,7 +61,7 @@ pub fn turn_functions_series(phi: f64) -> (f64, f64, f64, f64) {
     (s, g, ds, dg)
 }
 
-/// Closed forms of [`turn_functions`]; undefined at `φ = 0`.
+/// The same four functions in closed form, used above [`TAYLOR_THRESHOLD`]; undefined at `φ = 0`.
 pub fn turn_functions_closed_form(phi: f64) -> (f64, f64, f64, f64) {
     let (sin, cos) = crate::math::sin_cos(phi);
     closed_form_from(phi, sin, cos)
