@@ -84,7 +84,8 @@ fn trial(method: &str, objects: usize, rate_hz: f64, seconds: f64) -> Trial {
         let source = &scene[(k as usize) % scene.len()];
         frame.timestamp_s = k as f64 * 0.05;
         frame.measurements.clone_from(&source.measurements);
-        let flags = if (k as usize) % scene.len() == 0 { primm_wire::FRAME_FLAG_STREAM_START } else { 0 };
+        let flags =
+            if (k as usize).is_multiple_of(scene.len()) { primm_wire::FRAME_FLAG_STREAM_START } else { 0 };
         client.send_scheduled(&frame, k, flags, start_ns + offset.as_nanos() as u64);
     }
     let drain_until = Instant::now() + Duration::from_secs(2);

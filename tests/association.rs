@@ -40,7 +40,7 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
         .map(|_| DVec2::new(rng.random_range(-60.0..60.0), rng.random_range(-60.0..60.0)))
         .collect();
     let spread = rng.random_range(1.0..12.0);
-    let class_of = |i: usize| if i % 3 == 0 { ObjectClass::Pedestrian } else { ObjectClass::Car };
+    let class_of = |i: usize| if i.is_multiple_of(3) { ObjectClass::Pedestrian } else { ObjectClass::Car };
     let (track_count, measurement_count) = (rng.random_range(0..40), rng.random_range(0..40));
     let mut tracks = Vec::new();
     let mut priors = Vec::new();

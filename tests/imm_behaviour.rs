@@ -28,7 +28,7 @@ fn irregular_dt(step: usize) -> f64 {
 /// that successive samples of one run are practically independent, so that the sum of the
 /// samples follows χ² with `samples·n` degrees of freedom.
 fn sampled(step: usize) -> bool {
-    step >= 60 && step % 40 == 0
+    step >= 60 && step.is_multiple_of(40)
 }
 
 /// Mean NEES of `samples` independent samples and the two-sided 95 % χ² interval of that mean.

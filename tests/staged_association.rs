@@ -40,7 +40,7 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
         .map(|_| DVec2::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0)))
         .collect();
     let spread = rng.random_range(0.5..4.0);
-    let class_of = |i: usize| if i % 3 == 0 { ObjectClass::Pedestrian } else { ObjectClass::Car };
+    let class_of = |i: usize| if i.is_multiple_of(3) { ObjectClass::Pedestrian } else { ObjectClass::Car };
     let (track_count, measurement_count) = (rng.random_range(0..30), rng.random_range(0..30));
     let mut scene =
         Scene { tracks: Vec::new(), priors: Vec::new(), frame: Frame::new(0.05), accepted: Vec::new() };

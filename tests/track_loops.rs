@@ -186,7 +186,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
         );
         assert_ne!(estimates(&dispatched_tracks), estimates(&tracks), "{method}: the update changed nothing");
         assert!(
-            outcomes.iter().any(|outcome| *outcome == Ok(Some(RadialVelocityOutcome::Applied))),
+            outcomes.contains(&Ok(Some(RadialVelocityOutcome::Applied))),
             "{method}: no radial-velocity row was applied"
         );
     }

@@ -184,7 +184,7 @@ impl Norm {
 
 /// Lanes of the partial sums of [`sum`]: one AVX register of single-precision values.
 const LANES: usize = 8;
-const _: () = assert!(TOKENS <= LANES && MODEL_WIDTH % LANES == 0);
+const _: () = assert!(TOKENS <= LANES && MODEL_WIDTH.is_multiple_of(LANES));
 
 /// The sum of a token's values in a fixed order the compiler vectorises: eight partial sums
 /// (lane `l` adds values `l, l+8, l+16, l+24`), then the lanes pairwise. A plain left-to-right

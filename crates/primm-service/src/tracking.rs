@@ -318,7 +318,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         self.write_latency_interval();
 
         let interval = self.options.latency_report_interval_frames;
-        if interval > 0 && self.counters.frames_received % interval == 0 {
+        if interval > 0 && self.counters.frames_received.is_multiple_of(interval) {
             self.publish_latency_report();
         }
     }

@@ -422,7 +422,7 @@ impl EvaluationReport {
                 mark_best(&values, Better::Lower, *digits)
             })
             .collect();
-        let motion: [(fn(&SpeedHeadingAccumulator) -> Option<f64>, usize, bool); 3] = [
+        let motion: [MotionColumn; 3] = [
             (SpeedHeadingAccumulator::speed_rmse_mps, 3, true),
             (SpeedHeadingAccumulator::speed_mean_error_mps, 3, false),
             (SpeedHeadingAccumulator::heading_rmse_deg, 2, true),
@@ -804,6 +804,10 @@ fn metric_row(
     line
 }
 
+/// A column of speed and heading errors: the metric, its decimals, and whether lower is better
+/// (a bias is signed: no best value is marked).
+type MotionColumn = (fn(&SpeedHeadingAccumulator) -> Option<f64>, usize, bool);
+
 /// Reads one RMSE value from an accumulator.
 type RmseMetric = fn(&RmseAccumulator) -> Option<f64>;
 
@@ -880,7 +884,7 @@ pub(crate) fn group_thousands(value: u64) -> String {
     let digits = value.to_string();
     let mut out = String::with_capacity(digits.len() + digits.len() / 3);
     for (index, digit) in digits.chars().enumerate() {
-        if index > 0 && (digits.len() - index) % 3 == 0 {
+        if index > 0 && (digits.len() - index).is_multiple_of(3) {
             out.push(',');
         }
         out.push(digit);
