@@ -42,7 +42,7 @@
 use super::assignment::{AssignmentError, AssignmentSolver};
 use super::cost::{association_cost, LikelihoodPrior};
 use crate::config::{AssociationCost, AssociationStages, Config};
-use crate::extent::{expected_reflection, ExtentConfig};
+use crate::extent::{expected_reflection, ExpectedReflection, ExtentConfig, ObjectPrior};
 use crate::imm::ImmPrior;
 use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::track::Track;
@@ -277,6 +277,7 @@ impl Associator {
             let prior = &priors[usize::from(track_index)];
             let centre = prior.fused.mean;
             let object = extent.map(|_| prior.object_prior());
+            let mut reflections = ReflectionMemo::new();
             let first = self.sorted_x.partition_point(|&(x, _)| x < centre.x - window);
             for &(x, column) in &self.sorted_x[first..] {
                 if x > centre.x + window {
@@ -288,7 +289,7 @@ impl Associator {
                 };
                 let expected = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        centre + expected_reflection(extent, object, sensors[index].0).offset_m
+                        centre + reflections.get(extent, object, sensors[index].0).offset_m
                     }
                     _ => centre,
                 };
@@ -336,6 +337,7 @@ impl Associator {
             );
             let Some(prepared) = prepared else { continue };
             let object = extent.map(|_| priors[usize::from(track_index)].object_prior());
+            let mut reflections = ReflectionMemo::new();
             let (x, half) = (
                 prepared.mean_m().x,
                 match extent {
@@ -356,7 +358,7 @@ impl Associator {
                 };
                 let cost = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        let reflection = expected_reflection(extent, object, sensors[index].0);
+                        let reflection = reflections.get(extent, object, sensors[index].0);
                         prepared.cost_of_reflection(&measurement, &reflection)
                     }
                     _ => prepared.cost(&measurement),
@@ -483,4 +485,71 @@ fn union(parent: &mut [u16], a: usize, b: usize) {
 fn extent_of(config: &Config, class: ObjectClass) -> Option<&ExtentConfig> {
     let extent = &config.classes.get(class).extent;
     extent.enabled.then_some(extent)
+}
+
+/// The expected reflections of one track, per sensor position: the reflection depends on the
+/// track's prior and the sensor, not on the measurement, so each is computed once per track and
+/// sensor instead of once per candidate pair. On the stack; with more sensor positions than it
+/// holds, the rest are computed per pair (the same values).
+struct ReflectionMemo {
+    entries: [(DVec2, ExpectedReflection); REFLECTION_MEMO_SENSORS],
+    len: usize,
+}
+
+/// Sensor positions [`ReflectionMemo`] holds (a car carries four to six radars).
+const REFLECTION_MEMO_SENSORS: usize = 8;
+
+impl ReflectionMemo {
+    fn new() -> Self {
+        ReflectionMemo {
+            entries: [(DVec2::ZERO, ExpectedReflection::default()); REFLECTION_MEMO_SENSORS],
+            len: 0,
+        }
+    }
+
+    /// [`expected_reflection`] of `object` seen from `sensor_m`, computed at most once per
+    /// position (compared bit for bit, so the answer is exactly the function's).
+    fn get(&mut self, extent: &ExtentConfig, object: &ObjectPrior, sensor_m: DVec2) -> ExpectedReflection {
+        let same = |position: DVec2| {
+            position.x.to_bits() == sensor_m.x.to_bits() && position.y.to_bits() == sensor_m.y.to_bits()
+        };
+        if let Some((_, reflection)) = self.entries[..self.len].iter().find(|(position, _)| same(*position)) {
+            return *reflection;
+        }
+        let reflection = expected_reflection(extent, object, sensor_m);
+        if self.len < REFLECTION_MEMO_SENSORS {
+            self.entries[self.len] = (sensor_m, reflection);
+            self.len += 1;
+        }
+        reflection
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DMat2;
+
+    #[test]
+    fn the_reflection_memo_answers_exactly_what_the_model_computes_also_past_its_capacity() {
+        let extent = ExtentConfig { enabled: true, offset_scale: 0.5, ..ExtentConfig::default() };
+        let object = ObjectPrior {
+            centre_m: DVec2::new(20.0, 3.0),
+            centre_covariance_m2: DMat2::from_diagonal(DVec2::new(0.3, 0.2)),
+            velocity_mps: DVec2::new(8.0, 1.0),
+            velocity_covariance_m2: DMat2::from_diagonal(DVec2::new(0.5, 0.4)),
+        };
+        let mut memo = ReflectionMemo::new();
+        // Twelve sensor positions, each asked for three times in an interleaved order: more
+        // positions than the memo holds, and repeats both of held and of unheld ones.
+        let sensors: [DVec2; 12] =
+            core::array::from_fn(|k| DVec2::new(-2.0 + 0.4 * k as f64, [0.8, -0.8][k % 2]));
+        for round in 0..3 {
+            for k in 0..sensors.len() {
+                let sensor = sensors[(k + round * 5) % sensors.len()];
+                assert_eq!(memo.get(&extent, &object, sensor), expected_reflection(&extent, &object, sensor));
+            }
+        }
+        assert_eq!(memo.len, REFLECTION_MEMO_SENSORS);
+    }
 }
