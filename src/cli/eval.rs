@@ -2,36 +2,21 @@
 //! the metrics on confirmed tracks. The evaluation itself is [`primm_sim::eval::evaluate`]; this
 //! reads the arguments and the data, and prints and writes what it returns.
 
-use clap::{Args as ClapArgs, ValueEnum};
+use clap::Args as ClapArgs;
 use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_predictor::predictor_for;
-use primm_sim::eval::{evaluate, EvalError, EvaluateError as EvaluationError, EvaluationSettings, Progress};
+use primm_sim::eval::{
+    evaluate, EvalError, EvaluateError as EvaluationError, EvaluationSettings, Progress, Truth,
+};
 use primm_sim::io::{read_dataset_dir, CsvError, Sequence};
 use std::path::PathBuf;
 
 pub use primm_sim::eval::DEFAULT_MISS_SEED;
 
-/// What the one-step prior is scored against (RMSE, Tables II to VI).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum Truth {
-    /// The true object centre, where the data knows it (simulated data); the measurement
-    /// elsewhere.
-    #[default]
-    Centre,
-    /// The measurement that updated the track, i.e. the next measurement after the prior: the
-    /// paper's protocol on RadarScenes, where object-level measurements are the only truth.
-    /// True positions in the data are ignored altogether (also for the scenario subsets).
-    Measurement,
-}
-
-impl From<Truth> for primm_sim::eval::Truth {
-    fn from(truth: Truth) -> Self {
-        match truth {
-            Truth::Centre => primm_sim::eval::Truth::Centre,
-            Truth::Measurement => primm_sim::eval::Truth::Measurement,
-        }
-    }
+/// `--truth`: `centre` or `measurement` ([`Truth`]).
+fn parse_truth(text: &str) -> Result<Truth, String> {
+    Truth::from_key(text).ok_or_else(|| format!("`{text}` is neither `centre` nor `measurement`"))
 }
 
 /// Arguments of `primm eval`.
@@ -71,7 +56,7 @@ pub struct Args {
     pub miss_seed: u64,
     /// Reference of the RMSE: `centre` (the true object centre where the data has it) or
     /// `measurement` (the next measurement, the paper's RadarScenes protocol).
-    #[arg(long, value_enum, default_value_t = Truth::Centre)]
+    #[arg(long, value_parser = parse_truth, default_value = "centre", value_name = "centre|measurement")]
     pub truth: Truth,
     /// PR and PR-IMM get each track's true displacement from the data's true centres instead of
     /// the PR model's (a diagnostic: how far a perfect learned predictor would go; simulated
@@ -144,7 +129,7 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
     };
     let settings = EvaluationSettings {
         methods: args.methods.clone(),
-        truth: args.truth.into(),
+        truth: args.truth,
         miss_seed: args.miss_seed,
         displacement_oracle_noise_m: args
             .displacement_oracle

@@ -48,6 +48,11 @@ impl Truth {
         }
     }
 
+    /// The truth named `key` ([`key`](Self::key)), if any.
+    pub fn from_key(key: &str) -> Option<Self> {
+        [Truth::Centre, Truth::Measurement].into_iter().find(|truth| truth.key() == key)
+    }
+
     /// A sentence saying what the RMSE is measured against.
     pub fn description(self) -> &'static str {
         match self {
@@ -356,10 +361,10 @@ impl Evaluation {
             write_trajectory_svg(&path, &self.ground_truth, &self.panels, &options)?;
             written.push(path);
         }
-        if let Some(means) = self.report.result(Method::PrImm).and_then(|result| result.modes.mean()) {
+        let pr_imm_modes = self.report.result(Method::PrImm).map(|result| &result.modes);
+        if let Some((means, modes)) = pr_imm_modes.and_then(|modes| Some((modes.mean()?, modes))) {
             let path = dir.join("mode_probabilities.svg");
-            let samples = self.report.result(Method::PrImm).map_or(0, |result| result.modes.count());
-            write_mode_probability_svg(&path, means, samples)?;
+            write_mode_probability_svg(&path, means, modes.count())?;
             written.push(path);
         }
         Ok(written)
