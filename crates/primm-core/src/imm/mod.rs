@@ -20,265 +20,25 @@
 //! way), the others sharing `1 − c_PR`.
 
 use crate::config::ImmConfig;
-use crate::extent::ObjectPrior;
 use crate::gaussian::{
-    kalman_update_into, radial_velocity_update_in_place, replace_position, to_glam, to_nalgebra, Gaussian,
+    kalman_update_into, radial_velocity_update_in_place, replace_position, to_glam, to_nalgebra,
     PositionEstimate, RadialVelocityObservation, RadialVelocityOutcome, UpdateError,
 };
 use crate::measurement::Measurement;
 use crate::mode::{Mode, ModeSet, MODE_COUNT};
-use crate::motion::constant_acceleration::index as ca;
 use crate::motion::constant_velocity::index as cv;
-use crate::motion::coordinated_turn::index as ct;
-use crate::motion::{
-    ConstantAcceleration, ConstantVelocity, CoordinatedTurn, LearnedDisplacement, ModeModels, MotionModel,
-    PredictContext,
-};
-use crate::pose::RigidTransform;
+use crate::motion::{ModeModels, MotionModel, PredictContext};
 use crate::predictor::Displacement;
-use glam::{DMat2, DMat4, DVec2, DVec4};
+use glam::DVec2;
 use nalgebra::Matrix2;
 
-/// Mode probabilities in primm's mode order (PR, CV, CA, CT); inactive modes hold 0.
-pub type ModeProbabilities = [f64; MODE_COUNT];
+mod fusion;
+mod state;
 
-/// A track's estimate in every mode plus the mode probabilities: a small `Copy` value.
-/// Inactive modes are carried but never read.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ImmState {
-    /// PR mode, `[x, y]`.
-    pub learned: Gaussian<2>,
-    /// CV mode, `[x, y, vx, vy]`.
-    pub constant_velocity: Gaussian<4>,
-    /// CA mode, `[x, y, vx, vy, ax, ay]`.
-    pub constant_acceleration: Gaussian<6>,
-    /// CT mode, `[x, y, vx, vy, ω]`.
-    pub coordinated_turn: Gaussian<5>,
-    /// Mode probabilities `μ` (posterior) or `c` (in a prior).
-    pub probabilities: ModeProbabilities,
-    /// Velocity implied by the last learned displacement, m/s (PR's only velocity estimate).
-    pub learned_velocity_mps: DVec2,
-}
-
-impl ImmState {
-    /// The position marginal of one mode.
-    pub fn position(&self, mode: Mode) -> PositionEstimate {
-        for_mode(mode, Position(self))
-    }
-
-    /// The velocity estimate of one mode, m/s (PR: displacement over the last step).
-    pub fn velocity(&self, mode: Mode) -> DVec2 {
-        for_mode(mode, Velocity(self))
-    }
-
-    /// Adds `covariance_m2` to every mode's position covariance (the cross terms unchanged):
-    /// a new extended object's reflection spread.
-    pub fn add_position_covariance(&mut self, covariance_m2: &Matrix2<f64>) {
-        fn add<const N: usize>(gaussian: &mut Gaussian<N>, covariance_m2: &Matrix2<f64>) {
-            let mut block = gaussian.covariance.fixed_view_mut::<2, 2>(0, 0);
-            block += covariance_m2;
-        }
-        add(&mut self.learned, covariance_m2);
-        add(&mut self.constant_velocity, covariance_m2);
-        add(&mut self.constant_acceleration, covariance_m2);
-        add(&mut self.coordinated_turn, covariance_m2);
-    }
-
-    /// This state in another frame (see [`Gaussian::transformed`]): positions mapped,
-    /// velocities and accelerations rotated, turn rate and mode probabilities unchanged.
-    pub fn transformed(&self, transform: &RigidTransform) -> Self {
-        ImmState {
-            learned: self.learned.transformed(transform, &[]),
-            constant_velocity: self.constant_velocity.transformed(transform, &[cv::VX]),
-            constant_acceleration: self.constant_acceleration.transformed(transform, &[ca::VX, ca::AX]),
-            coordinated_turn: self.coordinated_turn.transformed(transform, &[ct::VX]),
-            probabilities: self.probabilities,
-            learned_velocity_mps: transform.apply_vector(self.learned_velocity_mps),
-        }
-    }
-}
-
-/// Where one mode lives, for a state of size `N`: its Gaussian in an [`ImmState`] and its model
-/// in [`ModeModels`]. One zero-sized type per mode implements it, so that [`for_mode`] can hand
-/// a [`ModeOperation`] the mode's state size, model and fields at compile time.
-trait ModeSlot<const N: usize> {
-    /// The mode.
-    const MODE: Mode;
-    /// The mode's motion model.
-    type Model: MotionModel<N>;
-    /// The mode's model among a class's models.
-    fn model(models: &ModeModels) -> &Self::Model;
-    /// The mode's Gaussian in `state`.
-    fn gaussian(state: &ImmState) -> &Gaussian<N>;
-    /// The mode's Gaussian in `state`, to write.
-    fn gaussian_mut(state: &mut ImmState) -> &mut Gaussian<N>;
-    /// The mode's velocity estimate in `state`, m/s.
-    fn velocity(state: &ImmState) -> DVec2;
-    /// Where the mode's state holds its velocity `[vx, vy]` (`None`: it has none).
-    const VELOCITY_INDEX: Option<usize>;
-}
-
-/// Declares a mode's [`ModeSlot`]: `slot: mode, field (of ImmState and ModeModels), N, model,
-/// |state| velocity`.
-macro_rules! mode_slot {
-    ($(#[$doc:meta])* $slot:ident: $mode:ident, $field:ident, $n:literal, $model:ty, $velocity_index:expr,
-     |$state:ident| $velocity:expr) => {
-        $(#[$doc])*
-        struct $slot;
-
-        impl ModeSlot<$n> for $slot {
-            const MODE: Mode = Mode::$mode;
-            const VELOCITY_INDEX: Option<usize> = $velocity_index;
-            type Model = $model;
-            #[inline(always)]
-            fn model(models: &ModeModels) -> &$model {
-                &models.$field
-            }
-            #[inline(always)]
-            fn gaussian(state: &ImmState) -> &Gaussian<$n> {
-                &state.$field
-            }
-            #[inline(always)]
-            fn gaussian_mut(state: &mut ImmState) -> &mut Gaussian<$n> {
-                &mut state.$field
-            }
-            #[inline(always)]
-            fn velocity($state: &ImmState) -> DVec2 {
-                $velocity
-            }
-        }
-    };
-}
-
-mode_slot!(
-    /// PR, whose state has no velocity: the velocity of its last displacement.
-    LearnedSlot: Learned, learned, 2, LearnedDisplacement, None, |state| state.learned_velocity_mps
-);
-mode_slot!(
-    /// CV.
-    ConstantVelocitySlot: ConstantVelocity, constant_velocity, 4, ConstantVelocity, Some(cv::VX),
-    |state| DVec2::new(state.constant_velocity.mean[cv::VX], state.constant_velocity.mean[cv::VY])
-);
-mode_slot!(
-    /// CA.
-    ConstantAccelerationSlot: ConstantAcceleration, constant_acceleration, 6, ConstantAcceleration, Some(ca::VX),
-    |state| DVec2::new(state.constant_acceleration.mean[ca::VX], state.constant_acceleration.mean[ca::VY])
-);
-mode_slot!(
-    /// CT.
-    CoordinatedTurnSlot: CoordinatedTurn, coordinated_turn, 5, CoordinatedTurn, Some(ct::VX),
-    |state| DVec2::new(state.coordinated_turn.mean[ct::VX], state.coordinated_turn.mean[ct::VY])
-);
-
-/// An operation on one mode, generic over the mode's state size and [`ModeSlot`].
-trait ModeOperation {
-    /// What the operation returns.
-    type Output;
-    /// Applies the operation to the mode of `S`.
-    fn apply<const N: usize, S: ModeSlot<N>>(self) -> Self::Output;
-}
-
-/// Applies `operation` to `mode`: the IMM's one per-mode dispatch.
-#[inline(always)]
-fn for_mode<O: ModeOperation>(mode: Mode, operation: O) -> O::Output {
-    match mode {
-        Mode::Learned => operation.apply::<2, LearnedSlot>(),
-        Mode::ConstantVelocity => operation.apply::<4, ConstantVelocitySlot>(),
-        Mode::ConstantAcceleration => operation.apply::<6, ConstantAccelerationSlot>(),
-        Mode::CoordinatedTurn => operation.apply::<5, CoordinatedTurnSlot>(),
-    }
-}
-
-/// A mode's position marginal.
-struct Position<'a>(&'a ImmState);
-
-impl ModeOperation for Position<'_> {
-    type Output = PositionEstimate;
-    #[inline(always)]
-    fn apply<const N: usize, S: ModeSlot<N>>(self) -> PositionEstimate {
-        S::gaussian(self.0).position()
-    }
-}
-
-/// A mode's velocity estimate, m/s.
-struct Velocity<'a>(&'a ImmState);
-
-impl ModeOperation for Velocity<'_> {
-    type Output = DVec2;
-    #[inline(always)]
-    fn apply<const N: usize, S: ModeSlot<N>>(self) -> DVec2 {
-        S::velocity(self.0)
-    }
-}
-
-/// A mode's Gaussian copied from one state into another.
-struct CopyMode<'a> {
-    from: &'a ImmState,
-    to: &'a mut ImmState,
-}
-
-impl ModeOperation for CopyMode<'_> {
-    type Output = ();
-    #[inline(always)]
-    fn apply<const N: usize, S: ModeSlot<N>>(self) {
-        *S::gaussian_mut(self.to) = *S::gaussian(self.from);
-    }
-}
-
-/// The outcome of [`Imm::predict`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ImmPrior {
-    /// Each mode's prior; `probabilities` holds the prior mode probabilities `c`.
-    pub state: ImmState,
-    /// Modes that took part in this step (the active ones, less PR without a displacement).
-    pub available: ModeSet,
-    /// Fused prior position and covariance (`eq:prior_fusion`, covariance with the spread of
-    /// the mode means), weights `c` renormalised over the available modes.
-    pub fused: PositionEstimate,
-}
-
-impl ImmPrior {
-    /// The fused prior velocity over the available modes, weights `c` renormalised over them,
-    /// m/s (PR: its last displacement over the step), as [`Imm::fuse_velocity`] fuses a
-    /// posterior's.
-    pub fn fused_velocity_mps(&self) -> DVec2 {
-        fused_velocity(&self.state, self.available)
-    }
-
-    /// The fused prior as an extended object's prior (`crate::extent`): position and its
-    /// covariance, [`fused_velocity_mps`](Self::fused_velocity_mps), and the velocity
-    /// covariance of the available physics modes (weights renormalised over them, with the
-    /// spread of their means; PR has none of its own).
-    pub fn object_prior(&self) -> ObjectPrior {
-        let physics = self.available.without(Mode::Learned);
-        let weights = renormalised(&self.state.probabilities, physics);
-        let mean = fused_velocity(&self.state, physics);
-        let mut velocity_covariance_m2 = DMat2::ZERO;
-        for mode in physics.iter() {
-            let marginal = match mode {
-                Mode::ConstantVelocity => marginal4(&self.state.constant_velocity),
-                Mode::ConstantAcceleration => marginal4(&self.state.constant_acceleration),
-                Mode::CoordinatedTurn => marginal4(&self.state.coordinated_turn),
-                Mode::Learned => continue,
-            };
-            let block = lower_right(&marginal.covariance);
-            let spread = self.state.velocity(mode) - mean;
-            velocity_covariance_m2 += (block + outer(spread, spread)) * weights[mode.index()];
-        }
-        ObjectPrior {
-            centre_m: self.fused.mean,
-            centre_covariance_m2: self.fused.covariance,
-            velocity_mps: self.fused_velocity_mps(),
-            velocity_covariance_m2,
-        }
-    }
-}
-
-/// The velocity over `modes`, weights `μ` (or `c`) renormalised over them, m/s.
-fn fused_velocity(state: &ImmState, modes: ModeSet) -> DVec2 {
-    let weights = renormalised(&state.probabilities, modes);
-    modes.iter().map(|mode| weights[mode.index()] * state.velocity(mode)).sum()
-}
+pub use fusion::{fused_prior, mix_positions, renormalised, ImmPrior, PositionVelocityEstimate};
+use fusion::{mix, mode_positions};
+use state::{for_mode, CopyMode, ModeOperation, ModeSlot};
+pub use state::{ImmState, ModeProbabilities};
 
 /// The IMM's configuration, prepared once: stateless and shared by all tracks.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -288,47 +48,6 @@ pub struct Imm {
     initial_probabilities: ModeProbabilities,
     temperature: f64,
     floor: f64,
-}
-
-/// Weighted mean and covariance with the spread-of-means term
-/// (`eq:mixed_pos`, `eq:mixed_pos_cov`); weights must sum to 1 over `modes`.
-#[inline]
-pub fn mix_positions(state: &ImmState, modes: ModeSet, weights: &ModeProbabilities) -> PositionEstimate {
-    mix(&mode_positions(state, modes), modes, weights)
-}
-
-/// Every mode's position estimate (entries of modes outside `modes` are left at zero).
-#[inline]
-fn mode_positions(state: &ImmState, modes: ModeSet) -> [PositionEstimate; MODE_COUNT] {
-    let mut positions = [PositionEstimate::default(); MODE_COUNT];
-    for mode in modes.iter() {
-        positions[mode.index()] = state.position(mode);
-    }
-    positions
-}
-
-/// [`mix_positions`] on positions already extracted.
-#[inline]
-fn mix(
-    positions: &[PositionEstimate; MODE_COUNT],
-    modes: ModeSet,
-    weights: &ModeProbabilities,
-) -> PositionEstimate {
-    let mut mean = DVec2::ZERO;
-    for mode in modes.iter() {
-        mean += weights[mode.index()] * positions[mode.index()].mean;
-    }
-    let mut covariance = DMat2::ZERO;
-    for mode in modes.iter() {
-        let position = &positions[mode.index()];
-        let spread = position.mean - mean;
-        covariance += (position.covariance + outer(spread, spread)) * weights[mode.index()];
-    }
-    PositionEstimate { mean, covariance }
-}
-
-fn outer(a: DVec2, b: DVec2) -> DMat2 {
-    DMat2::from_cols(a * b.x, a * b.y)
 }
 
 /// One mode's Kalman update from `prior` into `posterior` and its log-likelihood; an inactive
@@ -574,7 +293,7 @@ impl Imm {
             available = available.without(Mode::Learned);
         }
         prior.available = available;
-        prior.fused = mix_positions(state, available, &renormalised(&state.probabilities, available));
+        prior.fused = fused_prior(state, available);
     }
 
     /// Kalman update of every active mode with measurement `z`, tempered mode-probability
@@ -714,67 +433,6 @@ impl Imm {
         prior.state
     }
 
-    /// The fused position and covariance of a posterior (`eq:posterior_fusion`, covariance with
-    /// the spread of the mode means) over `modes`, weights `μ` renormalised over them.
-    pub fn fuse_posterior(&self, state: &ImmState, modes: ModeSet) -> PositionEstimate {
-        mix_positions(state, modes, &renormalised(&state.probabilities, modes))
-    }
-
-    /// The fused velocity over `modes`, m/s, weights `μ` renormalised over them; PR's velocity is
-    /// its last displacement divided by the step.
-    pub fn fuse_velocity(&self, state: &ImmState, modes: ModeSet) -> DVec2 {
-        fused_velocity(state, modes)
-    }
-
-    /// The fused position and velocity `[x, y, vx, vy]` of a posterior over `modes` and their
-    /// 4×4 covariance (with the spread of the mode means), weights `μ` renormalised over them:
-    /// `eq:posterior_fusion` extended from the position to the position and velocity. Each
-    /// physics mode contributes the `[x, y, vx, vy]` marginal of its state. The PR mode has a
-    /// position covariance but no velocity covariance: it contributes its position, its
-    /// velocity (last displacement over the step), its position covariance, no
-    /// position–velocity covariance, and as velocity covariance the physics modes' fused one
-    /// (zero when PR is the only mode). The position block equals
-    /// [`fuse_posterior`](Self::fuse_posterior)'s covariance.
-    pub fn fuse_position_velocity(&self, state: &ImmState, modes: ModeSet) -> PositionVelocityEstimate {
-        let weights = renormalised(&state.probabilities, modes);
-        let physics = modes.without(Mode::Learned);
-        let mut marginals = [PositionVelocityEstimate::default(); MODE_COUNT];
-        for mode in physics.iter() {
-            marginals[mode.index()] = match mode {
-                Mode::ConstantVelocity => marginal4(&state.constant_velocity),
-                Mode::ConstantAcceleration => marginal4(&state.constant_acceleration),
-                Mode::CoordinatedTurn => marginal4(&state.coordinated_turn),
-                Mode::Learned => unreachable!("left out of the physics modes"),
-            };
-        }
-        if modes.contains(Mode::Learned) {
-            let physics_weights = renormalised(&state.probabilities, physics);
-            let velocity_covariance: DMat2 = physics
-                .iter()
-                .map(|mode| {
-                    let covariance = marginals[mode.index()].covariance;
-                    physics_weights[mode.index()] * lower_right(&covariance)
-                })
-                .fold(DMat2::ZERO, |sum, term| sum + term);
-            let position = state.learned.position();
-            let velocity = state.learned_velocity_mps;
-            marginals[Mode::Learned.index()] = PositionVelocityEstimate {
-                mean: DVec4::new(position.mean.x, position.mean.y, velocity.x, velocity.y),
-                covariance: block_diagonal(position.covariance, velocity_covariance),
-            };
-        }
-        let mean: DVec4 = modes.iter().map(|mode| weights[mode.index()] * marginals[mode.index()].mean).sum();
-        let covariance = modes
-            .iter()
-            .map(|mode| {
-                let marginal = &marginals[mode.index()];
-                let spread = marginal.mean - mean;
-                weights[mode.index()] * (marginal.covariance + outer4(spread, spread))
-            })
-            .fold(DMat4::ZERO, |sum, term| sum + term);
-        PositionVelocityEstimate { mean, covariance }
-    }
-
     /// Raises every active mode's probability to at least the floor and renormalises, keeping
     /// the floored modes at exactly the floor.
     #[inline]
@@ -803,64 +461,4 @@ impl Imm {
         }
         mu
     }
-}
-
-/// A position and velocity `[x, y, vx, vy]` (m, m/s) and its covariance (m², m²/s, m²/s²).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PositionVelocityEstimate {
-    /// `[x, y, vx, vy]`.
-    pub mean: DVec4,
-    /// Covariance of `[x, y, vx, vy]`, symmetric.
-    pub covariance: DMat4,
-}
-
-/// The `[x, y, vx, vy]` marginal of a state whose first four elements are those.
-fn marginal4<const N: usize>(gaussian: &Gaussian<N>) -> PositionVelocityEstimate {
-    let mean = DVec4::new(gaussian.mean[0], gaussian.mean[1], gaussian.mean[2], gaussian.mean[3]);
-    let column = |c: usize| {
-        DVec4::new(
-            gaussian.covariance[(0, c)],
-            gaussian.covariance[(1, c)],
-            gaussian.covariance[(2, c)],
-            gaussian.covariance[(3, c)],
-        )
-    };
-    PositionVelocityEstimate {
-        mean,
-        covariance: DMat4::from_cols(column(0), column(1), column(2), column(3)),
-    }
-}
-
-/// The lower-right 2×2 block of a 4×4 matrix (the velocity block).
-fn lower_right(matrix: &DMat4) -> DMat2 {
-    DMat2::from_cols(
-        DVec2::new(matrix.z_axis.z, matrix.z_axis.w),
-        DVec2::new(matrix.w_axis.z, matrix.w_axis.w),
-    )
-}
-
-/// The 4×4 block-diagonal matrix `diag(upper_left, lower_right)`.
-fn block_diagonal(upper_left: DMat2, lower_right: DMat2) -> DMat4 {
-    DMat4::from_cols(
-        DVec4::new(upper_left.x_axis.x, upper_left.x_axis.y, 0.0, 0.0),
-        DVec4::new(upper_left.y_axis.x, upper_left.y_axis.y, 0.0, 0.0),
-        DVec4::new(0.0, 0.0, lower_right.x_axis.x, lower_right.x_axis.y),
-        DVec4::new(0.0, 0.0, lower_right.y_axis.x, lower_right.y_axis.y),
-    )
-}
-
-/// `a bᵀ`.
-fn outer4(a: DVec4, b: DVec4) -> DMat4 {
-    DMat4::from_cols(a * b.x, a * b.y, a * b.z, a * b.w)
-}
-
-/// `weights` restricted to `modes` and renormalised to sum to 1 (uniform if they sum to 0).
-#[inline]
-pub fn renormalised(weights: &ModeProbabilities, modes: ModeSet) -> ModeProbabilities {
-    let sum: f64 = modes.iter().map(|m| weights[m.index()]).sum();
-    let mut result = [0.0; MODE_COUNT];
-    for mode in modes.iter() {
-        result[mode.index()] = if sum > 0.0 { weights[mode.index()] / sum } else { 1.0 / modes.len() as f64 };
-    }
-    result
 }

@@ -1,0 +1,143 @@
+//! Where the tracks and the sensors are: the tracking frame of each step (world or vehicle,
+//! `crate::tracking_frame`), odometry resets, and the sensors' positions and fields of view in
+//! the tracking frame.
+
+use super::{ScanningSensor, Tracker, MAX_DETECTION_PROBABILITY};
+use crate::existence::FieldOfView;
+use crate::measurement::FrameView;
+use crate::measurement::{Measurement, ObjectClass};
+use crate::pose::EgoPose;
+use crate::predictor::DisplacementPredictor;
+use crate::tracking_frame::TrackingFrame;
+use glam::DVec2;
+
+impl<P: DisplacementPredictor> Tracker<P> {
+    /// Decides the frame of this step from the frame's ego pose and the configuration, and
+    /// moves the live tracks into it if they are in the other one: into the world frame with
+    /// this frame's pose (the tracks' vehicle frame is taken as this frame's, which is off by
+    /// the ego motion since the last frame), back into the vehicle frame of the last pose.
+    pub(super) fn enter_tracking_frame(&mut self, pose: Option<EgoPose>, dt_s: f64) {
+        let world = self.config.frame.tracking_frame == TrackingFrame::World;
+        self.step_pose = pose.filter(|_| world);
+        self.follow_odometry_reset(dt_s);
+        let step_frame = if self.step_pose.is_some() { TrackingFrame::World } else { TrackingFrame::Vehicle };
+        self.last_step.tracking_frame = step_frame;
+        if world && pose.is_none() {
+            self.stats.frames_without_ego_pose += 1;
+        }
+        if step_frame == TrackingFrame::World {
+            self.stats.frames_in_world_frame += 1;
+        }
+        if step_frame != self.tracks_frame && !self.table.is_empty() {
+            let transform = match (step_frame, self.step_pose, self.last_pose) {
+                (TrackingFrame::World, Some(pose), _) => Some(pose.vehicle_to_world()),
+                (TrackingFrame::Vehicle, _, Some(last)) => Some(last.world_to_vehicle()),
+                _ => None,
+            };
+            if let Some(transform) = transform {
+                self.table.tracks_mut().iter_mut().for_each(|track| track.transform(&transform));
+                self.last_step.tracking_frame_changed = true;
+            }
+        }
+        self.tracks_frame = step_frame;
+        if self.step_pose.is_some() {
+            self.last_pose = self.step_pose;
+        }
+    }
+
+    /// Moves the live world-frame tracks across an odometry reset: when this frame's pose is
+    /// further from the last one, or turned further, than `tracker.max_ego_speed_mps` and
+    /// `tracker.max_ego_yaw_rate_radps` allow over `dt_s` (plus 1 m and 0.1 rad), the vehicle
+    /// cannot have moved so; the world frame did. The tracks keep their place around the
+    /// vehicle: into its frame with the last pose, back out with this one.
+    pub(super) fn follow_odometry_reset(&mut self, dt_s: f64) {
+        let (Some(pose), Some(last)) = (self.step_pose, self.last_pose) else { return };
+        if self.tracks_frame != TrackingFrame::World {
+            return;
+        }
+        let tracker = &self.config.tracker;
+        let moved_m = pose.position().distance(last.position());
+        let turned_rad = crate::math::wrap_angle(pose.yaw_rad - last.yaw_rad).abs();
+        let jumped = moved_m > tracker.max_ego_speed_mps * dt_s + 1.0
+            || turned_rad > tracker.max_ego_yaw_rate_radps * dt_s + 0.1;
+        if !jumped {
+            return;
+        }
+        self.last_step.odometry_reset = true;
+        let (to_vehicle, to_world) = (last.world_to_vehicle(), pose.vehicle_to_world());
+        for track in self.table.tracks_mut() {
+            track.transform(&to_vehicle);
+            track.transform(&to_world);
+        }
+    }
+
+    /// The sensors that scanned in this frame, as its measurements name them, with their fields
+    /// of view in the tracking frame. A measurement without a sensor id or of a sensor without a
+    /// configured mount marks the frame (every track then counts as in view).
+    pub(super) fn find_scanning_sensors(&mut self) {
+        self.scanning_sensors.clear();
+        for index in 0..self.validated.len() {
+            let Some(measurement) = self.validated.accepted(index) else { continue };
+            let mount = measurement.sensor_id.and_then(|id| self.config.frame.sensor(id));
+            let Some(mount) = mount else {
+                self.last_step.unknown_sensor = true;
+                continue;
+            };
+            if self.scanning_sensors.iter().any(|sensor| sensor.id == mount.id) {
+                continue;
+            }
+            // There are at most MAX_SENSORS configured mounts, so this never overflows.
+            let _ = self.scanning_sensors.try_push(ScanningSensor {
+                id: mount.id,
+                field_of_view: FieldOfView::of(mount, self.step_pose),
+                detection_probability_factor: mount.detection_probability_factor,
+                clutter_density_factor: mount.clutter_density_factor,
+            });
+        }
+    }
+
+    /// Where the radar of every accepted measurement is, in the tracking frame: its mount,
+    /// mapped into the world in a world-frame step; without a configured mount the vehicle's
+    /// reference point (flagged, and counted where a row or an extent uses it).
+    pub(super) fn locate_measurement_sensors(&mut self) {
+        for index in 0..self.validated.len() {
+            let Some(measurement) = self.validated.accepted(index) else { continue };
+            let mount =
+                measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)).map(|m| m.position());
+            let in_vehicle = mount.unwrap_or(DVec2::ZERO);
+            let position = match self.step_pose {
+                Some(pose) => pose.car_to_world(in_vehicle),
+                None => in_vehicle,
+            };
+            self.measurement_sensors[index] = (position, mount.is_some());
+        }
+    }
+
+    /// Where the radar that measured `measurement` is, in the tracking frame: the world
+    /// position of its mount in a world-frame step (the vehicle's reference point, counted, for
+    /// a sensor without a configured mount), the vehicle frame's origin otherwise.
+    pub(super) fn sensor_position(&mut self, measurement: &Measurement) -> DVec2 {
+        let Some(pose) = self.step_pose else { return DVec2::ZERO };
+        match measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)) {
+            Some(mount) => pose.car_to_world(mount.position()),
+            None => {
+                self.last_step.initiations_from_unknown_sensor += 1;
+                pose.position()
+            }
+        }
+    }
+
+    /// The detection probability and clutter density of `class` for the sensor `sensor_id`
+    /// (the class's own for a sensor without a configured mount).
+    pub(super) fn detection_and_clutter(&self, class: ObjectClass, sensor_id: Option<u16>) -> (f64, f64) {
+        let existence = &self.config.classes.get(class).existence;
+        let (detection, clutter) = match sensor_id.and_then(|id| self.config.frame.sensor(id)) {
+            Some(mount) => (mount.detection_probability_factor, mount.clutter_density_factor),
+            None => (1.0, 1.0),
+        };
+        (
+            (existence.detection_probability * detection).min(MAX_DETECTION_PROBABILITY),
+            existence.clutter_density_per_m2 * clutter,
+        )
+    }
+}

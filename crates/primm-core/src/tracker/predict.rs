@@ -1,0 +1,115 @@
+//! The predict stage: the learned predictor gets its batch, the physics modes and the
+//! existence probabilities are predicted meanwhile, then the learned displacements are checked
+//! and every track's prior is completed and fused (`eq:prior_fusion`).
+
+use super::Tracker;
+use crate::config::{LearnedProcessNoise, PredictorConfig};
+use crate::displacement_check::{check_answer, DisplacementRejection};
+use crate::existence;
+use crate::mode::Mode;
+use crate::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
+use crate::track_loops;
+
+impl<P: DisplacementPredictor> Tracker<P> {
+    /// Hands the history (`eq:pr_input`) of every track of a class in `predictor.classes` to
+    /// the learned predictor.
+    pub(super) fn request_learned_predictions(&mut self, t: f64) {
+        self.requests.clear();
+        self.requested_rows.clear();
+        let modes = self.config.imm.modes;
+        if !modes.contains(Mode::Learned) {
+            return;
+        }
+        for (row, track) in self.table.tracks().iter().enumerate() {
+            if !self.config.predictor.predicts(track.class, modes) {
+                continue;
+            }
+            let (older, newer) = track.history.as_slices();
+            let mut window = [Default::default(); crate::predictor::MAX_HISTORY];
+            let len = older.len() + newer.len();
+            window[..older.len()].copy_from_slice(older);
+            window[older.len()..len].copy_from_slice(newer);
+            let step_start = self.last_timestamp_s.unwrap_or(t);
+            self.requests
+                .push(PredictionRequest::from_history(&window[..len], t).with_step_start(step_start));
+            // The table holds at most MAX_TRACKS (512) rows, so the row fits in u16.
+            self.requested_rows.push(row as u16);
+        }
+        self.predictor.submit(&self.requests);
+    }
+
+    /// Mixing and the CV, CA and CT predictions, while the predictor works.
+    pub(super) fn predict_physics(&mut self, dt_s: f64) {
+        self.dt_s = dt_s;
+        track_loops::predict_physics(
+            &self.imms,
+            &self.models,
+            self.table.tracks(),
+            dt_s,
+            &mut self.priors[..],
+        );
+    }
+
+    /// Every track's object may have ceased to exist since the last frame: `r⁻ = p_s · r`.
+    pub(super) fn predict_existence(&mut self, dt_s: f64) {
+        let survival = existence::survival_probability(dt_s, &self.config.tracker);
+        for track in self.table.tracks_mut() {
+            track.existence_probability *= survival;
+        }
+    }
+
+    /// The learned displacements collected and checked, then every track's prior completed:
+    /// the PR prior and the fused prior (`eq:prior_fusion`). A track without a request, or
+    /// whose answer is missing or refused, gets no displacement and its PR mode sits out.
+    pub(super) fn fuse_priors(&mut self) {
+        let count = self.table.len();
+        self.displacements[..count].fill(None);
+        if !self.requests.is_empty() {
+            self.collect_displacements();
+        }
+        track_loops::complete_priors(
+            &self.imms,
+            &self.models,
+            self.table.tracks(),
+            self.dt_s,
+            &self.displacements[..count],
+            &mut self.priors[..],
+        );
+    }
+
+    /// The predictor's answers, each checked (`crate::displacement_check`; a refused one is
+    /// counted and dropped) and handed to its track's row.
+    fn collect_displacements(&mut self) {
+        let answers = &mut self.answers[..self.requests.len()];
+        self.predictor.collect(answers);
+        for (answer, request) in answers.iter_mut().zip(self.requests.iter()) {
+            let Some(displacement) = answer.as_mut() else { continue };
+            if let Err(reason) = accept_displacement(request, displacement, &self.config.predictor) {
+                self.last_step.count_displacement_rejection(reason);
+                *answer = None;
+            }
+        }
+        self.last_step.predictions_missing = answers.iter().filter(|answer| answer.is_none()).count();
+        for (answer, &row) in answers.iter().zip(self.requested_rows.iter()) {
+            self.displacements[usize::from(row)] = *answer;
+        }
+    }
+}
+
+/// Checks one learned displacement against its request and sets its process noise `Q_PR`
+/// (`eq:pr_cov`) as `predictor.process_noise` says: the model's covariance, scaled, or none
+/// (the class's constant then applies).
+fn accept_displacement(
+    request: &PredictionRequest,
+    displacement: &mut Displacement,
+    predictor: &PredictorConfig,
+) -> Result<(), DisplacementRejection> {
+    check_answer(request, displacement, predictor.max_displacement_speed_mps)?;
+    displacement.covariance_m2 = match predictor.process_noise {
+        LearnedProcessNoise::Learned => {
+            displacement.covariance_m2.map(|q| q * predictor.learned_process_noise_scale)
+        }
+        LearnedProcessNoise::Constant => None,
+    };
+    Ok(())
+}

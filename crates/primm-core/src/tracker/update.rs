@@ -1,0 +1,172 @@
+//! Associate, update and coast: per-class optimal assignment, the Kalman and mode-probability
+//! update of every assigned track with its existence, and the tracks without a measurement.
+
+use super::{confirms, covariance, MeasurementFate, RowRecord, StepError, Tracker};
+use crate::existence::{self, Evidence};
+use crate::extent::ExpectedReflection;
+use crate::gaussian::RadialVelocityOutcome;
+use crate::measurement::FrameView;
+use crate::predictor::DisplacementPredictor;
+use crate::track::TrackStatus;
+use crate::track_loops;
+use glam::DVec2;
+
+impl<P: DisplacementPredictor> Tracker<P> {
+    /// Per-class gated optimal assignment (`eq:association_cost`).
+    pub(super) fn associate(&mut self) -> Result<(), StepError> {
+        self.locate_measurement_sensors();
+        self.associator.associate(
+            self.table.tracks(),
+            &self.priors[..self.table.len()],
+            &*self.validated,
+            &self.accepted[..self.validated.len()],
+            &self.measurement_sensors[..self.validated.len()],
+            &self.config,
+            &mut self.track_to_measurement[..],
+        )?;
+        Ok(())
+    }
+
+    /// The expected reflection of track `i`'s object for a sensor at `sensor_m` (a point class:
+    /// none).
+    pub(super) fn expected_reflection(&self, i: usize, sensor_m: DVec2) -> ExpectedReflection {
+        let class = self.table.tracks()[i].class;
+        let models = &self.models[class.index()];
+        match models.extent {
+            Some(_) => {
+                let prior = &self.priors[i];
+                models.expected_reflection(&prior.object_prior(), sensor_m)
+            }
+            None => ExpectedReflection::POINT,
+        }
+    }
+
+    /// Kalman and mode-probability update of every assigned track.
+    pub(super) fn update(&mut self, t: f64) {
+        let count = self.table.len();
+        for i in 0..count {
+            // An accepted measurement always reads back; if one did not, the track coasts rather
+            // than keep a stale state.
+            self.assigned_measurements[i] =
+                self.track_to_measurement[i].and_then(|index| self.validated.accepted(usize::from(index)));
+            let (Some(index), Some(measurement)) =
+                (self.track_to_measurement[i], self.assigned_measurements[i])
+            else {
+                self.track_to_measurement[i] = None;
+                continue;
+            };
+            let (sensor_m, mounted) = self.measurement_sensors[usize::from(index)];
+            self.assigned_sensor_positions[i] = sensor_m;
+            let models = &self.models[measurement.class.index()];
+            if !mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
+                self.last_step.updates_from_unknown_sensor += 1;
+            }
+        }
+        track_loops::update(
+            &self.imms,
+            &self.models,
+            self.table.tracks_mut(),
+            &self.priors[..count],
+            &self.assigned_measurements[..count],
+            &self.assigned_sensor_positions[..count],
+            // Radial velocities are over ground: they measure the velocity of world-frame
+            // tracks, not of vehicle-frame tracks of an ego whose motion is unknown.
+            self.step_pose.is_some(),
+            &mut self.update_outcomes[..count],
+        );
+        for i in 0..count {
+            let (Some(index), Some(measurement)) =
+                (self.track_to_measurement[i], self.assigned_measurements[i])
+            else {
+                continue;
+            };
+            if let Ok(radial_velocity) = self.update_outcomes[i] {
+                match radial_velocity {
+                    Some(RadialVelocityOutcome::Applied) => self.last_step.radial_velocity_rows_applied += 1,
+                    Some(RadialVelocityOutcome::Gated) => self.last_step.radial_velocity_rows_gated += 1,
+                    Some(RadialVelocityOutcome::NoLineOfSight) | None => {}
+                }
+                let class = self.table.tracks()[i].class;
+                let (detection, clutter) = self.detection_and_clutter(class, measurement.sensor_id);
+                let reflection = self.expected_reflection(i, self.assigned_sensor_positions[i]);
+                let prior = &self.priors[i].fused;
+                let likelihood = existence::gaussian_density_per_m2(
+                    measurement.position() - reflection.offset_m - prior.mean,
+                    prior.covariance
+                        + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2)
+                        + reflection.covariance_m2,
+                );
+                let tracker = &self.config.tracker;
+                let track = &mut self.table.tracks_mut()[i];
+                track.existence_probability = existence::updated_existence(
+                    track.existence_probability,
+                    Evidence::Detected { likelihood_per_m2: likelihood },
+                    detection,
+                    clutter,
+                );
+                track.record_hit(&measurement, t);
+                if track.status == TrackStatus::Tentative && confirms(track, tracker) {
+                    track.status = TrackStatus::Confirmed;
+                    self.last_step.newly_confirmed += 1;
+                }
+                self.last_step.assigned += 1;
+                self.fates[usize::from(index)] = MeasurementFate::Assigned;
+            } else {
+                // Numerically unusable: the track coasts and the measurement is free to start a
+                // track of its own.
+                self.last_step.update_failures += 1;
+                self.track_to_measurement[i] = None;
+            }
+        }
+    }
+
+    /// Tracks without a measurement keep their priors, and lose existence if a sensor of the
+    /// frame had them in view (a confirmed one then coasts); every existing track's frame
+    /// record.
+    pub(super) fn coast(&mut self) {
+        for i in 0..self.table.len() {
+            let measurement_index = self.track_to_measurement[i];
+            if measurement_index.is_none() {
+                let track = &self.table.tracks()[i];
+                let mut existence_probability = track.existence_probability;
+                let mut missed = false;
+                let prior_m = self.priors[i].fused.mean;
+                for sensor in self.scanning_sensors.iter().filter(|s| s.field_of_view.contains(prior_m)) {
+                    let (detection, clutter) = self.detection_and_clutter(track.class, Some(sensor.id));
+                    existence_probability = existence::updated_existence(
+                        existence_probability,
+                        Evidence::MissedInView,
+                        detection,
+                        clutter,
+                    );
+                    missed = true;
+                }
+                if self.last_step.unknown_sensor {
+                    let (detection, clutter) = self.detection_and_clutter(track.class, None);
+                    existence_probability = existence::updated_existence(
+                        existence_probability,
+                        Evidence::MissedInView,
+                        detection,
+                        clutter,
+                    );
+                    missed = true;
+                }
+                self.last_step.missed_in_view += usize::from(missed);
+                let track = &mut self.table.tracks_mut()[i];
+                track.estimate = self.imms[track.class.index()].coast(&self.priors[i]);
+                track.record_miss();
+                track.existence_probability = existence_probability;
+                if missed && track.status == TrackStatus::Confirmed {
+                    track.status = TrackStatus::Coasting;
+                }
+            }
+            let track = &mut self.table.tracks_mut()[i];
+            track.age_frames = track.age_frames.saturating_add(1);
+            self.rows[i] = RowRecord {
+                prior_position_m: Some(self.priors[i].fused.mean),
+                available: self.priors[i].available,
+                measurement_index,
+            };
+        }
+    }
+}
