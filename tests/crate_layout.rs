@@ -1,7 +1,10 @@
 //! The crate layout holds: `primm-core` stays free of I/O, runtime and CLI crates and builds
 //! as a real `no_std` library, and every dependency between primm's crates points the way
-//! `ARCHITECTURE.md` draws it (core ← predictor, core ← wire ← service, core ← sim), with the
-//! fuzz targets' crate on top of them and nothing depending on it.
+//! `ARCHITECTURE.md` draws it (core ← config ← predictor, core ← wire ← ipc ← service,
+//! core ← sim), with
+//! the fuzz targets' crate on top of them and nothing depending on it; the publisher, the
+//! subscriber and the tunnel use the shared-memory plumbing (`primm-ipc`), not the tracking
+//! service.
 
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -62,12 +65,20 @@ fn dependencies_between_primm_crates_point_one_way() {
     let set = |names: &[&str]| -> BTreeSet<String> { names.iter().map(|n| n.to_string()).collect() };
     assert_eq!(primm("primm-core"), set(&["primm-core"]));
     assert_eq!(primm("primm-config"), set(&["primm-config", "primm-core"]));
-    assert_eq!(primm("primm-predictor"), set(&["primm-predictor", "primm-core"]));
+    assert_eq!(primm("primm-predictor"), set(&["primm-predictor", "primm-config", "primm-core"]));
     assert_eq!(primm("primm-wire"), set(&["primm-wire", "primm-core"]));
-    assert_eq!(primm("primm-service"), set(&["primm-service", "primm-wire", "primm-core"]));
+    assert_eq!(primm("primm-ipc"), set(&["primm-ipc", "primm-wire", "primm-core"]));
+    assert_eq!(primm("primm-service"), set(&["primm-service", "primm-ipc", "primm-wire", "primm-core"]));
     assert_eq!(primm("primm-sim"), set(&["primm-sim", "primm-core"]));
     assert_eq!(primm("primm-ffi"), set(&["primm-ffi", "primm-config", "primm-predictor", "primm-core"]));
-    assert_eq!(primm("primm-tunnel"), set(&["primm-tunnel", "primm-service", "primm-wire", "primm-core"]));
+    assert_eq!(primm("primm-tunnel"), set(&["primm-tunnel", "primm-ipc", "primm-wire", "primm-core"]));
+    for program in ["primm-publisher", "primm-subscriber"] {
+        assert_eq!(
+            primm(program),
+            set(&[program, "primm-ipc", "primm-sim", "primm-wire", "primm-core"]),
+            "{program}"
+        );
+    }
     assert_eq!(
         primm("primm-fuzz-targets"),
         set(&[
@@ -77,10 +88,20 @@ fn dependencies_between_primm_crates_point_one_way() {
             "primm-ffi",
             "primm-wire",
             "primm-service",
+            "primm-ipc",
             "primm-sim",
             "primm-core"
         ])
     );
+}
+
+#[test]
+fn the_publisher_subscriber_and_tunnel_do_not_build_the_tracking_service() {
+    for package in ["primm-publisher", "primm-subscriber", "primm-tunnel"] {
+        let names = dependency_names(package, &[]);
+        assert!(names.contains("primm-ipc"), "{package}: {names:?}");
+        assert!(!names.contains("primm-service"), "{package} depends on primm-service");
+    }
 }
 
 #[test]
@@ -90,6 +111,7 @@ fn no_library_crate_depends_on_the_fuzz_targets_or_a_fuzzing_crate() {
         "primm-config",
         "primm-predictor",
         "primm-wire",
+        "primm-ipc",
         "primm-service",
         "primm-sim",
         "primm-ffi",
@@ -105,9 +127,15 @@ fn no_library_crate_depends_on_the_fuzz_targets_or_a_fuzzing_crate() {
 
 #[test]
 fn zenoh_is_built_into_primm_only_with_the_tunnel_feature() {
-    for package in
-        ["primm-core", "primm-service", "primm-wire", "primm-ffi", "primm-publisher", "primm-subscriber"]
-    {
+    for package in [
+        "primm-core",
+        "primm-ipc",
+        "primm-service",
+        "primm-wire",
+        "primm-ffi",
+        "primm-publisher",
+        "primm-subscriber",
+    ] {
         assert!(!dependency_names(package, &[]).contains("zenoh"), "{package} depends on zenoh");
     }
     assert!(!dependency_names("primm", &[]).contains("zenoh"), "a plain `primm` build includes zenoh");

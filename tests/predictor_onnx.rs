@@ -2,9 +2,9 @@
 //! the step displacement of coasting tracks, and clear start-up errors for unusable model files.
 
 use glam::DVec2;
-use primm_core::config::InferenceEngine;
+use primm_config::InferenceEngine;
 use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
-use primm_predictor::onnx::{ModelError, MotionFrame, OnnxPredictor, PrModel};
+use primm_predictor::onnx::{InputRotation, ModelError, OnnxPredictor, PrModel};
 use std::path::{Path, PathBuf};
 
 fn repo_path(relative: &str) -> PathBuf {
@@ -194,13 +194,13 @@ fn history(points: &[(f64, f64, f64)]) -> Vec<HistoryEntry> {
         .collect()
 }
 
-/// The model's displacement for one request, with the request rotated into the frame of its
-/// latest motion and the output rotated back, as `OnnxPredictor` does.
+/// The model's displacement for one request, with the request rotated onto its latest motion
+/// and the output rotated back, as `OnnxPredictor` does.
 fn run_one(model: &mut PrModel, request: &PredictionRequest) -> DVec2 {
-    let frame = MotionFrame::of(request);
+    let rotation = InputRotation::of(request);
     let mut features = request.features;
     for row in &mut features[..request.len] {
-        let position = frame.to_model(DVec2::new(f64::from(row[0]), f64::from(row[1])));
+        let position = rotation.to_model(DVec2::new(f64::from(row[0]), f64::from(row[1])));
         row[0] = position.x as f32;
         row[1] = position.y as f32;
     }
@@ -208,7 +208,7 @@ fn run_one(model: &mut PrModel, request: &PredictionRequest) -> DVec2 {
     valid[..request.len].fill(1.0);
     let mut out = [0.0f32; 2];
     model.run(features.as_flattened(), &valid, &mut out).unwrap();
-    frame.from_model(DVec2::new(f64::from(out[0]), f64::from(out[1])))
+    rotation.from_model(DVec2::new(f64::from(out[0]), f64::from(out[1])))
 }
 
 #[test]
@@ -246,7 +246,7 @@ fn a_rotated_history_gets_the_rotated_displacement() {
     }
     // Without a direction of motion (one measurement) the input goes in unrotated.
     let single = PredictionRequest::from_history(&history(&points[..1]), 0.03);
-    assert_eq!(MotionFrame::of(&single), MotionFrame::IDENTITY);
+    assert_eq!(InputRotation::of(&single), InputRotation::IDENTITY);
 }
 
 #[test]

@@ -15,7 +15,7 @@ Each window is laid out exactly like ``PredictionRequest`` (``eq:pr_input``): ro
 hold ``[x_l - x_j, y_l - y_j, v_r_l, RCS_l, t_l - tau]``, rows ``len..`` are zero (right
 padding), and ``valid`` marks the rows ``0..len``. Windows are kept in the world frame; before a
 window goes into the model, :func:`motion_frames` and :func:`to_model_frame` rotate it into the
-frame of its latest motion (primm-predictor's ``MotionFrame``), and displacements are rotated the
+frame of its latest motion (primm-predictor's ``InputRotation``), and displacements are rotated the
 same way.
 
 Two displacement labels are kept per window:

@@ -3,7 +3,7 @@
     python training/make_test_fixtures.py [--out tests/fixtures]
 
 Each model is valid ONNX but breaks one part of the PR model contract
-(``crates/primm-predictor/src/onnx.rs``), so loading it must fail with a start-up error naming the problem:
+(``crates/primm-predictor/src/onnx/contract.rs``), so loading it must fail with a start-up error naming the problem:
 
 * ``pr_wrong_feature_shape.onnx``: ``features`` is ``[batch, 4, 5]`` (four history rows);
 * ``pr_fixed_batch.onnx``: ``features`` is ``[1, 5, 5]`` (no symbolic batch axis);

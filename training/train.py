@@ -724,7 +724,7 @@ def write_metadata(args, model, mean, std, scale, sets, selection, train_windows
                 "input_frame": (
                     "positions relative to the latest measurement, rotated so that the latest motion (second-latest "
                     "to latest measurement) points along +x; histories of one measurement or whose last two are "
-                    "closer than 0.01 m unrotated (primm-predictor MotionFrame); the output displacement is in the "
+                    "closer than 0.01 m unrotated (primm-predictor InputRotation); the output displacement is in the "
                     "same frame and is rotated back by the caller"
                 ),
                 "training_positions": (

@@ -8,7 +8,7 @@
 //!
 //! ```no_run
 //! use primm_publisher::replay::{Pacing, ReplayOptions, Replayer};
-//! use primm_service::{ServiceNames, ShutdownFlag};
+//! use primm_ipc::{ServiceNames, ShutdownFlag};
 //!
 //! let sequence = primm_publisher::builtin_scenario(7, Some(2.0))?;
 //! let mut replayer = Replayer::new(&ServiceNames::new(""), false)?;
@@ -23,9 +23,9 @@ pub mod replay;
 
 use crate::replay::{Pacing, ReplayError, ReplayOptions, Replayer};
 use primm_core::readable_number::readable;
-use primm_service::catalog::SERVICE_PREFIX_ENV;
-use primm_service::realtime::{RealtimeArgs, RealtimeRefused, RealtimeReport};
-use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
+use primm_ipc::catalog::SERVICE_PREFIX_ENV;
+use primm_ipc::realtime::{RealtimeArgs, RealtimeRefused, RealtimeReport};
+use primm_ipc::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::{read_dataset_dir, read_sequence_file, CsvError, Sequence};
 use primm_sim::scenario::{ConfigError as ScenarioConfigError, Preset, ScenarioGenerator};
 use std::path::PathBuf;

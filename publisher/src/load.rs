@@ -7,9 +7,9 @@
 use crate::replay::{ReplayError, Replayer};
 use hdrhistogram::Histogram;
 use primm_core::measurement::{Measurement, ObjectClass};
-use primm_service::clock::monotonic_ns;
-use primm_service::latency::MAX_TRACKABLE_NS;
-use primm_service::ShutdownFlag;
+use primm_ipc::clock::monotonic_ns;
+use primm_ipc::latency::MAX_TRACKABLE_NS;
+use primm_ipc::ShutdownFlag;
 use primm_sim::io::{RecordedFrame, RecordedMeasurement, Sequence};
 use primm_wire::{TrackFrame, FRAME_FLAG_STREAM_END, FRAME_FLAG_STREAM_START};
 use rand::SeedableRng;
@@ -184,6 +184,45 @@ pub fn latency_histogram() -> Histogram<u64> {
     Histogram::new_with_bounds(1, MAX_TRACKABLE_NS, 3).expect("valid histogram bounds")
 }
 
+impl RateTrial {
+    /// A trial at `rate_hz` before its first frame.
+    fn starting(rate_hz: f64) -> Self {
+        RateTrial {
+            rate_hz,
+            sent: 0,
+            send_failures: 0,
+            answered: 0,
+            rejected: 0,
+            late_sends: 0,
+            latencies: std::array::from_fn(|_| latency_histogram()),
+            elapsed: Duration::ZERO,
+        }
+    }
+
+    /// Counts one answer received at `now_ns` and records its latencies: from the input's
+    /// publication, from its scheduled send time (coordinated-omission corrected; the
+    /// publication time where the frame had no schedule) and from the tracker's publication.
+    fn record_answer(&mut self, answer: &TrackFrame, now_ns: u64) {
+        self.answered += 1;
+        if answer.status != 0 {
+            self.rejected += 1;
+        }
+        let mut record_since = |latency: ClientLatency, since_ns: u64| {
+            if since_ns != 0 && since_ns <= now_ns {
+                self.latencies[latency as usize].saturating_record((now_ns - since_ns).max(1));
+            }
+        };
+        record_since(ClientLatency::PublisherToSubscriber, answer.input_publish_time_ns);
+        let scheduled = if answer.input_scheduled_time_ns != 0 {
+            answer.input_scheduled_time_ns
+        } else {
+            answer.input_publish_time_ns
+        };
+        record_since(ClientLatency::PublisherToSubscriberCorrected, scheduled);
+        record_since(ClientLatency::TrackerToSubscriber, answer.publish_time_ns);
+    }
+}
+
 /// Sends `scene` (repeated, each repetition a new stream) at `options.rate_hz` through
 /// `replayer` (opened with flow control, so that it reads the answers) for
 /// `options.duration`, each frame stamped with its scheduled send time, and reads the answers
@@ -202,37 +241,12 @@ pub fn run_rate_trial(
     }
     let interval = Duration::from_secs_f64(1.0 / options.rate_hz);
     let frames = (options.rate_hz * options.duration.as_secs_f64()).ceil().max(1.0) as u64;
-    let mut trial = RateTrial {
-        rate_hz: options.rate_hz,
-        sent: 0,
-        send_failures: 0,
-        answered: 0,
-        rejected: 0,
-        late_sends: 0,
-        latencies: std::array::from_fn(|_| latency_histogram()),
-        elapsed: Duration::ZERO,
-    };
+    let mut trial = RateTrial::starting(options.rate_hz);
     let start = Instant::now();
     let start_ns = monotonic_ns();
     let mut record = |trial: &mut RateTrial, answer: &TrackFrame| {
         let now_ns = monotonic_ns();
-        trial.answered += 1;
-        if answer.status != 0 {
-            trial.rejected += 1;
-        }
-        let mut record_since = |latency: ClientLatency, since_ns: u64| {
-            if since_ns != 0 && since_ns <= now_ns {
-                trial.latencies[latency as usize].saturating_record((now_ns - since_ns).max(1));
-            }
-        };
-        record_since(ClientLatency::PublisherToSubscriber, answer.input_publish_time_ns);
-        let scheduled = if answer.input_scheduled_time_ns != 0 {
-            answer.input_scheduled_time_ns
-        } else {
-            answer.input_publish_time_ns
-        };
-        record_since(ClientLatency::PublisherToSubscriberCorrected, scheduled);
-        record_since(ClientLatency::TrackerToSubscriber, answer.publish_time_ns);
+        trial.record_answer(answer, now_ns);
         on_answer(now_ns, &trial.latencies);
     };
     let scene_frames = scene.frames.len();

@@ -9,10 +9,10 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::{LoanError, ReceiveError, SendError};
 use primm_core::readable_number::readable;
-use primm_service::catalog::{self, ConnectError, Ipc, ServiceNames, Stream};
-use primm_service::clock::monotonic_ns;
-use primm_service::log_limit::LogLimiter;
-use primm_service::shutdown::ShutdownFlag;
+use primm_ipc::catalog::{self, ConnectError, Ipc, ServiceNames, Stream};
+use primm_ipc::clock::monotonic_ns;
+use primm_ipc::log_limit::LogLimiter;
+use primm_ipc::shutdown::ShutdownFlag;
 use primm_sim::io::{RecordedFrame, Sequence};
 use primm_wire::{
     MeasurementFrame, MeasurementFrameHeader, MeasurementFrameWriter, TrackFrame, WireMeasurement,
@@ -341,18 +341,11 @@ impl Replayer {
                         summary.interrupted = true;
                         return Ok(summary);
                     }
-                    let mut scheduled_time_ns = 0;
-                    if let Pacing::Recorded { speed } = options.pacing {
-                        let offset = Duration::from_secs_f64(
-                            ((frame.timestamp_s - first.timestamp_s) / speed).clamp(0.0, 1.0e9),
-                        );
-                        let due = start + offset;
-                        scheduled_time_ns = start_ns.saturating_add(offset.as_nanos() as u64).max(1);
-                        let now = Instant::now();
-                        if due > now {
-                            std::thread::sleep(due - now);
-                        }
-                    }
+                    let scheduled_time_ns = wait_for_schedule(
+                        options.pacing,
+                        (start, start_ns),
+                        frame.timestamp_s - first.timestamp_s,
+                    );
                     if let Some(max) = options.max_in_flight {
                         self.wait_in_flight(max.saturating_sub(1), options.answer_timeout, shutdown)?;
                     }
@@ -368,26 +361,7 @@ impl Replayer {
                     if last_of_replay || last_of_limit {
                         flags |= FRAME_FLAG_STREAM_END;
                     }
-                    match self.send_scheduled(&sequence.name, frame, flags, scheduled_time_ns) {
-                        Ok(sent) => {
-                            summary.frames_sent += 1;
-                            summary.measurements_sent += frame.measurements.len() as u64;
-                            if sent.receivers == 0 {
-                                summary.frames_without_receiver += 1;
-                            }
-                        }
-                        Err(error @ (ReplayError::Loan(_) | ReplayError::Send(_))) => {
-                            summary.frames_dropped += 1;
-                            if self.drop_log.occur() {
-                                tracing::warn!(
-                                    %error,
-                                    occurrences = self.drop_log.occurrences(),
-                                    "measurement frame dropped"
-                                );
-                            }
-                        }
-                        Err(error) => return Err(error),
-                    }
+                    self.send_counted(&sequence.name, frame, flags, scheduled_time_ns, &mut summary)?;
                     if last_of_limit {
                         return Ok(summary);
                     }
@@ -398,4 +372,50 @@ impl Replayer {
             }
         }
     }
+
+    /// Sends one frame and counts it in `summary`: sent (and whether anyone received it), or
+    /// dropped for want of a sample or a send (counted and logged; the replay goes on). Any
+    /// other error ends the replay.
+    fn send_counted(
+        &mut self,
+        name: &str,
+        frame: &RecordedFrame,
+        flags: u32,
+        scheduled_time_ns: u64,
+        summary: &mut ReplaySummary,
+    ) -> Result<(), ReplayError> {
+        match self.send_scheduled(name, frame, flags, scheduled_time_ns) {
+            Ok(sent) => {
+                summary.frames_sent += 1;
+                summary.measurements_sent += frame.measurements.len() as u64;
+                if sent.receivers == 0 {
+                    summary.frames_without_receiver += 1;
+                }
+                Ok(())
+            }
+            Err(error @ (ReplayError::Loan(_) | ReplayError::Send(_))) => {
+                summary.frames_dropped += 1;
+                if self.drop_log.occur() {
+                    tracing::warn!(%error, occurrences = self.drop_log.occurrences(), "measurement frame dropped");
+                }
+                Ok(())
+            }
+            Err(error) => Err(error),
+        }
+    }
+}
+
+/// With recorded pacing, sleeps until the frame recorded `since_first_s` after the sequence's
+/// first is due (`start` plus that time over the speed) and returns its scheduled send time,
+/// ns (at least 1); as fast as possible: 0 (no schedule) at once.
+fn wait_for_schedule(pacing: Pacing, (start, start_ns): (Instant, u64), since_first_s: f64) -> u64 {
+    let Pacing::Recorded { speed } = pacing else { return 0 };
+    let offset = Duration::from_secs_f64((since_first_s / speed).clamp(0.0, 1.0e9));
+    let due = start + offset;
+    let scheduled_time_ns = start_ns.saturating_add(offset.as_nanos() as u64).max(1);
+    let now = Instant::now();
+    if due > now {
+        std::thread::sleep(due - now);
+    }
+    scheduled_time_ns
 }

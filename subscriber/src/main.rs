@@ -14,7 +14,7 @@ struct Cli {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    primm_service::logging::init_logging();
+    primm_ipc::logging::init_logging();
     match primm_subscriber::run(cli.args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {

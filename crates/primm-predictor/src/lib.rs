@@ -50,7 +50,7 @@ pub mod split;
 pub mod threaded;
 
 use onnx::{ModelError, OnnxPredictor};
-use primm_core::config::InferenceEngine;
+use primm_config::InferenceEngine;
 use primm_core::mode::Method;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use std::path::Path;

@@ -512,35 +512,7 @@ impl Layer {
             }
             let mut mixed = [0.0f32; MODEL_WIDTH];
             for head in 0..HEADS {
-                let channels = head * HEAD_WIDTH..(head + 1) * HEAD_WIDTH;
-                let mut scores = [0.0f32; LANES];
-                for channel in channels.clone() {
-                    let value = queries[query][channel];
-                    for (score, key) in scores.iter_mut().zip(&keys_by_channel[channel]) {
-                        *score += value * key;
-                    }
-                }
-                // The largest score among the keys the head may see is subtracted first.
-                let mut peak = f32::NEG_INFINITY;
-                for (score, weight) in scores.iter().zip(&key_weights) {
-                    if *weight != 0.0 {
-                        peak = peak.max(*score);
-                    }
-                }
-                let mut weights = [0.0f32; LANES];
-                for lane in 0..LANES {
-                    weights[lane] = exp(scores[lane] - peak) * key_weights[lane];
-                }
-                let total = ((weights[0] + weights[1]) + (weights[2] + weights[3]))
-                    + ((weights[4] + weights[5]) + (weights[6] + weights[7]));
-                for key in 0..TOKENS {
-                    if key_weight[key] != 0.0 {
-                        let share = weights[key] / total;
-                        for channel in channels.clone() {
-                            mixed[channel] += share * values[key][channel];
-                        }
-                    }
-                }
+                attend_head(head, &queries[query], &keys_by_channel, &key_weights, &values, &mut mixed);
             }
             let attended = self.output.apply(&mixed);
             let token = &mut tokens[query];
@@ -555,6 +527,49 @@ impl Layer {
             let out = self.feed_forward_out.apply(&hidden);
             for (value, add) in token.iter_mut().zip(&out) {
                 *value += add;
+            }
+        }
+    }
+}
+
+/// Adds one head's attention of `query` over the keys of non-zero weight into that head's
+/// channels of `mixed`: scores against `keys_by_channel` (channel-major, one lane per token),
+/// a softmax with the largest visible score subtracted first, the values weighted by it.
+#[inline(always)]
+fn attend_head(
+    head: usize,
+    query: &[f32; MODEL_WIDTH],
+    keys_by_channel: &[[f32; LANES]; MODEL_WIDTH],
+    key_weights: &[f32; LANES],
+    values: &[[f32; MODEL_WIDTH]; TOKENS],
+    mixed: &mut [f32; MODEL_WIDTH],
+) {
+    let channels = head * HEAD_WIDTH..(head + 1) * HEAD_WIDTH;
+    let mut scores = [0.0f32; LANES];
+    for channel in channels.clone() {
+        let value = query[channel];
+        for (score, key) in scores.iter_mut().zip(&keys_by_channel[channel]) {
+            *score += value * key;
+        }
+    }
+    // The largest score among the keys the head may see is subtracted first.
+    let mut peak = f32::NEG_INFINITY;
+    for (score, weight) in scores.iter().zip(key_weights) {
+        if *weight != 0.0 {
+            peak = peak.max(*score);
+        }
+    }
+    let mut weights = [0.0f32; LANES];
+    for lane in 0..LANES {
+        weights[lane] = exp(scores[lane] - peak) * key_weights[lane];
+    }
+    let total = ((weights[0] + weights[1]) + (weights[2] + weights[3]))
+        + ((weights[4] + weights[5]) + (weights[6] + weights[7]));
+    for key in 0..TOKENS {
+        if key_weights[key] != 0.0 {
+            let share = weights[key] / total;
+            for channel in channels.clone() {
+                mixed[channel] += share * values[key][channel];
             }
         }
     }

@@ -6,21 +6,17 @@
 //!                         reads the sample in place ──► primm/latency (LatencyReport)
 //! ```
 //!
-//! - [`catalog`]: service names and QoS, shared by every primm program.
 //! - [`tracking`]: the tracking loop.
 //! - [`frame_step`]: one received frame through the tracker, as the loop does it.
-//! - [`latency`]: latency histograms, reports and tables.
-//! - [`latency_files`]: the histograms as HdrHistogram interval logs (`.hlog`) and percentile
-//!   distributions (`.hgrm`) in a directory (`--latency-out`).
-//! - [`latency_plot`]: latency-by-percentile plots (SVG).
-//! - [`clock`]: the monotonic clock the latencies are measured with.
-//! - [`shutdown`]: SIGINT/SIGTERM handling.
-//! - [`log_limit`]: bounded logging of repeated faults.
-//! - [`logging`]: the programs' log output.
-//! - [`realtime`]: CPU affinity, `SCHED_FIFO` priority and locked memory for the programs' threads.
+//!
+//! The plumbing every primm program shares lives in `primm-ipc`; its modules are re-exported
+//! here, so that a program hosting the tracker names one crate: [`catalog`] (service names and
+//! QoS), [`clock`], [`shutdown`], [`log_limit`], [`logging`], [`realtime`], [`latency`],
+//! [`latency_files`] and [`latency_plot`].
 //!
 //! The publisher's replay loop and the subscriber's loop live in the `primm-publisher` and
-//! `primm-subscriber` packages; both use [`catalog`] to open the same services.
+//! `primm-subscriber` packages; both open the same services through `primm-ipc`'s catalogue and
+//! do not depend on this crate.
 //!
 //! Hosting a tracker (any `DisplacementPredictor`; here the physics-only IMM) under a private
 //! prefix, so that it does not meet another setup on the same machine:
@@ -40,17 +36,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod catalog;
-pub mod clock;
 pub mod frame_step;
-pub mod latency;
-pub mod latency_files;
-pub mod latency_plot;
-pub mod log_limit;
-pub mod logging;
-pub mod realtime;
-pub mod shutdown;
 pub mod tracking;
+
+pub use primm_ipc::{
+    catalog, clock, latency, latency_files, latency_plot, log_limit, logging, realtime, shutdown,
+};
 
 pub use catalog::{ConnectError, ServiceNames};
 pub use shutdown::ShutdownFlag;

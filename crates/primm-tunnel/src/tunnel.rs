@@ -13,8 +13,8 @@ use iceoryx2::waitset::{WaitSetAttachmentError, WaitSetCreateError, WaitSetRunEr
 use iceoryx2_integrations_zenoh_link_carrier::{CreationError, ZenohCarrier};
 use iceoryx2_link::{Link, WakeCreationError};
 use iceoryx2_link_tunnel::Tunnel;
-use primm_service::catalog::{self, ConnectError, Ipc, ServiceNames};
-use primm_service::ShutdownFlag;
+use primm_ipc::catalog::{self, ConnectError, Ipc, ServiceNames};
+use primm_ipc::ShutdownFlag;
 use primm_wire::{LatencyReport, MeasurementFrame, TrackFrame};
 use std::time::{Duration, Instant};
 use zenoh::Wait;

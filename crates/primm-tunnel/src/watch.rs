@@ -5,7 +5,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::ZeroCopySend;
 use iceoryx2::service::header::payload_header::PayloadHeader;
 use iceoryx2::service::header::publish_subscribe::Header;
-use primm_service::catalog::Ipc;
+use primm_ipc::catalog::Ipc;
 use primm_wire::{LatencyReport, MeasurementFrame, TrackFrame};
 use std::fmt::Debug;
 
