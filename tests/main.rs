@@ -49,6 +49,7 @@ mod predictor_usefulness;
 mod process_noise;
 mod radial_velocity_update;
 mod scenario;
+mod sensor_layout;
 mod service_allocation;
 mod service_faults;
 mod service_overload;

@@ -27,7 +27,7 @@ fn short_generator(preset: Preset, duration_s: f64) -> ScenarioGenerator {
 }
 
 fn mount_of(config: &ScenarioConfig, sensor_id: u16) -> &RadarMount {
-    config.radar.sensors.iter().find(|s| s.id == sensor_id).expect("known sensor")
+    config.radar.sensors.iter().find(|s| s.layout.id == sensor_id).expect("known sensor")
 }
 
 /// Mean and standard deviation.
@@ -108,16 +108,16 @@ fn check_kinematics(preset: Preset, sequences: u32) -> [f64; 2] {
             for (t, o) in &track {
                 let (max_speed, max_accel, max_decel, max_yaw) = match o.class {
                     ObjectClass::Pedestrian => (
-                        cfg.pedestrian.max_speed_mps,
-                        cfg.pedestrian.max_acceleration_mps2,
-                        cfg.pedestrian.max_deceleration_mps2,
-                        cfg.pedestrian.max_yaw_rate_radps,
+                        cfg.pedestrian.limits.max_speed_mps,
+                        cfg.pedestrian.limits.max_acceleration_mps2,
+                        cfg.pedestrian.limits.max_deceleration_mps2,
+                        cfg.pedestrian.limits.max_yaw_rate_radps,
                     ),
                     _ => (
-                        cfg.car.max_speed_mps,
-                        cfg.car.max_acceleration_mps2,
-                        cfg.car.max_deceleration_mps2,
-                        cfg.car.max_yaw_rate_radps,
+                        cfg.car.limits.max_speed_mps,
+                        cfg.car.limits.max_acceleration_mps2,
+                        cfg.car.limits.max_deceleration_mps2,
+                        cfg.car.limits.max_yaw_rate_radps,
                     ),
                 };
                 let ctx = format!("{preset} object {id} ({}) at t = {t}", o.class);
@@ -140,7 +140,7 @@ fn check_kinematics(preset: Preset, sequences: u32) -> [f64; 2] {
                 if o.class == ObjectClass::Car {
                     let lateral = o.speed_mps * o.yaw_rate_radps.abs();
                     assert!(
-                        lateral <= cfg.car.max_lateral_acceleration_mps2 + 1e-6,
+                        lateral <= cfg.car.limits.max_lateral_acceleration_mps2.expect("a car limit") + 1e-6,
                         "{ctx}: lateral acceleration {lateral}"
                     );
                 }
@@ -160,14 +160,14 @@ fn check_kinematics(preset: Preset, sequences: u32) -> [f64; 2] {
                     b.speed_mps
                 );
                 let max_jerk = if a.class == ObjectClass::Pedestrian {
-                    cfg.pedestrian.max_jerk_mps3
+                    cfg.pedestrian.limits.max_jerk_mps3
                 } else {
-                    cfg.car.max_jerk_mps3
+                    cfg.car.limits.max_jerk_mps3
                 };
                 let limit_speed = if a.class == ObjectClass::Pedestrian {
-                    cfg.pedestrian.max_speed_mps
+                    cfg.pedestrian.limits.max_speed_mps
                 } else {
-                    cfg.car.max_speed_mps
+                    cfg.car.limits.max_speed_mps
                 };
                 let cruising = a.speed_mps > 0.0 && b.speed_mps > 0.0 && b.speed_mps < limit_speed;
                 if cruising {
@@ -232,7 +232,7 @@ fn frames_are_irregular_positive_steps_from_interleaved_sensors() {
 fn polar_errors(cfg: &ScenarioConfig, frame: &RecordedFrame) -> Vec<(ObjectClass, u16, f64, f64, f64)> {
     let sensor_id = frame.sensor_id.expect("sensor id");
     let mount = mount_of(cfg, sensor_id);
-    let origin = DVec2::new(mount.x_m, mount.y_m);
+    let origin = mount.layout.position();
     frame
         .measurements
         .iter()
@@ -310,7 +310,7 @@ fn radial_velocity_is_the_projected_true_velocity() {
         for (frame, truth) in generated.sequence.frames.iter().zip(&generated.truth) {
             let pose = frame.ego_pose.expect("ego pose");
             let mount = mount_of(&cfg, frame.sensor_id.expect("sensor id"));
-            let origin = DVec2::new(mount.x_m, mount.y_m);
+            let origin = mount.layout.position();
             for m in &frame.measurements {
                 let id = m.measurement.ground_truth_id.expect("ground-truth id");
                 let object = truth.object(id).expect("measured object exists");
@@ -425,8 +425,8 @@ fn hidden_objects_are_missed_more_often_than_visible_ones() {
         for (frame, truth) in generated.sequence.frames.iter().zip(&generated.truth) {
             let pose = frame.ego_pose.expect("pose");
             let mount = mount_of(&cfg, frame.sensor_id.expect("sensor"));
-            let origin = pose.car_to_world(DVec2::new(mount.x_m, mount.y_m));
-            let boresight = pose.yaw_rad + mount.yaw_deg.to_radians();
+            let origin = pose.point_to_world(mount.layout.position());
+            let boresight = pose.yaw_rad + mount.layout.yaw_rad;
             let measured: HashSet<u64> =
                 frame.measurements.iter().filter_map(|m| m.measurement.ground_truth_id).collect();
             for object in &truth.objects {
@@ -434,7 +434,7 @@ fn hidden_objects_are_missed_more_often_than_visible_ones() {
                 let azimuth = (rel.to_angle() - boresight + std::f64::consts::PI)
                     .rem_euclid(2.0 * std::f64::consts::PI)
                     - std::f64::consts::PI;
-                if rel.length() > 40.0 || azimuth.abs() > (mount.half_fov_deg - 10.0).to_radians() {
+                if rel.length() > 40.0 || azimuth.abs() > mount.layout.half_fov_rad - 10f64.to_radians() {
                     continue;
                 }
                 let occluded = truth.objects.iter().any(|other| {
@@ -505,13 +505,13 @@ fn configuration_is_validated_and_serialisable() {
     assert_eq!(partial.car, cfg.car);
 
     let mut bad = cfg.clone();
-    bad.car.max_speed_mps = 5.0;
+    bad.car.limits.max_speed_mps = 5.0;
     assert_eq!(bad.validate().unwrap_err().field, "car.desired_speed_mps");
     let mut bad = cfg.clone();
     bad.radar.scan_jitter_s = 0.01;
     assert_eq!(bad.validate().unwrap_err().field, "radar.scan_jitter_s");
     let mut bad = cfg.clone();
-    bad.radar.sensors[1].id = bad.radar.sensors[0].id;
+    bad.radar.sensors[1].layout.id = bad.radar.sensors[0].layout.id;
     assert_eq!(bad.validate().unwrap_err().field, "radar.sensors[1].id");
     let mut bad = cfg.clone();
     bad.pedestrian.stop_probability = 1.5;

@@ -235,7 +235,7 @@ mod tests {
         let mut expected = ScenarioConfig::default();
         expected.splits.seed_base = 12345;
         expected.car.desired_speed_mps = [12.0, 18.0];
-        expected.car.max_speed_mps = 20.0;
+        expected.car.limits.max_speed_mps = 20.0;
         expected.radar.scan_jitter_s = 0.004;
         assert_eq!(config, expected);
         // The command-line overrides still apply on top of the file.

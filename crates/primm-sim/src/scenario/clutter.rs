@@ -34,10 +34,11 @@ use rand::Rng;
 use rand_chacha::ChaCha12Rng;
 use rand_distr::{Distribution, Poisson, StandardNormal};
 
-use super::config::{ClutterConfig, RadarConfig, RadarMount};
+use super::config::{ClutterConfig, RadarConfig};
 use super::kinematics::wrap_angle;
 use crate::io::RecordedMeasurement;
 use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use primm_core::pose::SensorMount;
 
 /// Adds the false detections of one scan of sensor `sensor_index` to `measurements`, the real
 /// object measurements of that scan. `doppler_bias_mps` is the scan's ego-motion compensation
@@ -54,7 +55,7 @@ pub(crate) fn add_false_detections(
     if !clutter.is_enabled() {
         return;
     }
-    let mount = &radar.sensors[sensor_index];
+    let mount = &radar.sensors[sensor_index].layout;
     let mut false_detections: Vec<RecordedMeasurement> =
         measurements.iter().filter_map(|real| ghost(clutter, radar, mount, &real.measurement, rng)).collect();
     let count = clutter_count(clutter.mean_false_detections_per_scan, rng);
@@ -91,7 +92,7 @@ fn symmetric(rng: &mut ChaCha12Rng, half_width: f64) -> f64 {
 
 /// A false detection of `mount` at car-frame `position`.
 fn false_detection(
-    mount: &RadarMount,
+    mount: &SensorMount,
     position: DVec2,
     radial_velocity_mps: f64,
     rcs_dbsm: f64,
@@ -117,7 +118,7 @@ fn false_detection(
 fn ghost(
     clutter: &ClutterConfig,
     radar: &RadarConfig,
-    mount: &RadarMount,
+    mount: &SensorMount,
     real: &Measurement,
     rng: &mut ChaCha12Rng,
 ) -> Option<RecordedMeasurement> {
@@ -127,12 +128,12 @@ fn ghost(
     let [shortest, longest] = clutter.ghost_extra_range_m;
     let extra_range = rng.random_range(shortest..=longest);
     let radial_velocity = real.radial_velocity_mps + radar.doppler_noise_mps * unit_normal(rng);
-    let origin = DVec2::new(mount.x_m, mount.y_m);
+    let origin = mount.position();
     let line_of_sight = real.position() - origin;
     let range = line_of_sight.length();
-    let azimuth = wrap_angle(line_of_sight.to_angle() - mount.yaw_deg.to_radians());
+    let azimuth = wrap_angle(line_of_sight.to_angle() - mount.yaw_rad);
     let ghost_range = range + extra_range;
-    if range <= 0.0 || ghost_range > mount.max_range_m || azimuth.abs() > mount.half_fov_deg.to_radians() {
+    if range <= 0.0 || ghost_range > mount.max_range_m || azimuth.abs() > mount.half_fov_rad {
         return None;
     }
     let position = origin + line_of_sight * (ghost_range / range);
@@ -150,16 +151,15 @@ fn ghost(
 fn clutter_detection(
     clutter: &ClutterConfig,
     radar: &RadarConfig,
-    mount: &RadarMount,
+    mount: &SensorMount,
     doppler_bias_mps: f64,
     rng: &mut ChaCha12Rng,
 ) -> RecordedMeasurement {
     let (near, far) = clutter_ranges(clutter, mount);
     // Uniform in area: the squared range is uniform.
     let range = (near * near + rng.random::<f64>() * (far * far - near * near)).sqrt();
-    let azimuth = symmetric(rng, mount.half_fov_deg.to_radians());
-    let position =
-        DVec2::new(mount.x_m, mount.y_m) + DVec2::from_angle(mount.yaw_deg.to_radians() + azimuth) * range;
+    let azimuth = symmetric(rng, mount.half_fov_rad);
+    let position = mount.position() + DVec2::from_angle(mount.yaw_rad + azimuth) * range;
     let (class, rcs_mean, rcs_std) = if rng.random_bool(clutter.car_fraction) {
         (ObjectClass::Car, clutter.car_rcs_mean_dbsm, clutter.car_rcs_std_db)
     } else {
@@ -176,7 +176,7 @@ fn clutter_detection(
 
 /// The range interval of the clutter of `mount`, metres: the configured one, cut at the
 /// sensor's range.
-fn clutter_ranges(clutter: &ClutterConfig, mount: &RadarMount) -> (f64, f64) {
+fn clutter_ranges(clutter: &ClutterConfig, mount: &SensorMount) -> (f64, f64) {
     (clutter.min_range_m, clutter.max_range_m.min(mount.max_range_m))
 }
 
@@ -187,15 +187,14 @@ mod tests {
     use rand::SeedableRng;
 
     /// The position of `m` seen from `mount`: range and azimuth from boresight.
-    fn polar(mount: &RadarMount, m: &Measurement) -> (f64, f64) {
-        let rel = m.position() - DVec2::new(mount.x_m, mount.y_m);
-        (rel.length(), wrap_angle(rel.to_angle() - mount.yaw_deg.to_radians()))
+    fn polar(mount: &SensorMount, m: &Measurement) -> (f64, f64) {
+        let rel = m.position() - mount.position();
+        (rel.length(), wrap_angle(rel.to_angle() - mount.yaw_rad))
     }
 
     /// A real object measurement of sensor `mount` at range `range` on its boresight.
-    fn real_measurement(mount: &RadarMount, id: u64, range: f64) -> RecordedMeasurement {
-        let position =
-            DVec2::new(mount.x_m, mount.y_m) + DVec2::from_angle(mount.yaw_deg.to_radians()) * range;
+    fn real_measurement(mount: &SensorMount, id: u64, range: f64) -> RecordedMeasurement {
+        let position = mount.position() + DVec2::from_angle(mount.yaw_rad) * range;
         RecordedMeasurement {
             measurement: Measurement {
                 x_m: position.x,
@@ -223,7 +222,7 @@ mod tests {
         (0..scans)
             .map(|scan| {
                 let sensor = scan % radar.sensors.len();
-                let mount = &radar.sensors[sensor];
+                let mount = &radar.sensors[sensor].layout;
                 let mut measurements: Vec<RecordedMeasurement> =
                     (0..real).map(|id| real_measurement(mount, id as u64, 10.0 + id as f64)).collect();
                 add_false_detections(clutter, &radar, sensor, 0.05, &mut measurements, &mut rng);
@@ -256,7 +255,7 @@ mod tests {
         let radar = RadarConfig::default();
         let (mut near_half, mut total) = (0usize, 0usize);
         for (sensor, detections) in false_detections_of(&clutter, 4000, 0) {
-            let mount = &radar.sensors[sensor];
+            let mount = &radar.sensors[sensor].layout;
             let (near, far) = clutter_ranges(&clutter, mount);
             for detection in &detections {
                 let m = &detection.measurement;
@@ -264,7 +263,7 @@ mod tests {
                 assert_eq!((m.ground_truth_id, detection.true_position), (None, None));
                 let (range, azimuth) = polar(mount, m);
                 assert!((near - 1e-9..=far + 1e-9).contains(&range), "range {range} outside [{near}, {far}]");
-                assert!(azimuth.abs() <= mount.half_fov_deg.to_radians() + 1e-9, "azimuth {azimuth}");
+                assert!(azimuth.abs() <= mount.half_fov_rad + 1e-9, "azimuth {azimuth}");
                 total += 1;
                 near_half += usize::from(range * range < 0.5 * (near * near + far * far));
             }
@@ -318,7 +317,7 @@ mod tests {
         let real_per_scan = 3;
         let mut ghosts = 0usize;
         for (sensor, detections) in false_detections_of(&clutter, scans, real_per_scan) {
-            let mount = &radar.sensors[sensor];
+            let mount = &radar.sensors[sensor].layout;
             for detection in &detections {
                 let m = &detection.measurement;
                 let (range, azimuth) = polar(mount, m);
@@ -344,7 +343,7 @@ mod tests {
         let clutter = ClutterConfig { ghost_probability: 1.0, ..ClutterConfig::default() };
         let mut radar = RadarConfig::default();
         radar.sensors.truncate(1);
-        let mount = radar.sensors[0].clone();
+        let mount = radar.sensors[0].layout;
         let mut measurements = vec![real_measurement(&mount, 1, mount.max_range_m - 0.5)];
         let mut rng = ChaCha12Rng::seed_from_u64(3);
         add_false_detections(&clutter, &radar, 0, 0.0, &mut measurements, &mut rng);
@@ -361,7 +360,7 @@ mod tests {
         let radar = RadarConfig::default();
         let mut rng = ChaCha12Rng::seed_from_u64(5);
         for real in [0, 10, 200, MAX_MEASUREMENTS_PER_FRAME - 1, MAX_MEASUREMENTS_PER_FRAME] {
-            let mount = &radar.sensors[1];
+            let mount = &radar.sensors[1].layout;
             let original: Vec<RecordedMeasurement> =
                 (0..real).map(|id| real_measurement(mount, id as u64, 5.0 + 0.2 * id as f64)).collect();
             let mut measurements = original.clone();
@@ -436,7 +435,7 @@ mod tests {
     #[test]
     fn switched_off_clutter_draws_nothing_and_adds_nothing() {
         let radar = RadarConfig::default();
-        let mount = &radar.sensors[2];
+        let mount = &radar.sensors[2].layout;
         let original = vec![real_measurement(mount, 1, 20.0), real_measurement(mount, 2, 30.0)];
         let mut measurements = original.clone();
         let mut rng = ChaCha12Rng::seed_from_u64(9);

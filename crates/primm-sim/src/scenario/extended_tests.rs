@@ -8,6 +8,7 @@ use super::kinematics::wrap_angle;
 use super::{GeneratedSequence, ObjectState, ScenarioGenerator, Split};
 use crate::io::{read_sequence_file, RecordedFrame, RecordedMeasurement};
 use primm_core::measurement::ObjectClass;
+use primm_core::pose::SensorMount;
 
 /// Sequences of `config` (shortened to `duration_s`) of the evaluation split.
 fn sequences(mut config: ScenarioConfig, duration_s: f64, count: u32) -> Vec<GeneratedSequence> {
@@ -18,7 +19,7 @@ fn sequences(mut config: ScenarioConfig, duration_s: f64, count: u32) -> Vec<Gen
 
 fn mount_of(config: &ScenarioConfig, frame: &RecordedFrame) -> RadarMount {
     let id = frame.sensor_id.expect("sensor id");
-    config.radar.sensors.iter().find(|s| s.id == id).expect("known sensor").clone()
+    config.radar.sensors.iter().find(|s| s.layout.id == id).expect("known sensor").clone()
 }
 
 /// An object's box in the car frame of one frame: corners counter-clockwise.
@@ -51,12 +52,12 @@ impl CarFrameBox {
 
     /// Whether the whole box lies within the sensor's field of view (shrunk by `margin_rad`)
     /// and nearer than `range_m`.
-    fn inside_view(&self, mount: &RadarMount, margin_rad: f64, range_m: f64) -> bool {
-        let origin = DVec2::new(mount.x_m, mount.y_m);
+    fn inside_view(&self, mount: &SensorMount, margin_rad: f64, range_m: f64) -> bool {
+        let origin = mount.position();
         self.corners.iter().all(|corner| {
             let rel = *corner - origin;
-            let azimuth = wrap_angle(rel.to_angle() - mount.yaw_deg.to_radians());
-            rel.length() < range_m && azimuth.abs() < mount.half_fov_deg.to_radians() - margin_rad
+            let azimuth = wrap_angle(rel.to_angle() - mount.yaw_rad);
+            rel.length() < range_m && azimuth.abs() < mount.half_fov_rad - margin_rad
         })
     }
 }
@@ -90,12 +91,12 @@ fn detections_lie_on_the_visible_contour_of_the_box() {
     for generated in sequences(config.clone(), 5.0, 6) {
         for (frame, m, object) in vehicle_detections(&generated) {
             let mount = mount_of(&config, frame);
-            let sensor = DVec2::new(mount.x_m, mount.y_m);
+            let sensor = mount.layout.position();
             let body = CarFrameBox::new(object, frame);
             assert_eq!(m.true_position, Some(body.centre), "the truth stays the object centre");
             let measured = m.measurement.position();
             let range = measured.distance(sensor);
-            let azimuth = wrap_angle((measured - sensor).to_angle() - mount.yaw_deg.to_radians());
+            let azimuth = wrap_angle((measured - sensor).to_angle() - mount.layout.yaw_rad);
             // Noise of one point: range noise, azimuth noise growing off boresight, and the
             // sensor's misalignment.
             let sigma_azimuth =
@@ -137,7 +138,7 @@ fn radial_velocity_and_true_velocity_are_those_of_the_rigid_body() {
             assert!(true_velocity.distance(velocity) < 1e-9, "{true_velocity:?} against {velocity:?}");
             let mount = mount_of(&config, frame);
             let measured = m.measurement.position();
-            let line_of_sight = (measured - DVec2::new(mount.x_m, mount.y_m)).normalize();
+            let line_of_sight = (measured - mount.layout.position()).normalize();
             let lever = measured - m.true_position.expect("true position");
             let point_velocity = velocity + lever.perp() * object.yaw_rate_radps;
             residuals.push(m.measurement.radial_velocity_mps - point_velocity.dot(line_of_sight));
@@ -165,7 +166,7 @@ fn several_detections_of_one_vehicle_arrive_at_the_configured_rate() {
         for (frame, truth) in generated.sequence.frames.iter().zip(&generated.truth) {
             let mount = mount_of(&config, frame);
             for object in truth.objects.iter().filter(|o| o.class != ObjectClass::Pedestrian) {
-                if !CarFrameBox::new(object, frame).inside_view(&mount, 2f64.to_radians(), 90.0) {
+                if !CarFrameBox::new(object, frame).inside_view(&mount.layout, 2f64.to_radians(), 90.0) {
                     continue;
                 }
                 let count = frame

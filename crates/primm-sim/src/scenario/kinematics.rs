@@ -4,20 +4,14 @@ use std::f64::consts::PI;
 
 use glam::DVec2;
 
-/// Hard physical limits of a class of objects.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Limits {
-    pub max_speed: f64,
-    pub max_accel: f64,
-    pub max_decel: f64,
-    pub max_jerk: f64,
-    pub max_yaw_rate: f64,
-    pub max_yaw_accel: f64,
-    /// Largest `speed × yaw rate`; infinite for classes without that limit.
-    pub max_lateral_accel: f64,
-    /// Braking is faded out as `speed / stop_taper` near standstill, seconds.
-    pub stop_taper: f64,
-}
+use super::config::MotionLimits;
+
+/// Braking fades out near standstill, but never below this deceleration, m/s², so that a
+/// stop is reached in finite time.
+const MIN_STOPPING_DECELERATION_MPS2: f64 = 0.3;
+/// The lateral acceleration limit caps the yaw rate as if the object were at least this
+/// fast, m/s.
+const MIN_LATERAL_LIMIT_SPEED_MPS: f64 = 0.5;
 
 /// Kinematic state: centre position, heading, speed and their rates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,19 +50,20 @@ impl Kinematics {
 
     /// Advances by `dt` seconds towards the commanded acceleration and yaw rate, respecting
     /// `limits`. The speed never becomes negative; reaching standstill ends braking.
-    pub(crate) fn step(&mut self, accel_cmd: f64, yaw_rate_cmd: f64, dt: f64, limits: &Limits) {
-        let mut target = accel_cmd.clamp(-limits.max_decel, limits.max_accel);
+    pub(crate) fn step(&mut self, accel_cmd: f64, yaw_rate_cmd: f64, dt: f64, limits: &MotionLimits) {
+        let (max_accel, max_decel) = (limits.max_acceleration_mps2, limits.max_deceleration_mps2);
+        let mut target = accel_cmd.clamp(-max_decel, max_accel);
         if target < 0.0 {
             // Drivers and walkers release the brake as they come to a stop.
-            target = target.max(-(self.speed / limits.stop_taper).max(0.3));
+            target = target.max(-(self.speed / limits.stop_taper_s).max(MIN_STOPPING_DECELERATION_MPS2));
         } else {
             // Ease off in time to meet the speed limit without exceeding the jerk limit.
-            let headroom = (limits.max_speed - self.speed).max(0.0);
-            target = target.min((limits.max_jerk * headroom).sqrt());
+            let headroom = (limits.max_speed_mps - self.speed).max(0.0);
+            target = target.min((limits.max_jerk_mps3 * headroom).sqrt());
         }
-        let jerk_step = limits.max_jerk * dt;
-        let accel = (self.accel + (target - self.accel).clamp(-jerk_step, jerk_step))
-            .clamp(-limits.max_decel, limits.max_accel);
+        let jerk_step = limits.max_jerk_mps3 * dt;
+        let accel =
+            (self.accel + (target - self.accel).clamp(-jerk_step, jerk_step)).clamp(-max_decel, max_accel);
         let old_speed = self.speed;
         let mut speed = old_speed + accel * dt;
         let mut accel_applied = accel;
@@ -78,14 +73,18 @@ impl Kinematics {
             moving_time = if accel < 0.0 { (old_speed / -accel).min(dt) } else { dt };
             speed = 0.0;
             accel_applied = 0.0;
-        } else if speed > limits.max_speed {
-            speed = limits.max_speed;
+        } else if speed > limits.max_speed_mps {
+            speed = limits.max_speed_mps;
             accel_applied = (speed - old_speed) / dt;
         }
 
-        let lateral_cap = limits.max_lateral_accel / speed.max(0.5);
-        let yaw_cap = limits.max_yaw_rate.min(lateral_cap);
-        let yaw_step = limits.max_yaw_accel * dt;
+        let yaw_cap = match limits.max_lateral_acceleration_mps2 {
+            Some(max_lateral) => {
+                limits.max_yaw_rate_radps.min(max_lateral / speed.max(MIN_LATERAL_LIMIT_SPEED_MPS))
+            }
+            None => limits.max_yaw_rate_radps,
+        };
+        let yaw_step = limits.max_yaw_acceleration_radps2 * dt;
         let yaw_target = yaw_rate_cmd.clamp(-yaw_cap, yaw_cap);
         let yaw_rate = (self.yaw_rate + (yaw_target - self.yaw_rate).clamp(-yaw_step, yaw_step))
             .clamp(-yaw_cap, yaw_cap);
@@ -105,17 +104,8 @@ impl Kinematics {
 mod tests {
     use super::*;
 
-    fn limits() -> Limits {
-        Limits {
-            max_speed: 15.0,
-            max_accel: 3.0,
-            max_decel: 7.0,
-            max_jerk: 6.0,
-            max_yaw_rate: 0.7,
-            max_yaw_accel: 1.2,
-            max_lateral_accel: 3.5,
-            stop_taper: 0.8,
-        }
+    fn limits() -> MotionLimits {
+        MotionLimits { max_speed_mps: 15.0, ..MotionLimits::car() }
     }
 
     #[test]
@@ -127,13 +117,13 @@ mod tests {
         for step in 0..2000 {
             let (a, w) = if step < 800 { (10.0, 2.0) } else { (-10.0, -2.0) };
             k.step(a, w, dt, &l);
-            assert!(k.speed >= 0.0 && k.speed <= l.max_speed + 1e-9);
-            assert!(k.accel <= l.max_accel + 1e-9 && k.accel >= -l.max_decel - 1e-9);
-            assert!(k.yaw_rate.abs() <= l.max_yaw_rate + 1e-9);
-            assert!(k.speed * k.yaw_rate.abs() <= l.max_lateral_accel + 1e-6);
+            assert!(k.speed >= 0.0 && k.speed <= l.max_speed_mps + 1e-9);
+            assert!(k.accel <= l.max_acceleration_mps2 + 1e-9 && k.accel >= -l.max_deceleration_mps2 - 1e-9);
+            assert!(k.yaw_rate.abs() <= l.max_yaw_rate_radps + 1e-9);
+            assert!(k.speed * k.yaw_rate.abs() <= l.max_lateral_acceleration_mps2.unwrap() + 1e-6);
             if k.speed > 0.0 && previous.speed > 0.0 {
                 assert!(
-                    (k.accel - previous.accel).abs() <= l.max_jerk * dt + 1e-9,
+                    (k.accel - previous.accel).abs() <= l.max_jerk_mps3 * dt + 1e-9,
                     "step {step}: {previous:?} -> {k:?}"
                 );
             }

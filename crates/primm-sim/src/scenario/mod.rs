@@ -51,9 +51,10 @@ use rand_chacha::ChaCha12Rng;
 use serde::{Deserialize, Serialize};
 
 pub use config::{
-    CarConfig, ClutterConfig, ConfigError, EgoConfig, ExtendedObjectConfig, Interval, PedestrianConfig,
-    Preset, RadarConfig, RadarMount, ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError,
-    SequenceConfig, SplitConfig, TrafficConfig, MAX_DETECTIONS_PER_OBJECT,
+    CarConfig, ClutterConfig, ConfigError, DriverConfig, EgoConfig, ExtendedObjectConfig, Interval,
+    MotionLimits, PedestrianConfig, Preset, RadarConfig, RadarMount, ReflectionConfig, RoadConfig,
+    ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig, TrafficConfig, WalkerConfig,
+    MAX_DETECTIONS_PER_OBJECT,
 };
 pub use events::{
     count_events, EventCounts, CLOSE_PROXIMITY_DISTANCE_M, CROSSING_DISTANCE_M,
@@ -239,7 +240,7 @@ impl ScenarioGenerator {
             );
             let ego_pose = world.ego_pose();
             let mut frame = RecordedFrame::new(index as u64, scan.t);
-            frame.sensor_id = Some(cfg.radar.sensors[scan.sensor].id);
+            frame.sensor_id = Some(cfg.radar.sensors[scan.sensor].layout.id);
             frame.ego_pose = Some(ego_pose);
             frame.measurements = scanned.measurements;
             sequence.frames.push(frame);

@@ -72,7 +72,7 @@ fn symmetric(rng: &mut ChaCha12Rng, half_width: f64) -> f64 {
 
 /// World pose of a sensor: position and boresight heading.
 pub(crate) fn sensor_pose(ego: &EgoPose, mount: &RadarMount) -> (DVec2, f64) {
-    (ego.car_to_world(DVec2::new(mount.x_m, mount.y_m)), ego.yaw_rad + mount.yaw_deg.to_radians())
+    (ego.point_to_world(mount.layout.position()), ego.yaw_rad + mount.layout.yaw_rad)
 }
 
 /// Whether the segment from `a` to `b` passes through the box of `agent`.
@@ -165,7 +165,7 @@ pub(crate) fn scan(
         mount,
         origin,
         boresight,
-        half_fov: mount.half_fov_deg.to_radians(),
+        half_fov: mount.layout.half_fov_rad,
         unit: Normal::new(0.0, 1.0).expect("unit normal"),
     };
     let scan_bias = radar.scan_doppler_bias_mps * sensor.unit.sample(rng);
@@ -179,7 +179,7 @@ pub(crate) fn scan(
             ObjectClass::Pedestrian => &cfg.pedestrian_reflection,
             _ => &cfg.car_reflection,
         };
-        let max_range = mount.max_range_m.min(refl.detection_range_m);
+        let max_range = mount.layout.max_range_m.min(refl.detection_range_m);
         let Some(range) = range_if_in_view(&sensor, object, max_range) else { continue };
         let Some(faces) = visible_faces(object, origin) else { continue };
         let truth = ObjectTruth {
@@ -214,7 +214,7 @@ pub(crate) fn scan(
                 radial_velocity_mps: echo.sum_vr / n + scan_bias,
                 rcs_dbsm: echo.sum_rcs / n,
                 class: object.class,
-                sensor_id: Some(mount.id),
+                sensor_id: Some(mount.layout.id),
                 ground_truth_id: Some(object.id),
             },
             true_position: Some(truth.position),
@@ -382,7 +382,7 @@ fn extended_detections(
                 radial_velocity_mps: vr + scan_bias,
                 rcs_dbsm: rcs,
                 class: object.class,
-                sensor_id: Some(sensor.mount.id),
+                sensor_id: Some(sensor.mount.layout.id),
                 ground_truth_id: Some(object.id),
             },
             true_position: Some(target.truth.position),

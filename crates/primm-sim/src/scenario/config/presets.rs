@@ -1,0 +1,297 @@
+//! Named configurations: the reference one and its variants.
+
+use serde::{Deserialize, Serialize};
+
+use super::types::{CarConfig, ClutterConfig, ExtendedObjectConfig, PedestrianConfig};
+use super::ScenarioConfig;
+
+/// Named configurations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Preset {
+    /// The reference configuration ([`ScenarioConfig::default`]).
+    Default,
+    /// A harder configuration for robustness checks: faster and more aggressive cars, more
+    /// erratic and faster pedestrians, denser traffic, noisier sensors with more misses, and
+    /// more false detections than [`Preset::Clutter`].
+    Robustness,
+    /// The default scene seen from an ego vehicle that turns at most junctions of a denser
+    /// road grid, at town speeds: ego yaw rates up to about 0.5 rad/s.
+    Turning,
+    /// The default scene with false detections ([`ClutterConfig::urban`]): about 1.5 per scan,
+    /// mostly static, some moving-looking, a few multipath ghosts.
+    Clutter,
+    /// The [`Preset::Turning`] scene with the false detections of [`Preset::Clutter`].
+    ClutterTurning,
+    /// The default scene with vehicles measured as extended objects
+    /// ([`ExtendedObjectConfig::vehicles`]): detections from the visible contour and corners of
+    /// each vehicle's box, now and then several per vehicle and scan.
+    Extended,
+    /// The [`Preset::Turning`] scene with the extended vehicles of [`Preset::Extended`].
+    ExtendedTurning,
+    /// The [`Preset::Clutter`] scene with the extended vehicles of [`Preset::Extended`].
+    ExtendedClutter,
+    /// The [`Preset::ClutterTurning`] scene with the extended vehicles of [`Preset::Extended`].
+    ExtendedClutterTurning,
+}
+
+impl Preset {
+    /// All presets.
+    pub const ALL: [Preset; 9] = [
+        Preset::Default,
+        Preset::Robustness,
+        Preset::Turning,
+        Preset::Clutter,
+        Preset::ClutterTurning,
+        Preset::Extended,
+        Preset::ExtendedTurning,
+        Preset::ExtendedClutter,
+        Preset::ExtendedClutterTurning,
+    ];
+
+    /// The preset's name (`default`, `robustness`, `turning`, `clutter`, `clutter_turning`,
+    /// `extended`, `extended_turning`, `extended_clutter`, `extended_clutter_turning`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Default => "default",
+            Preset::Robustness => "robustness",
+            Preset::Turning => "turning",
+            Preset::Clutter => "clutter",
+            Preset::ClutterTurning => "clutter_turning",
+            Preset::Extended => "extended",
+            Preset::ExtendedTurning => "extended_turning",
+            Preset::ExtendedClutter => "extended_clutter",
+            Preset::ExtendedClutterTurning => "extended_clutter_turning",
+        }
+    }
+
+    /// The preset called `name`, if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// The configuration of this preset.
+    pub fn config(self) -> ScenarioConfig {
+        match self {
+            Preset::Default => ScenarioConfig::default(),
+            Preset::Robustness => ScenarioConfig::robustness(),
+            Preset::Turning => ScenarioConfig::turning(),
+            Preset::Clutter => ScenarioConfig::clutter(),
+            Preset::ClutterTurning => ScenarioConfig::clutter_turning(),
+            Preset::Extended => ScenarioConfig::extended(Preset::Default),
+            Preset::ExtendedTurning => ScenarioConfig::extended(Preset::Turning),
+            Preset::ExtendedClutter => ScenarioConfig::extended(Preset::Clutter),
+            Preset::ExtendedClutterTurning => ScenarioConfig::extended(Preset::ClutterTurning),
+        }
+    }
+}
+
+impl std::fmt::Display for Preset {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Preset {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::from_name(s).ok_or_else(|| {
+            let names: Vec<String> = Self::ALL.iter().map(|p| format!("`{}`", p.name())).collect();
+            format!("unknown preset `{s}` (expected one of {})", names.join(", "))
+        })
+    }
+}
+
+impl ScenarioConfig {
+    /// The ego-turning preset: see [`Preset::Turning`].
+    pub fn turning() -> Self {
+        let mut config = Self::default();
+        config.splits.seed_base = 0x5455_524e_494e;
+        config.road.block_length_m = 90.0;
+        config.ego.desired_speed_mps = [6.0, 10.0];
+        config.ego.start_distance_to_junction_m = [15.0, 40.0];
+        config.ego.turn_left_probability = Some(0.45);
+        config.ego.turn_right_probability = Some(0.45);
+        config
+    }
+
+    /// The clutter preset: see [`Preset::Clutter`].
+    pub fn clutter() -> Self {
+        let mut config = Self::default();
+        config.splits.seed_base = 0x434c_5554_5452;
+        config.clutter = ClutterConfig::urban();
+        config
+    }
+
+    /// The ego-turning clutter preset: see [`Preset::ClutterTurning`].
+    pub fn clutter_turning() -> Self {
+        let mut config = Self::turning();
+        config.splits.seed_base = 0x434c_5455_524e;
+        config.clutter = ClutterConfig::urban();
+        config
+    }
+
+    /// The `base` preset's scene with vehicles measured as extended objects
+    /// ([`ExtendedObjectConfig::vehicles`]) and a seed base of its own (see
+    /// [`Preset::Extended`]). With the same seed, traffic, scan timing and the ego vehicle are
+    /// those of `base`; the clutter presets' false detections come from their own stream too.
+    pub fn extended(base: Preset) -> Self {
+        let mut config = base.config();
+        // A seed base per extended preset: "EXT" and the base preset's own seed base.
+        config.splits.seed_base = config.splits.seed_base.wrapping_add(0x4558_5400_0000_0000);
+        config.extended_objects = ExtendedObjectConfig::vehicles();
+        config
+    }
+
+    /// The robustness preset: see [`Preset::Robustness`].
+    pub fn robustness() -> Self {
+        let mut config = Self::default();
+        config.splits.seed_base = 0x524f_4255_5354;
+        config.road.block_length_m = 90.0;
+        config.road.signal_green_s = 12.0;
+        config.traffic.car_count = 20;
+        config.traffic.pedestrian_count = 24;
+        config.traffic.pedestrian_group_probability = 0.4;
+        config.ego.desired_speed_mps = [10.0, 16.0];
+        robust_cars(&mut config.car);
+        robust_pedestrians(&mut config.pedestrian);
+        robust_sensors(&mut config);
+        config
+    }
+}
+
+/// The faster and more aggressive cars of [`Preset::Robustness`].
+fn robust_cars(car: &mut CarConfig) {
+    car.desired_speed_mps = [11.0, 19.5];
+    car.limits.max_speed_mps = 22.0;
+    car.limits.max_acceleration_mps2 = 3.5;
+    car.limits.max_deceleration_mps2 = 8.0;
+    car.limits.max_jerk_mps3 = 9.0;
+    car.limits.max_yaw_rate_radps = 0.8;
+    car.limits.max_yaw_acceleration_radps2 = 1.6;
+    car.limits.max_lateral_acceleration_mps2 = Some(4.5);
+    car.comfortable_acceleration_mps2 = 2.4;
+    car.comfortable_deceleration_mps2 = 3.5;
+    car.curve_lateral_acceleration_mps2 = 3.5;
+    car.time_headway_s = 0.9;
+    car.turn_left_probability = 0.25;
+    car.turn_right_probability = 0.3;
+    car.lane_change_probability = 0.7;
+    car.lane_change_duration_s = 2.5;
+    car.speed_change_interval_s = [2.0, 6.0];
+}
+
+/// The faster and more erratic pedestrians of [`Preset::Robustness`].
+fn robust_pedestrians(ped: &mut PedestrianConfig) {
+    ped.desired_speed_mps = [1.0, 2.0];
+    ped.hurry_probability = 0.25;
+    ped.hurry_speed_mps = [2.2, 3.4];
+    ped.limits.max_speed_mps = 3.5;
+    ped.limits.max_acceleration_mps2 = 2.5;
+    ped.limits.max_deceleration_mps2 = 3.0;
+    ped.limits.max_jerk_mps3 = 10.0;
+    ped.limits.max_yaw_rate_radps = 3.5;
+    ped.limits.max_yaw_acceleration_radps2 = 12.0;
+    ped.heading_wander_rad = 0.25;
+    ped.heading_wander_time_s = 1.0;
+    ped.leg_length_m = [3.0, 15.0];
+    ped.stop_probability = 0.25;
+    ped.stop_duration_s = [0.5, 4.0];
+    ped.turn_around_probability = 0.25;
+    ped.mid_block_crossing_probability = 0.3;
+}
+
+/// The noisier sensors, stronger RCS fluctuation and false detections of
+/// [`Preset::Robustness`].
+fn robust_sensors(config: &mut ScenarioConfig) {
+    let radar = &mut config.radar;
+    radar.phase_jitter_s = 0.003;
+    radar.scan_jitter_s = 0.004;
+    radar.range_noise_m = 0.25;
+    radar.azimuth_noise_deg = 1.2;
+    radar.doppler_noise_mps = 0.2;
+    radar.scan_doppler_bias_mps = 0.08;
+    radar.miss_probability = 0.08;
+    radar.occluded_point_probability = 0.1;
+    for sensor in &mut radar.sensors {
+        sensor.azimuth_bias_deg *= 2.0;
+    }
+    config.car_reflection.rcs_fluctuation_db = 6.0;
+    config.pedestrian_reflection.rcs_fluctuation_db = 5.0;
+    config.pedestrian_reflection.micro_doppler_fraction = 0.5;
+    config.clutter = ClutterConfig {
+        mean_false_detections_per_scan: 2.0,
+        moving_fraction: 0.2,
+        ghost_probability: 0.05,
+        ..ClutterConfig::urban()
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_preset_is_valid_and_found_by_its_name() {
+        for preset in Preset::ALL {
+            preset.config().validate().unwrap_or_else(|error| panic!("{preset}: {error}"));
+            assert_eq!(Preset::from_name(preset.name()), Some(preset));
+            assert_eq!(preset.name().parse::<Preset>(), Ok(preset));
+        }
+        let error = "clutter-free".parse::<Preset>().unwrap_err();
+        for preset in Preset::ALL {
+            assert!(error.contains(&format!("`{}`", preset.name())), "{error}");
+        }
+    }
+
+    #[test]
+    fn every_preset_has_its_own_seed_base() {
+        for (i, a) in Preset::ALL.into_iter().enumerate() {
+            for b in &Preset::ALL[..i] {
+                assert_ne!(a.config().splits.seed_base, b.config().splits.seed_base, "{a} and {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn only_the_clutter_and_robustness_presets_add_false_detections() {
+        for preset in Preset::ALL {
+            let clutter = preset.config().clutter;
+            let expected = matches!(
+                preset,
+                Preset::Clutter
+                    | Preset::ClutterTurning
+                    | Preset::Robustness
+                    | Preset::ExtendedClutter
+                    | Preset::ExtendedClutterTurning
+            );
+            assert_eq!(clutter.is_enabled(), expected, "{preset}");
+        }
+        assert_eq!(ScenarioConfig::default().clutter, ClutterConfig::default());
+        let robust = Preset::Robustness.config().clutter.mean_false_detections_per_scan;
+        assert!(robust > Preset::Clutter.config().clutter.mean_false_detections_per_scan);
+    }
+
+    #[test]
+    fn the_extended_presets_are_their_base_presets_with_extended_vehicles() {
+        let pairs = [
+            (Preset::Extended, Preset::Default),
+            (Preset::ExtendedTurning, Preset::Turning),
+            (Preset::ExtendedClutter, Preset::Clutter),
+            (Preset::ExtendedClutterTurning, Preset::ClutterTurning),
+        ];
+        for preset in Preset::ALL {
+            let extended = pairs.iter().any(|(p, _)| *p == preset);
+            assert_eq!(preset.config().extended_objects.enabled, extended, "{preset}");
+        }
+        for (extended, base) in pairs {
+            let mut config = extended.config();
+            assert_eq!(config.extended_objects, ExtendedObjectConfig::vehicles());
+            assert_ne!(config.splits.seed_base, base.config().splits.seed_base);
+            config.extended_objects = ExtendedObjectConfig::default();
+            config.splits.seed_base = base.config().splits.seed_base;
+            assert_eq!(config, base.config(), "{extended} against {base}");
+        }
+        assert!((ExtendedObjectConfig::vehicles().mean_detection_count() - 1.25).abs() < 1e-12);
+    }
+}
