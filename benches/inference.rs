@@ -9,14 +9,14 @@
 //! `pr_model/B` is one `PrModel::run` of B samples (the parity fixture's inputs, repeated):
 //! what the inference thread spends per frame when B model rows are needed. `onnx_predictor/N`
 //! is a whole frame of N tracks through `OnnxPredictor` with every other track coasting, so
-//! 1.5·N model rows (see `src/predictor/onnx.rs`).
+//! 1.5·N model rows (see `crates/primm-predictor/src/onnx/predictor.rs`).
 //!
 //! Shipped model (d 32, 2 layers), tract 0.23, one thread, idle 2-core Xeon 2.5 GHz:
 //! `pr_model` 121.6 µs (B = 1), 463.7 µs (16), 1.521 ms (64), 5.534 ms (256), i.e. 121.6, 29.0,
 //! 23.8 and 21.6 µs per sample; `onnx_predictor` 649 µs (16 tracks), 2.19 ms (64 tracks).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use primm_core::config::InferenceEngine;
+use primm_config::InferenceEngine;
 use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
 use primm_predictor::onnx::{OnnxPredictor, PrModel};
 use std::hint::black_box;

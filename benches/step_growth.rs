@@ -22,7 +22,8 @@
 
 use hdrhistogram::Histogram;
 use plotters::prelude::*;
-use primm_core::config::{Config, InferenceEngine};
+use primm_config::{InferenceConfig, InferenceEngine};
+use primm_core::config::Config;
 use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
@@ -265,9 +266,9 @@ fn main() {
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pr.onnx");
     let inference_threads: usize = argument("--inference-threads")
         .and_then(|v| v.parse().ok())
-        .unwrap_or(Config::default().predictor.inference_threads);
+        .unwrap_or(InferenceConfig::default().inference_threads);
     let engine: InferenceEngine = argument("--engine")
-        .map_or(Config::default().predictor.engine, |name| name.parse().expect("--engine native|tract"));
+        .map_or(InferenceConfig::default().engine, |name| name.parse().expect("--engine native|tract"));
     // `--config FILE`: another tracker configuration (e.g. the previous lifecycle and association
     // settings, to measure what existence and staged association cost).
     let base = argument("--config").map_or_else(Config::default, |path| {
@@ -276,21 +277,7 @@ fn main() {
     // `--sequence FILE`: a measurement CSV (e.g. a generated evaluation sequence) instead of the
     // lanes; its frames are replayed once (the first WARM_UP_FRAMES untimed) and the row's
     // object count is the number of distinct ground-truth objects in it.
-    let sequence = argument("--sequence").map(|path| {
-        let sequence =
-            primm_sim::io::read_sequence_file(Path::new(&path)).expect("--sequence names a measurement CSV");
-        let frames: Vec<Frame> = sequence
-            .frames
-            .iter()
-            .map(|frame| frame.to_frame().expect("a frame within the limits"))
-            .collect();
-        let objects: std::collections::BTreeSet<u64> = frames
-            .iter()
-            .flat_map(|frame| frame.measurements.iter().filter_map(|m| m.ground_truth_id))
-            .collect();
-        eprintln!("{path}: {} frames, {} objects", frames.len(), objects.len());
-        (frames, objects.len())
-    });
+    let sequence = argument("--sequence").map(|path| read_sequence(&path));
     let counts = match &sequence {
         Some((_, objects)) => vec![*objects],
         None => counts,
@@ -321,16 +308,33 @@ fn main() {
     let text = table(&rows);
     println!("{text}");
     if !std::env::args().any(|a| a == "--no-write") {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
-        std::fs::create_dir_all(&dir).unwrap();
         let header = format!(
             "Tracker step time vs objects (`cargo bench --bench step_growth`), {frames} timed frames per row after {WARM_UP_FRAMES} warm-up frames; PR on {inference_threads} inference thread(s), engine {engine:?}.\n\n"
         );
-        std::fs::write(dir.join("step_growth.md"), header + &text).unwrap();
-        std::fs::write(dir.join("step_growth.json"), serde_json::to_string_pretty(&rows).unwrap()).unwrap();
-        if let Err(error) = plot(&rows, &dir.join("step_growth.svg")) {
-            eprintln!("cannot draw the plot: {error}");
-        }
-        eprintln!("wrote {}", dir.join("step_growth.{md,json,svg}").display());
+        write_results(&rows, &(header + &text));
     }
+}
+
+/// The frames of a measurement CSV and the number of distinct ground-truth objects in it.
+fn read_sequence(path: &str) -> (Vec<Frame>, usize) {
+    let sequence =
+        primm_sim::io::read_sequence_file(Path::new(path)).expect("--sequence names a measurement CSV");
+    let frames: Vec<Frame> =
+        sequence.frames.iter().map(|frame| frame.to_frame().expect("a frame within the limits")).collect();
+    let objects: std::collections::BTreeSet<u64> =
+        frames.iter().flat_map(|frame| frame.measurements.iter().filter_map(|m| m.ground_truth_id)).collect();
+    eprintln!("{path}: {} frames, {} objects", frames.len(), objects.len());
+    (frames, objects.len())
+}
+
+/// Writes the table (`markdown`), the rows as JSON and the plot into `benches/results`.
+fn write_results(rows: &[Row], markdown: &str) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/results");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("step_growth.md"), markdown).unwrap();
+    std::fs::write(dir.join("step_growth.json"), serde_json::to_string_pretty(rows).unwrap()).unwrap();
+    if let Err(error) = plot(rows, &dir.join("step_growth.svg")) {
+        eprintln!("cannot draw the plot: {error}");
+    }
+    eprintln!("wrote {}", dir.join("step_growth.{md,json,svg}").display());
 }

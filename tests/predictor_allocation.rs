@@ -7,7 +7,8 @@ use crate::common;
 use crate::common::counting_allocator;
 
 use counting_allocator::{allocations, count_allocations};
-use primm_core::config::{Config, InferenceEngine};
+use primm_config::InferenceEngine;
+use primm_core::config::Config;
 use primm_core::measurement::Frame;
 use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
 use primm_core::tracker::Tracker;

@@ -4,7 +4,8 @@
 //! generated validation sequence with clutter and a turning ego vehicle, where car and
 //! pedestrian tracks share every frame. The PR method alone ignores the list.
 
-use primm_core::config::{Config, InferenceEngine};
+use primm_config::InferenceEngine;
+use primm_core::config::Config;
 use primm_core::measurement::{ClassSet, Frame, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};

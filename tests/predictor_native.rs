@@ -3,7 +3,7 @@
 //! for a model it does not compute exactly.
 
 use crate::common::counting_allocator::count_allocations;
-use primm_core::config::InferenceEngine;
+use primm_config::InferenceEngine;
 use primm_core::predictor::{FEATURES, MAX_HISTORY};
 use primm_predictor::native::Unsupported;
 use primm_predictor::onnx::{ModelSource, PrModel, MAX_PROBE_DIFFERENCE_M};

@@ -13,7 +13,7 @@
 //!   then bisection, a fresh tracker per trial; `primm_publisher::load`).
 
 use super::latency_out::parse_positive_seconds;
-use primm_core::config::InferenceEngine;
+use super::TrackerArgs;
 use primm_core::mode::Method;
 use primm_core::stage_timing::Stage;
 use primm_publisher::load::{
@@ -41,18 +41,12 @@ pub struct TrackerSettings {
     /// Tracking method: cv, ca, ct, imm, pr, pr-imm.
     #[arg(long, default_value = "imm")]
     pub method: Method,
-    /// What runs the PR model: `native` or `tract` (default: the configuration's).
-    #[arg(long, value_name = "ENGINE")]
-    pub engine: Option<InferenceEngine>,
-    /// PR model (ONNX) for pr and pr-imm (default: the model built into primm).
-    #[arg(long, value_name = "FILE")]
-    pub model: Option<PathBuf>,
+    /// The tracker's configuration, model, engine and tracking frame.
+    #[command(flatten)]
+    pub tracker: TrackerArgs,
     /// Inference threads (default: the configuration's).
     #[arg(long, value_name = "COUNT")]
     pub inference_threads: Option<usize>,
-    /// Tracker configuration (TOML).
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
     /// Let the tracker spin on its input instead of sleeping until notified.
     #[arg(long)]
     pub busy_poll: bool,
@@ -62,21 +56,9 @@ impl TrackerSettings {
     /// The `primm serve` arguments for these settings.
     pub fn serve_arguments(&self) -> Vec<OsString> {
         let mut arguments: Vec<OsString> = vec!["--method".into(), self.method.id().into()];
-        if let Some(engine) = self.engine {
-            let name = match engine {
-                InferenceEngine::Native => "native",
-                InferenceEngine::Tract => "tract",
-            };
-            arguments.extend(["--engine".into(), name.into()]);
-        }
-        if let Some(model) = &self.model {
-            arguments.extend(["--model".into(), model.into()]);
-        }
+        arguments.extend(self.tracker.to_arguments());
         if let Some(threads) = self.inference_threads {
             arguments.extend(["--inference-threads".into(), threads.to_string().into()]);
-        }
-        if let Some(config) = &self.config {
-            arguments.extend(["--config".into(), config.into()]);
         }
         if self.busy_poll {
             arguments.push("--busy-poll".into());
@@ -535,6 +517,7 @@ fn summary_text(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use primm_config::InferenceEngine;
 
     #[test]
     fn the_tracker_loss_count_is_read_from_its_summary_line() {
@@ -548,10 +531,8 @@ mod tests {
     fn tracker_settings_become_serve_arguments() {
         let settings = TrackerSettings {
             method: Method::PrImm,
-            engine: Some(InferenceEngine::Tract),
-            model: None,
+            tracker: TrackerArgs { engine: Some(InferenceEngine::Tract), ..TrackerArgs::default() },
             inference_threads: Some(2),
-            config: None,
             busy_poll: true,
         };
         let arguments: Vec<String> = settings

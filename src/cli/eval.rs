@@ -2,8 +2,8 @@
 //! the metrics on confirmed tracks. The evaluation itself is [`primm_sim::eval::evaluate`]; this
 //! reads the arguments and the data, and prints and writes what it returns.
 
+use super::TrackerArgs;
 use clap::Args as ClapArgs;
-use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_predictor::predictor_for;
 use primm_sim::eval::{
@@ -40,17 +40,9 @@ pub struct Args {
     /// Sequence drawn in the trajectory figure (file stem); the first one by default.
     #[arg(long, value_name = "NAME")]
     pub plot_sequence: Option<String>,
-    /// Tracker configuration (TOML); the built-in defaults otherwise.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// Overrides the configuration's `frame.tracking_frame`: `world` (tracks in the world
-    /// frame when frames carry an ego pose) or `vehicle` (always the vehicle frame).
-    #[arg(long, value_name = "FRAME", value_parser = super::parse_tracking_frame)]
-    pub tracking_frame: Option<TrackingFrame>,
-    /// ONNX model of the learned predictor (default: the model built into primm,
-    /// models/pr.onnx).
-    #[arg(long, value_name = "FILE")]
-    pub model: Option<PathBuf>,
+    /// The tracker's configuration, model, engine and tracking frame.
+    #[command(flatten)]
+    pub tracker: TrackerArgs,
     /// Seed of the measurement removal for the missed-detection rows.
     #[arg(long, default_value_t = DEFAULT_MISS_SEED)]
     pub miss_seed: u64,
@@ -108,13 +100,7 @@ pub enum EvaluateError {
 
 /// Runs `primm eval`.
 pub fn run(args: &Args) -> Result<(), EvaluateError> {
-    let config = super::with_tracking_frame(
-        match &args.config {
-            Some(path) => primm_config::from_file(path)?,
-            None => Config::default(),
-        },
-        args.tracking_frame,
-    );
+    let primm_config::Settings { tracker: config, inference } = args.tracker.load_settings()?;
     let sequences = read_dataset_dir(&args.data)?;
     if sequences.is_empty() {
         return Err(EvaluateError::NoData { dir: args.data.clone() });
@@ -136,9 +122,9 @@ pub fn run(args: &Args) -> Result<(), EvaluateError> {
             .then(|| args.displacement_oracle_noise_m.unwrap_or(0.0)),
         plot_sequence,
     };
-    let engine = config.predictor.engine;
+    let engine = inference.engine;
     let mut predictor = |method: Method| {
-        predictor_for(method, args.model.as_deref(), engine).map_err(|reason| reason.to_string())
+        predictor_for(method, args.tracker.model.as_deref(), engine).map_err(|reason| reason.to_string())
     };
     let evaluation = evaluate(sequences, &config, &settings, &mut predictor, &mut print_progress)?;
 

@@ -12,20 +12,8 @@ pub mod score;
 pub mod serve;
 pub mod soak;
 pub mod track;
+pub mod tracker_args;
 #[cfg(feature = "tunnel")]
 pub mod tunnel;
 
-use primm_core::config::{Config, TrackingFrame};
-
-/// Parses `--tracking-frame`.
-fn parse_tracking_frame(text: &str) -> Result<TrackingFrame, String> {
-    TrackingFrame::from_name(text).ok_or_else(|| format!("`{text}` is neither `world` nor `vehicle`"))
-}
-
-/// `config` with `--tracking-frame` applied, if given.
-fn with_tracking_frame(mut config: Config, tracking_frame: Option<TrackingFrame>) -> Config {
-    if let Some(frame) = tracking_frame {
-        config.frame.tracking_frame = frame;
-    }
-    config
-}
+pub use tracker_args::TrackerArgs;

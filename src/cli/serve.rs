@@ -1,8 +1,9 @@
 //! `primm serve`: the tracker as a shared-memory service.
 
 use super::latency_out::{print_files, LatencyOutArgs};
+use super::TrackerArgs;
 use primm_config::ConfigError;
-use primm_core::config::{Config, InferenceEngine};
+use primm_config::{InferenceConfig, Settings};
 use primm_core::mode::Method;
 use primm_core::predictor::{DisplacementPredictor, NoPredictor};
 use primm_core::tracker::Tracker;
@@ -26,14 +27,10 @@ use std::time::Duration;
     about = "Track frames from primm/measurements and publish primm/tracks and primm/latency over shared memory"
 )]
 pub struct Args {
-    /// Tracker configuration (TOML); the built-in defaults when absent.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// Learned displacement predictor (ONNX) for the methods pr and pr-imm; default: the
-    /// model built into primm (models/pr.onnx). It runs on a dedicated inference thread with the configuration's
-    /// `predictor.deadline_ms`.
-    #[arg(long, value_name = "FILE")]
-    pub model: Option<PathBuf>,
+    /// The tracker's configuration, model (run on dedicated inference threads with the
+    /// configuration's `predictor.deadline_ms`), engine and tracking frame.
+    #[command(flatten)]
+    pub tracker: TrackerArgs,
     /// Tracking method: cv, ca, ct, imm, pr, pr-imm. Overrides the configuration's `imm.modes`.
     #[arg(long, default_value = "imm")]
     pub method: Method,
@@ -51,10 +48,6 @@ pub struct Args {
     /// `predictor.inference_threads`.
     #[arg(long, value_name = "COUNT")]
     pub inference_threads: Option<usize>,
-    /// What runs the PR model: `native` (primm's forward pass where the model allows it) or
-    /// `tract`; overrides the configuration's `predictor.engine`.
-    #[arg(long, value_name = "ENGINE")]
-    pub engine: Option<InferenceEngine>,
     /// The time the published tracks describe: `frame` (the newest frame's time, as the step
     /// left them) or `now` (predicted from the newest frame to the publish time, so that a
     /// consumer gets them at the time they describe; costs one prediction per track after the
@@ -125,26 +118,21 @@ pub enum ServeError {
 
 /// Runs the service until SIGINT or SIGTERM, then prints the counters and the latency table.
 pub fn run(args: Args) -> Result<(), ServeError> {
-    let config = match &args.config {
-        Some(path) => primm_config::from_file(path)?,
-        None => Config::default(),
-    };
-    if let (Some(path), false) = (&args.model, args.method.needs_predictor()) {
+    let mut settings = args.tracker.load_settings()?;
+    if let (Some(path), false) = (&args.tracker.model, args.method.needs_predictor()) {
         return Err(ServeError::ModelWithoutPredictor { path: path.clone(), method: args.method });
     }
-    let mut config = config.with_modes(args.method.modes());
+    settings.tracker = settings.tracker.with_modes(args.method.modes());
     if let Some(threads) = args.inference_threads {
-        config.predictor.inference_threads = threads;
-    }
-    if let Some(engine) = args.engine {
-        config.predictor.engine = engine;
+        settings.inference.inference_threads = threads;
     }
     // Checked before the model and its threads are set up, so a bad value is named, not spawned.
-    config.validate()?;
+    settings.validate()?;
+    let Settings { tracker: config, inference } = settings;
     let realtime = args.realtime.settings();
     let mut report = RealtimeReport::default();
     if args.method.needs_predictor() {
-        let predictor = learned_predictor(args.model.as_deref(), &config, args.method)?;
+        let predictor = learned_predictor(args.tracker.model.as_deref(), &inference, args.method)?;
         for (index, part) in predictor.parts().iter().enumerate() {
             if let Some(thread) = part.inference_thread() {
                 realtime.apply_to_inference_thread(thread, index, &mut report);
@@ -163,20 +151,19 @@ pub fn run(args: Args) -> Result<(), ServeError> {
 /// hand-over allocates nothing from the first frame on.
 fn learned_predictor(
     path: Option<&Path>,
-    config: &Config,
+    inference: &InferenceConfig,
     method: Method,
 ) -> Result<SplitPredictor<ThreadedPredictor>, ServeError> {
-    let model = load_predictor(path, config.predictor.engine)
-        .map_err(|source| ServeError::Model { method, source })?;
-    let deadline = config.predictor.deadline();
+    let model =
+        load_predictor(path, inference.engine).map_err(|source| ServeError::Model { method, source })?;
     tracing::info!(
         model = %model.model().source(),
         engine = ?model.model().engine(),
-        deadline_ms = config.predictor.deadline_ms,
-        inference_threads = config.predictor.inference_threads,
+        deadline_ms = inference.deadline_ms,
+        inference_threads = inference.inference_threads,
         "learned predictor loaded"
     );
-    on_inference_threads(model, config.predictor.inference_threads, deadline)
+    on_inference_threads(model, inference.inference_threads, inference.deadline())
         .map_err(ServeError::InferenceThread)
 }
 

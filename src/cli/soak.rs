@@ -20,10 +20,10 @@
 mod bounds;
 mod scene;
 
+use super::TrackerArgs;
 use bounds::check_bounds;
 use clap::Args as ClapArgs;
 use hdrhistogram::Histogram;
-use primm_core::config::Config;
 use primm_core::invariants::check_tracker;
 use primm_core::limits::MAX_TRACKS;
 use primm_core::mode::Method;
@@ -33,7 +33,6 @@ use primm_predictor::load_predictor;
 use primm_predictor::onnx::ModelError;
 use primm_predictor::split::{on_inference_threads, InferenceThreadsError};
 use scene::SoakScene;
-use std::path::PathBuf;
 use std::time::Instant;
 
 /// Violations printed in full; the rest are only counted.
@@ -57,12 +56,9 @@ pub struct Args {
     /// Seed of the scene.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Tracker configuration (TOML); the built-in defaults otherwise.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// ONNX model of the learned predictor (default: the built-in model).
-    #[arg(long, value_name = "FILE")]
-    pub model: Option<PathBuf>,
+    /// The tracker's configuration, model, engine and tracking frame.
+    #[command(flatten)]
+    pub tracker: TrackerArgs,
     /// Run the learned predictor on the inference threads with the configuration's deadline
     /// and `predictor.inference_threads` (as `primm serve`) instead of synchronously.
     #[arg(long)]
@@ -110,18 +106,15 @@ struct SoakOutcome {
 
 /// Runs the soak and prints its report; fails when any violation was found.
 pub fn run(args: &Args) -> Result<(), SoakError> {
-    let config = match &args.config {
-        Some(path) => primm_config::from_file(path)?,
-        None => Config::default(),
-    };
-    let config = config.with_modes(args.method.modes());
+    let settings = args.tracker.load_settings()?;
+    let config = settings.tracker.with_modes(args.method.modes());
     if !args.method.needs_predictor() {
         return soak(Tracker::new(config)?, args);
     }
-    let model = load_predictor(args.model.as_deref(), config.predictor.engine)?;
+    let model = load_predictor(args.tracker.model.as_deref(), settings.inference.engine)?;
     if args.inference_thread {
-        let deadline = config.predictor.deadline();
-        let threads = config.predictor.inference_threads;
+        let deadline = settings.inference.deadline();
+        let threads = settings.inference.inference_threads;
         let predictor = on_inference_threads(model, threads, deadline).map_err(SoakError::InferenceThread)?;
         soak(Tracker::with_predictor(config, predictor)?, args)
     } else {

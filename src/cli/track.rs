@@ -1,7 +1,7 @@
 //! `primm track`: offline tracking of a measurement CSV file into a track CSV file.
 
+use super::TrackerArgs;
 use clap::Args as ClapArgs;
-use primm_core::config::{Config, TrackingFrame};
 use primm_core::mode::Method;
 use primm_core::tracker::{StepError, Tracker};
 use primm_core::validation::FrameError;
@@ -25,17 +25,9 @@ pub struct Args {
     /// Method: cv, ca, ct, pr, imm or pr-imm.
     #[arg(long, default_value = "pr-imm")]
     pub method: Method,
-    /// Tracker configuration (TOML); the built-in defaults otherwise.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// Overrides the configuration's `frame.tracking_frame`: `world` (tracks in the world
-    /// frame when frames carry an ego pose) or `vehicle` (always the vehicle frame).
-    #[arg(long, value_name = "FRAME", value_parser = super::parse_tracking_frame)]
-    pub tracking_frame: Option<TrackingFrame>,
-    /// ONNX model of the learned predictor (default: the model built into primm,
-    /// models/pr.onnx).
-    #[arg(long, value_name = "FILE")]
-    pub model: Option<PathBuf>,
+    /// The tracker's configuration, model, engine and tracking frame.
+    #[command(flatten)]
+    pub tracker: TrackerArgs,
     /// Also write the association CSV (which track took each measurement; scored by
     /// `primm score`).
     #[arg(long, value_name = "FILE")]
@@ -101,15 +93,9 @@ fn create(path: &Path) -> Result<std::fs::File, TrackError> {
 
 /// Runs `primm track`.
 pub fn run(args: &Args) -> Result<(), TrackError> {
-    let config = super::with_tracking_frame(
-        match &args.config {
-            Some(path) => primm_config::from_file(path)?,
-            None => Config::default(),
-        },
-        args.tracking_frame,
-    )
-    .with_modes(args.method.modes());
-    let predictor = predictor_for(args.method, args.model.as_deref(), config.predictor.engine)?;
+    let settings = args.tracker.load_settings()?;
+    let config = settings.tracker.with_modes(args.method.modes());
+    let predictor = predictor_for(args.method, args.tracker.model.as_deref(), settings.inference.engine)?;
     let mut tracker = Tracker::with_predictor(config, predictor)?;
     let sequence = read_sequence_file(&args.input)?;
     let file = create(&args.output)?;

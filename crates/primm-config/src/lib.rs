@@ -1,11 +1,13 @@
 //! # primm-config: the tracker configuration as a TOML file
 //!
 //! `primm-core` keeps its [`Config`] a plain, validated value so that it needs no parser. This
-//! crate reads the TOML form of it: [`from_toml_str`] and [`from_file`] parse, reject unknown
-//! keys and values of the wrong type, then run [`Config::validate`], whose error names the
-//! offending key. [`DEFAULT_CONFIG_TOML`] is the documented default file,
-//! `config/primm.toml`, embedded; a test checks that it parses to exactly
-//! [`Config::default`].
+//! crate reads the TOML form of it: [`settings_from_toml_str`] and [`settings_from_file`] parse,
+//! reject unknown keys and values of the wrong type, then validate, with an error that names
+//! the offending key. A file also says how the learned model runs ([`InferenceConfig`]: engine,
+//! inference threads, deadline), which the tracker never reads; [`Settings`] holds both, and
+//! [`from_toml_str`] and [`from_file`] return the tracker's part alone.
+//! [`DEFAULT_CONFIG_TOML`] is the documented default file, `config/primm.toml`, embedded; a
+//! test checks that it parses to exactly [`Settings::default`].
 //!
 //! ```
 //! let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 8.4", "gate_m = 4.5");
@@ -17,11 +19,39 @@
 //! # Ok::<(), primm_config::ConfigError>(())
 //! ```
 
+mod file;
+mod inference;
+
+pub use inference::{InferenceConfig, InferenceEngine, UnknownEngine, MAX_INFERENCE_THREADS};
 use primm_core::config::Config;
 use std::path::Path;
 
 /// The default configuration file (`config/primm.toml`), embedded.
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../../config/primm.toml");
+
+/// Everything a configuration file sets: the tracker's configuration and how the learned model
+/// runs (which the tracker never reads).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Settings {
+    /// The tracker's configuration.
+    pub tracker: Config,
+    /// The learned model's engine, inference threads and deadline.
+    pub inference: InferenceConfig,
+}
+
+impl Settings {
+    /// Checks every value; the error names the first offending key.
+    pub fn validate(&self) -> Result<(), primm_core::config::ConfigError> {
+        self.tracker.validate()?;
+        self.inference.validate()
+    }
+
+    /// This configuration as a TOML document that [`settings_from_toml_str`] reads back
+    /// unchanged.
+    pub fn to_toml_string(&self) -> Result<String, toml::ser::Error> {
+        toml::to_string(&file::FileLayout::from(self))
+    }
+}
 
 /// A configuration that could not be read, parsed or validated.
 #[derive(Debug, thiserror::Error)]
@@ -42,23 +72,35 @@ pub enum ConfigError {
     Invalid(#[from] primm_core::config::ConfigError),
 }
 
-/// Parses and validates a TOML document.
-pub fn from_toml_str(text: &str) -> Result<Config, ConfigError> {
-    let config: Config = toml::from_str(text)?;
-    config.validate()?;
-    Ok(config)
+/// Parses and validates a whole TOML document.
+pub fn settings_from_toml_str(text: &str) -> Result<Settings, ConfigError> {
+    let settings = Settings::from(toml::from_str::<file::FileLayout>(text)?);
+    settings.validate()?;
+    Ok(settings)
 }
 
-/// Reads, parses and validates a TOML file.
-pub fn from_file(path: &Path) -> Result<Config, ConfigError> {
+/// Reads, parses and validates a whole TOML file.
+pub fn settings_from_file(path: &Path) -> Result<Settings, ConfigError> {
     let text = std::fs::read_to_string(path)
         .map_err(|source| ConfigError::Io { path: path.display().to_string(), source })?;
-    from_toml_str(&text)
+    settings_from_toml_str(&text)
 }
 
-/// Writes a configuration as a TOML document that [`from_toml_str`] reads back unchanged.
+/// Parses and validates a TOML document; the tracker's part of it (the inference keys are
+/// checked too).
+pub fn from_toml_str(text: &str) -> Result<Config, ConfigError> {
+    settings_from_toml_str(text).map(|settings| settings.tracker)
+}
+
+/// Reads, parses and validates a TOML file; the tracker's part of it.
+pub fn from_file(path: &Path) -> Result<Config, ConfigError> {
+    settings_from_file(path).map(|settings| settings.tracker)
+}
+
+/// Writes a tracker configuration, with the default inference keys, as a TOML document that
+/// [`from_toml_str`] reads back unchanged.
 pub fn to_toml_string(config: &Config) -> Result<String, toml::ser::Error> {
-    toml::to_string(config)
+    Settings { tracker: config.clone(), inference: InferenceConfig::default() }.to_toml_string()
 }
 
 #[cfg(test)]
@@ -75,6 +117,7 @@ mod tests {
 
     #[test]
     fn the_embedded_file_parses_to_exactly_the_core_defaults() {
+        assert_eq!(settings_from_toml_str(DEFAULT_CONFIG_TOML).unwrap(), Settings::default());
         assert_eq!(from_toml_str(DEFAULT_CONFIG_TOML).unwrap(), Config::default());
     }
 
@@ -121,11 +164,34 @@ mod tests {
         let start = DEFAULT_CONFIG_TOML.find("[predictor]").unwrap();
         let end = DEFAULT_CONFIG_TOML.find("[classes.car]").unwrap();
         let without = format!("{}{}", &DEFAULT_CONFIG_TOML[..start], &DEFAULT_CONFIG_TOML[end..]);
-        assert_eq!(from_toml_str(&without).unwrap().predictor, PredictorConfig::default());
+        assert_eq!(settings_from_toml_str(&without).unwrap(), Settings::default());
         for bad in ["0.0", "-1.0", "nan", "5000.0"] {
             let text = DEFAULT_CONFIG_TOML.replace("deadline_ms = 5.0", &format!("deadline_ms = {bad}"));
             assert_eq!(invalid_key(&text), "predictor.deadline_ms", "deadline {bad}");
         }
+    }
+
+    #[test]
+    fn the_inference_keys_are_read_beside_the_tracker_s_and_survive_a_round_trip() {
+        let text = DEFAULT_CONFIG_TOML
+            .replace("engine = \"native\"", "engine = \"tract\"")
+            .replace("inference_threads = 2", "inference_threads = 3");
+        let settings = settings_from_toml_str(&text).unwrap();
+        assert_eq!(settings.inference.engine, InferenceEngine::Tract);
+        assert_eq!(settings.inference.inference_threads, 3);
+        assert_eq!(settings.tracker, Config::default());
+        let again = settings_from_toml_str(&settings.to_toml_string().unwrap()).unwrap();
+        assert_eq!(again, settings);
+        let bad = DEFAULT_CONFIG_TOML.replace("inference_threads = 2", "inference_threads = 0");
+        assert_eq!(invalid_key(&bad), "predictor.inference_threads");
+    }
+
+    #[test]
+    fn an_error_in_the_file_names_its_line() {
+        let text = DEFAULT_CONFIG_TOML.replace("engine = \"native\"", "engine = \"onnxruntime\"");
+        let line = DEFAULT_CONFIG_TOML.lines().position(|line| line.starts_with("engine = ")).unwrap() + 1;
+        let error = from_toml_str(&text).unwrap_err().to_string();
+        assert!(error.contains(&format!("line {line}")), "{error}");
     }
 
     #[test]

@@ -8,7 +8,7 @@ use crate::types::{
 };
 use core::ffi::{c_char, CStr};
 use core::fmt;
-use primm_core::config::Config;
+use primm_config::Settings;
 use primm_core::measurement::{FrameView, Measurement, UnknownClass};
 use primm_core::mode::Mode;
 use primm_core::pose::EgoPose;
@@ -55,12 +55,12 @@ impl PrimmTracker {
     /// # Safety
     /// The pointers in `options` are NULL or valid as documented on [`PrimmTrackerOptions`].
     unsafe fn new(options: &PrimmTrackerOptions) -> Result<Box<Self>, Failure> {
-        let config = if options.config_toml.is_null() {
-            Config::default()
+        let Settings { tracker: config, inference } = if options.config_toml.is_null() {
+            Settings::default()
         } else {
             // SAFETY: the caller passes a NUL-terminated string.
             let text = unsafe { CStr::from_ptr(options.config_toml) };
-            primm_config::from_toml_str(text.to_str().map_err(Failure::ConfigNotUtf8)?)
+            primm_config::settings_from_toml_str(text.to_str().map_err(Failure::ConfigNotUtf8)?)
                 .map_err(Failure::Config)?
         };
         let config = match method_from_code(options.method).map_err(Failure::UnknownMethod)? {
@@ -86,15 +86,11 @@ impl PrimmTracker {
                 None if options.use_builtin_model => OnnxPredictor::embedded().map_err(Failure::Model)?,
                 None => return Err(Failure::ModelRequired),
             };
-            onnx.set_engine(config.predictor.engine);
+            onnx.set_engine(inference.engine);
             if options.inference_thread {
                 Box::new(
-                    on_inference_threads(
-                        onnx,
-                        config.predictor.inference_threads,
-                        config.predictor.deadline(),
-                    )
-                    .map_err(Failure::InferenceThread)?,
+                    on_inference_threads(onnx, inference.inference_threads, inference.deadline())
+                        .map_err(Failure::InferenceThread)?,
                 )
             } else {
                 Box::new(onnx)

@@ -137,7 +137,7 @@ fn primm_track_imm(input: &Path) -> String {
     let config = Config::default().with_modes(method.modes());
     let mut tracker = Tracker::with_predictor(
         config,
-        predictor_for(method, None, Config::default().predictor.engine).unwrap(),
+        predictor_for(method, None, primm_config::InferenceEngine::default()).unwrap(),
     )
     .unwrap();
     let sequence = read_sequence_file(input).unwrap();

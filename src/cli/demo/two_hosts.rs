@@ -50,35 +50,7 @@ pub(super) fn run(args: Args) -> Result<(), DemoError> {
     let tracks_b = catalog::tracks(&node_b, &names)?;
     wait_for_ports(&tracks_a, &tracks_b, &mut tracker, &mut subscriber)?;
 
-    let (ready_a, ready_b) = (file("tunnel-a.ready"), file("tunnel-b.ready"));
-    let listening_a = file("tunnel-a.listening");
-    let _ = std::fs::remove_file(&listening_a);
-    // Port 0: the operating system picks a free port for host A's tunnel, which names it in
-    // its listening file; host B connects there (no port is chosen here, so none can be taken
-    // by someone else in between).
-    let listening_option = listening_a.to_string_lossy().into_owned();
-    let mut tunnel_a = spawn_tunnel(
-        &exe,
-        &prefix,
-        &domain_a,
-        &["--listen", "tcp/127.0.0.1:0", "--listening-file", &listening_option],
-        &ready_a,
-        "the tunnel of host A",
-        file("tunnel-a.log"),
-    )?;
-    let listen = wait_for_listening(&mut tunnel_a, &listening_a)?;
-    println!("  host A's tunnel listens on {listen}");
-    let mut tunnel_b = spawn_tunnel(
-        &exe,
-        &prefix,
-        &domain_b,
-        &["--connect", &listen],
-        &ready_b,
-        "the tunnel of host B",
-        file("tunnel-b.log"),
-    )?;
-    wait_for_tunnels([(&mut tunnel_a, &ready_a), (&mut tunnel_b, &ready_b)])?;
-    std::thread::sleep(SETTLE);
+    let (tunnel_a, tunnel_b) = start_tunnels(&exe, &prefix, [&domain_a, &domain_b], &file)?;
 
     let publisher = spawn_publisher(&exe, &prefix, Some(&domain_a), &args, file("publisher.log"))?;
     let replay_s = args.duration_s / args.speed.max(1e-3);
@@ -112,6 +84,47 @@ pub(super) fn run(args: Args) -> Result<(), DemoError> {
     super::print_latency_files(&args);
     println!("demo finished: every frame tracked on host A and answered on host B through the tunnel");
     Ok(())
+}
+
+/// Starts host A's tunnel listening on a port the operating system picks, then host B's
+/// connecting to it; returns once both have a peer and zenoh had [`SETTLE`] to exchange the
+/// subscriptions.
+fn start_tunnels(
+    exe: &Path,
+    prefix: &str,
+    [domain_a, domain_b]: [&str; 2],
+    file: &dyn Fn(&str) -> PathBuf,
+) -> Result<(Managed, Managed), DemoError> {
+    let (ready_a, ready_b) = (file("tunnel-a.ready"), file("tunnel-b.ready"));
+    let listening_a = file("tunnel-a.listening");
+    let _ = std::fs::remove_file(&listening_a);
+    // Port 0: the operating system picks a free port for host A's tunnel, which names it in
+    // its listening file; host B connects there (no port is chosen here, so none can be taken
+    // by someone else in between).
+    let listening_option = listening_a.to_string_lossy().into_owned();
+    let mut tunnel_a = spawn_tunnel(
+        exe,
+        prefix,
+        domain_a,
+        &["--listen", "tcp/127.0.0.1:0", "--listening-file", &listening_option],
+        &ready_a,
+        "the tunnel of host A",
+        file("tunnel-a.log"),
+    )?;
+    let listen = wait_for_listening(&mut tunnel_a, &listening_a)?;
+    println!("  host A's tunnel listens on {listen}");
+    let mut tunnel_b = spawn_tunnel(
+        exe,
+        prefix,
+        domain_b,
+        &["--connect", &listen],
+        &ready_b,
+        "the tunnel of host B",
+        file("tunnel-b.log"),
+    )?;
+    wait_for_tunnels([(&mut tunnel_a, &ready_a), (&mut tunnel_b, &ready_b)])?;
+    std::thread::sleep(SETTLE);
+    Ok((tunnel_a, tunnel_b))
 }
 
 /// Waits up to [`READY_TIMEOUT`] until `tunnel` has written its listening file, and returns

@@ -19,7 +19,7 @@ impl Default for Config {
             tracker: tracker(),
             classes: ClassTable { car: car(), pedestrian: pedestrian(), two_wheeler: two_wheeler() },
             predictor: PredictorConfig::default(),
-            frame: FrameConfig::default(),
+            frame: CoordinatesConfig::default(),
         }
     }
 }

@@ -18,11 +18,11 @@ pub use predictor::*;
 pub use sections::*;
 use validation::*;
 
+pub use crate::coordinates::{CoordinateFrame, CoordinatesConfig};
 pub use crate::existence::{ExistenceConfig, Lifecycle};
 pub use crate::extent::ExtentConfig;
 use crate::measurement::{ClassSet, ObjectClass};
 use crate::mode::{ModeSet, MODE_COUNT};
-pub use crate::tracking_frame::{FrameConfig, TrackingFrame};
 use alloc::string::String;
 use nalgebra::Matrix2;
 
@@ -42,12 +42,12 @@ pub struct Config {
     pub tracker: TrackerConfig,
     /// Per-class parameters.
     pub classes: ClassTable,
-    /// How the service runs the learned predictor (absent: the defaults).
+    /// The tracker's use of the learned predictor (absent: the defaults).
     #[cfg_attr(feature = "serde", serde(default))]
     pub predictor: PredictorConfig,
     /// The tracking frame and the sensors' mounting poses (absent: the defaults).
     #[cfg_attr(feature = "serde", serde(default))]
-    pub frame: FrameConfig,
+    pub frame: CoordinatesConfig,
 }
 
 /// An invalid configuration value.

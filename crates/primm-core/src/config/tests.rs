@@ -96,35 +96,6 @@ fn an_empty_mode_set_is_rejected() {
 }
 
 #[test]
-fn engine_names_parse_and_another_name_is_refused_with_it() {
-    assert_eq!("native".parse::<InferenceEngine>(), Ok(InferenceEngine::Native));
-    assert_eq!("tract".parse::<InferenceEngine>(), Ok(InferenceEngine::Tract));
-    assert_eq!("onnx".parse::<InferenceEngine>(), Err(UnknownEngine { text: "onnx".into() }));
-}
-
-#[test]
-fn no_or_too_many_inference_threads_are_rejected() {
-    for bad in [0, MAX_INFERENCE_THREADS + 1, usize::MAX] {
-        let mut config = Config::default();
-        config.predictor.inference_threads = bad;
-        assert_eq!(invalid_key(&config), "predictor.inference_threads", "threads {bad}");
-    }
-    let mut config = Config::default();
-    config.predictor.inference_threads = MAX_INFERENCE_THREADS;
-    assert!(config.validate().is_ok());
-}
-
-#[test]
-fn a_non_positive_or_huge_predictor_deadline_is_rejected() {
-    for bad in [0.0, -1.0, f64::NAN, 5000.0] {
-        let mut config = Config::default();
-        config.predictor.deadline_ms = bad;
-        assert_eq!(invalid_key(&config), "predictor.deadline_ms", "deadline {bad}");
-    }
-    assert_eq!(Config::default().predictor.deadline(), core::time::Duration::from_millis(5));
-}
-
-#[test]
 fn a_non_positive_or_non_finite_displacement_speed_bound_is_rejected() {
     for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         let mut config = Config::default();

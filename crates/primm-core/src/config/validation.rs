@@ -145,22 +145,14 @@ pub(super) fn validate_association(association: &AssociationConfig) -> Result<()
     Ok(())
 }
 
-/// The `tracker` and `predictor` sections; the deadline is checked between the frame interval
-/// and the coast times, so that the first offending key named stays what it was.
+/// The `tracker` and `predictor` sections.
 pub(super) fn validate_tracker_and_predictor(
     tracker: &TrackerConfig,
     predictor: &PredictorConfig,
 ) -> Result<(), ConfigError> {
     positive("tracker.max_frame_interval_s", tracker.max_frame_interval_s)?;
-    positive("predictor.deadline_ms", predictor.deadline_ms)?;
-    if predictor.deadline_ms > 1000.0 {
-        return Err(invalid("predictor.deadline_ms", "must be at most 1000 ms (one second)"));
-    }
     positive("predictor.max_displacement_speed_mps", predictor.max_displacement_speed_mps)?;
     positive("predictor.learned_process_noise_scale", predictor.learned_process_noise_scale)?;
-    if !(1..=MAX_INFERENCE_THREADS).contains(&predictor.inference_threads) {
-        return Err(invalid("predictor.inference_threads", "must be from 1 to 8"));
-    }
     positive("tracker.max_coast_s", tracker.max_coast_s)?;
     positive("tracker.tentative_max_coast_s", tracker.tentative_max_coast_s)?;
     if tracker.confirmation_hits == 0 {

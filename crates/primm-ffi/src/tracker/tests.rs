@@ -7,6 +7,7 @@ use crate::types::{
     PRIMM_NO_SENSOR_ID, PRIMM_OBJECT_CLASS_CAR, PRIMM_OBJECT_CLASS_PEDESTRIAN, PRIMM_TRACK_STATUS_CONFIRMED,
 };
 use core::ptr::{null, null_mut};
+use primm_core::config::Config;
 use primm_core::measurement::{Frame, ObjectClass};
 use std::ffi::CString;
 
@@ -548,7 +549,7 @@ fn pr_imm_through_the_c_api_equals_the_core_tracker_with_the_built_in_model_and_
     let frames = scenario_frames(1.5);
     let config = Config::default().with_modes(primm_core::mode::Method::PrImm.modes());
     let mut predictor = OnnxPredictor::embedded().unwrap();
-    predictor.set_engine(config.predictor.engine);
+    predictor.set_engine(primm_config::InferenceConfig::default().engine);
     let mut core = Tracker::with_predictor(config, predictor).unwrap();
 
     let built_in = create(&PrimmTrackerOptions {
