@@ -39,7 +39,7 @@ fn flooded(frame: &Frame, rng: &mut ChaCha8Rng) -> Frame {
 fn a_flood_of_false_detections_loses_no_confirmed_track_and_allocates_nothing() {
     // The lane objects are measured at their centres: point objects.
     let mut config = Config::default().with_modes(Method::Imm.modes()).with_point_objects();
-    config.frame.tracking_frame = primm_core::config::TrackingFrame::Vehicle;
+    config.frame.tracking_frame = primm_core::config::CoordinateFrame::Vehicle;
     let mut tracker = Tracker::new(config).unwrap();
     let mut frames = common::scene_frames(&common::lanes(16), 160, 0.04, 0.2, 5);
     for frame in &mut frames {

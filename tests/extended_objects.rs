@@ -47,7 +47,7 @@ fn frames(count: usize, seed: u64) -> Vec<(Frame, Vec<DVec2>)> {
             let t = k as f64 * DT_S;
             let pose = ego_pose(t);
             let sensor = k % 4;
-            let sensor_world = pose.car_to_world(MOUNTS_M[sensor]);
+            let sensor_world = pose.point_to_world(MOUNTS_M[sensor]);
             let mut frame = Frame::new(t);
             frame.ego_pose = Some(pose);
             let mut centres = Vec::new();

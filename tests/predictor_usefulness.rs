@@ -23,7 +23,7 @@ fn objects(sequence: &Sequence) -> BTreeMap<u64, Vec<(HistoryEntry, DVec2, Objec
                 continue;
             };
             let m = &recorded.measurement;
-            let position = pose.car_to_world(m.position());
+            let position = pose.point_to_world(m.position());
             objects.entry(id).or_default().push((
                 HistoryEntry {
                     x_m: position.x,
@@ -32,7 +32,7 @@ fn objects(sequence: &Sequence) -> BTreeMap<u64, Vec<(HistoryEntry, DVec2, Objec
                     rcs_dbsm: m.rcs_dbsm,
                     timestamp_s: frame.timestamp_s,
                 },
-                pose.car_to_world(truth),
+                pose.point_to_world(truth),
                 m.class,
             ));
         }

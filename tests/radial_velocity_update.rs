@@ -45,7 +45,7 @@ fn frames(count: usize, sensor_id: Option<u16>, seed: u64) -> Vec<(Frame, Vec<DV
         .map(|k| {
             let t = k as f64 * DT_S;
             let pose = ego_pose(t);
-            let sensor_world = pose.car_to_world(SENSOR_3_M);
+            let sensor_world = pose.point_to_world(SENSOR_3_M);
             let mut frame = Frame::new(t);
             frame.ego_pose = Some(pose);
             let mut velocities = Vec::new();

@@ -2,7 +2,7 @@
 //! ego vehicle, poses that come and go, bad poses, sensor mounts.
 
 use glam::DVec2;
-use primm_core::config::{Config, TrackingFrame};
+use primm_core::config::{Config, CoordinateFrame};
 use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::pose::EgoPose;
@@ -12,7 +12,7 @@ use primm_core::validation::FrameError;
 
 const DT_S: f64 = 0.05;
 
-fn config(tracking_frame: TrackingFrame) -> Config {
+fn config(tracking_frame: CoordinateFrame) -> Config {
     // The scene measures its objects' centres: point objects.
     let mut config = Config::default().with_modes(Method::Imm.modes()).with_point_objects();
     config.frame.tracking_frame = tracking_frame;
@@ -37,7 +37,7 @@ fn frame(t: f64, objects: &[(DVec2, DVec2)], with_pose: bool) -> Frame {
     let pose = ego_pose(t);
     let mut frame = Frame::new(t);
     frame.ego_pose = with_pose.then_some(pose);
-    let sensor_world = pose.car_to_world(DVec2::new(3.86, 0.70));
+    let sensor_world = pose.point_to_world(DVec2::new(3.86, 0.70));
     for (index, &(position, velocity)) in objects.iter().enumerate() {
         let vehicle = pose.world_to_car(position);
         let line_of_sight = (position - sensor_world).normalize();
@@ -72,7 +72,7 @@ fn run(tracker: &mut Tracker, frames: impl Iterator<Item = Frame>) -> Vec<TrackO
 
 #[test]
 fn a_parked_car_seen_from_a_turning_ego_stands_still_in_the_world_frame() {
-    let mut tracker = Tracker::new(config(TrackingFrame::World)).unwrap();
+    let mut tracker = Tracker::new(config(CoordinateFrame::World)).unwrap();
     let outputs = run(&mut tracker, (0..60).map(|k| frame(k as f64 * DT_S, &objects(k as f64 * DT_S), true)));
     assert_eq!(outputs.len(), 2, "{outputs:?}");
     let t = 59.0 * DT_S;
@@ -112,8 +112,8 @@ fn the_world_frame_follows_a_turning_scene_better_than_the_vehicle_frame() {
         }
         total / count as f64
     };
-    let world = prior_error(TrackingFrame::World);
-    let vehicle = prior_error(TrackingFrame::Vehicle);
+    let world = prior_error(CoordinateFrame::World);
+    let vehicle = prior_error(CoordinateFrame::Vehicle);
     assert!(world < 0.5 * vehicle, "prior error world {world} m vs vehicle {vehicle} m");
 }
 
@@ -121,8 +121,8 @@ fn the_world_frame_follows_a_turning_scene_better_than_the_vehicle_frame() {
 fn without_poses_the_world_setting_tracks_exactly_as_the_vehicle_frame() {
     let frames: Vec<Frame> =
         (0..40).map(|k| frame(k as f64 * DT_S, &objects(k as f64 * DT_S), false)).collect();
-    let mut world = Tracker::new(config(TrackingFrame::World)).unwrap();
-    let mut vehicle = Tracker::new(config(TrackingFrame::Vehicle)).unwrap();
+    let mut world = Tracker::new(config(CoordinateFrame::World)).unwrap();
+    let mut vehicle = Tracker::new(config(CoordinateFrame::Vehicle)).unwrap();
     for frame in &frames {
         assert_eq!(world.step(frame).unwrap(), vehicle.step(frame).unwrap());
     }
@@ -132,7 +132,7 @@ fn without_poses_the_world_setting_tracks_exactly_as_the_vehicle_frame() {
 
 #[test]
 fn tracks_survive_a_stream_that_stops_and_resumes_sending_poses() {
-    let mut tracker = Tracker::new(config(TrackingFrame::World)).unwrap();
+    let mut tracker = Tracker::new(config(CoordinateFrame::World)).unwrap();
     let with_pose = |k: usize| !(30..45).contains(&k);
     let mut ids = Vec::new();
     let mut errors = [0.0f64; 70];
@@ -164,7 +164,7 @@ fn tracks_survive_a_stream_that_stops_and_resumes_sending_poses() {
 
 #[test]
 fn a_frame_with_a_broken_pose_is_rejected_and_changes_no_track() {
-    let mut tracker = Tracker::new(config(TrackingFrame::World)).unwrap();
+    let mut tracker = Tracker::new(config(CoordinateFrame::World)).unwrap();
     run(&mut tracker, (0..10).map(|k| frame(k as f64 * DT_S, &objects(k as f64 * DT_S), true)));
     let before = tracker.tracks().to_vec();
     for broken in [
@@ -188,18 +188,18 @@ fn a_frame_with_a_broken_pose_is_rejected_and_changes_no_track() {
 
 #[test]
 fn a_sensor_without_a_mount_is_seen_from_the_reference_point_and_counted() {
-    let mut tracker = Tracker::new(config(TrackingFrame::World)).unwrap();
+    let mut tracker = Tracker::new(config(CoordinateFrame::World)).unwrap();
     let mut first = frame(0.0, &objects(0.0), true);
     first.measurements[0].sensor_id = Some(99);
     first.measurements[1].sensor_id = None;
     tracker.step(&first).unwrap();
     assert_eq!(tracker.stats().initiations_from_unknown_sensor, 2);
     // With the mount, the initial velocity lies along the line of sight from the sensor.
-    let mut tracker = Tracker::new(config(TrackingFrame::World)).unwrap();
+    let mut tracker = Tracker::new(config(CoordinateFrame::World)).unwrap();
     let outputs = tracker.step(&frame(0.0, &objects(0.0), true)).unwrap();
     let crossing = outputs.iter().find(|o| o.ground_truth_id == Some(1)).unwrap();
     let pose = ego_pose(0.0);
-    let sensor = pose.car_to_world(DVec2::new(3.86, 0.70));
+    let sensor = pose.point_to_world(DVec2::new(3.86, 0.70));
     let line_of_sight = (objects(0.0)[1].0 - sensor).normalize();
     let velocity = crossing.world_velocity_mps.unwrap();
     assert!(velocity.perp_dot(line_of_sight).abs() < 1e-6, "{velocity} not along {line_of_sight}");

@@ -6,9 +6,16 @@
 //! velocities over ground. Tracking in the vehicle frame therefore starts a parked car ahead of
 //! a moving ego with the wrong velocity and sees stationary objects sweep arcs while the ego
 //! turns. When a frame carries the ego pose ([`FrameView::ego_pose`]) and the configuration
-//! asks for [`TrackingFrame::World`], the tracker maps every measurement into the world
+//! asks for [`CoordinateFrame::World`], the tracker maps every measurement into the world
 //! (odometry) frame with that pose and keeps its tracks there; the line of sight of a radial
 //! velocity then starts at the world position of the sensor that measured it.
+//!
+//! Naming: in primm a *frame* alone is a time sample (`Frame`, `FrameView`, the wire's
+//! `MeasurementFrame` and `TrackFrame`). A coordinate frame is always called one
+//! ([`CoordinateFrame`], [`CoordinatesConfig`]); poses map points with
+//! [`EgoPose::point_to_world`](crate::pose::EgoPose::point_to_world) and give whole transforms
+//! with [`EgoPose::vehicle_to_world`](crate::pose::EgoPose::vehicle_to_world). The
+//! configuration keys keep their names (`frame.tracking_frame`, `frame.sensors`).
 //!
 //! [`FrameView::ego_pose`]: crate::measurement::FrameView::ego_pose
 
@@ -23,7 +30,7 @@ pub const MAX_MOUNT_DISTANCE_M: f64 = 100.0;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-pub enum TrackingFrame {
+pub enum CoordinateFrame {
     /// The world (odometry) frame of the frames' ego poses; frames without a pose are tracked
     /// in the vehicle frame (see the tracker's documentation for a stream that switches).
     #[default]
@@ -33,18 +40,18 @@ pub enum TrackingFrame {
     Vehicle,
 }
 
-impl TrackingFrame {
+impl CoordinateFrame {
     /// The short name used in configuration and output (`world`, `vehicle`).
     pub fn name(self) -> &'static str {
         match self {
-            TrackingFrame::World => "world",
-            TrackingFrame::Vehicle => "vehicle",
+            CoordinateFrame::World => "world",
+            CoordinateFrame::Vehicle => "vehicle",
         }
     }
 
     /// Parses the short name; `None` for anything else.
     pub fn from_name(name: &str) -> Option<Self> {
-        [TrackingFrame::World, TrackingFrame::Vehicle].into_iter().find(|frame| frame.name() == name)
+        [CoordinateFrame::World, CoordinateFrame::Vehicle].into_iter().find(|frame| frame.name() == name)
     }
 }
 
@@ -52,15 +59,15 @@ impl TrackingFrame {
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
-pub struct FrameConfig {
+pub struct CoordinatesConfig {
     /// The frame the tracks are kept in when frames carry an ego pose.
-    pub tracking_frame: TrackingFrame,
+    pub tracking_frame: CoordinateFrame,
     /// Mounting pose of every sensor, by sensor id. A measurement of a sensor not listed here
     /// (or without a sensor id) is seen from the vehicle's reference point, and counted.
     pub sensors: ArrayVec<SensorMount, MAX_SENSORS>,
 }
 
-impl Default for FrameConfig {
+impl Default for CoordinatesConfig {
     /// World frame; RadarScenes' four front and side radars (ids 1–4), as the scenario
     /// generator mounts them.
     fn default() -> Self {
@@ -80,11 +87,11 @@ impl Default for FrameConfig {
         sensors.push(mount(2, 3.86, -0.70, -25.0));
         sensors.push(mount(3, 3.86, 0.70, 25.0));
         sensors.push(mount(4, 3.66, 0.87, 85.0));
-        FrameConfig { tracking_frame: TrackingFrame::World, sensors }
+        CoordinatesConfig { tracking_frame: CoordinateFrame::World, sensors }
     }
 }
 
-impl FrameConfig {
+impl CoordinatesConfig {
     /// The mount of sensor `id`, if configured.
     pub fn sensor(&self, id: u16) -> Option<&SensorMount> {
         self.sensors.iter().find(|mount| mount.id == id)
@@ -131,7 +138,7 @@ mod tests {
 
     #[test]
     fn the_default_mounts_are_valid_and_found_by_id() {
-        let config = FrameConfig::default();
+        let config = CoordinatesConfig::default();
         assert_eq!(config.problem(), None);
         assert_eq!(config.sensor(3).map(|mount| mount.y_m), Some(0.70));
         assert_eq!(config.sensor(0), None);
@@ -139,13 +146,13 @@ mod tests {
 
     #[test]
     fn duplicate_ids_and_non_finite_mounts_are_problems() {
-        let mut config = FrameConfig::default();
+        let mut config = CoordinatesConfig::default();
         config.sensors[1].id = 1;
         assert_eq!(config.problem().map(|p| p.1), Some("sensor ids must be unique"));
-        let mut config = FrameConfig::default();
+        let mut config = CoordinatesConfig::default();
         config.sensors[0].yaw_rad = f64::NAN;
         assert!(config.problem().is_some());
-        let mut config = FrameConfig::default();
+        let mut config = CoordinatesConfig::default();
         config.sensors[0].x_m = 1e3;
         assert!(config.problem().is_some());
     }

@@ -159,7 +159,7 @@ impl FieldOfView {
     pub fn of(mount: &SensorMount, pose: Option<EgoPose>) -> Self {
         let (sin, cos) = math::sin_cos(mount.yaw_rad + pose.map_or(0.0, |pose| pose.yaw_rad));
         let origin_m = match pose {
-            Some(pose) => pose.car_to_world(mount.position()),
+            Some(pose) => pose.point_to_world(mount.position()),
             None => mount.position(),
         };
         let half_angle = mount.half_fov_rad.clamp(0.0, core::f64::consts::PI);
@@ -256,7 +256,7 @@ mod tests {
         // A turned ego turns the field of view with it.
         let pose = EgoPose { x_m: 100.0, y_m: -20.0, yaw_rad: core::f64::consts::FRAC_PI_2 };
         let turned = FieldOfView::of(&mount(0.0), Some(pose));
-        assert!(turned.contains(pose.car_to_world(DVec2::new(40.0, 0.0))));
+        assert!(turned.contains(pose.point_to_world(DVec2::new(40.0, 0.0))));
         assert!(!turned.contains(DVec2::new(140.0, -20.0)));
     }
 

@@ -53,6 +53,7 @@ extern crate alloc;
 
 pub mod association;
 pub mod config;
+pub mod coordinates;
 pub mod displacement_check;
 pub mod duplicates;
 pub mod existence;
@@ -76,6 +77,5 @@ pub mod track;
 pub mod track_loops;
 pub mod track_table;
 pub mod tracker;
-pub mod tracking_frame;
 mod validated_frame;
 pub mod validation;

@@ -172,7 +172,7 @@ pub trait FrameView {
     fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass>;
     /// The ego vehicle's pose in the world frame at the frame's time, if the frame carries one.
     /// With a pose the tracker keeps its tracks in the world frame (see
-    /// [`TrackingFrame`](crate::config::TrackingFrame)).
+    /// [`CoordinateFrame`](crate::config::CoordinateFrame)).
     fn ego_pose(&self) -> Option<EgoPose> {
         None
     }

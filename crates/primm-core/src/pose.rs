@@ -49,7 +49,7 @@ impl EgoPose {
     }
 
     /// Maps a point from the vehicle frame into the world frame, m.
-    pub fn car_to_world(&self, point_vehicle_m: DVec2) -> DVec2 {
+    pub fn point_to_world(&self, point_vehicle_m: DVec2) -> DVec2 {
         self.position() + rotate(self.yaw_rad, point_vehicle_m)
     }
 
@@ -207,11 +207,11 @@ mod tests {
     #[test]
     fn a_point_goes_to_the_world_and_back() {
         let point = DVec2::new(30.0, -4.0);
-        let world = POSE.car_to_world(point);
+        let world = POSE.point_to_world(point);
         assert!(close(POSE.world_to_car(world), point));
         // The reference point is the pose's position; the x axis points along the yaw.
-        assert!(close(POSE.car_to_world(DVec2::ZERO), POSE.position()));
-        let ahead = POSE.car_to_world(DVec2::X) - POSE.position();
+        assert!(close(POSE.point_to_world(DVec2::ZERO), POSE.position()));
+        let ahead = POSE.point_to_world(DVec2::X) - POSE.position();
         assert!(close(ahead, DVec2::new(0.7f64.cos(), 0.7f64.sin())));
     }
 

@@ -17,13 +17,13 @@
 //! only. With `replay_frames = 0` (or `max_frame_delay_s = 0`) nothing is kept and a late frame
 //! is rejected as before.
 
+use crate::coordinates::CoordinateFrame;
 use crate::limits::{MAX_REPLAY_FRAMES, MAX_TRACKS};
 use crate::measurement::FrameView;
 use crate::pose::EgoPose;
 use crate::recorded_frame::RecordedFrame;
 use crate::track::Track;
 use crate::tracker::TrackerStats;
-use crate::tracking_frame::TrackingFrame;
 use alloc::boxed::Box;
 use alloc::vec::Vec;
 use arrayvec::ArrayVec;
@@ -38,7 +38,7 @@ pub(crate) struct TrackerSnapshot {
     /// The newest tracked frame's time, s.
     pub last_timestamp_s: Option<f64>,
     /// The frame the tracks were in.
-    pub tracks_frame: TrackingFrame,
+    pub tracks_frame: CoordinateFrame,
     /// The ego pose of the newest frame tracked in the world frame.
     pub last_pose: Option<EgoPose>,
     /// The counters.
@@ -51,7 +51,7 @@ impl TrackerSnapshot {
             tracks: Vec::with_capacity(MAX_TRACKS),
             next_id: 1,
             last_timestamp_s: None,
-            tracks_frame: TrackingFrame::Vehicle,
+            tracks_frame: CoordinateFrame::Vehicle,
             last_pose: None,
             stats: TrackerStats::default(),
         }

@@ -29,7 +29,7 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, PoisonError};
 
 use glam::DVec2;
-use primm_core::config::TrackingFrame;
+use primm_core::config::CoordinateFrame;
 use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -75,8 +75,8 @@ pub struct SequenceTruth {
 
 impl SequenceTruth {
     /// The truth of `sequence` for a tracker that tracks in `tracking_frame`.
-    pub fn new(sequence: &Sequence, tracking_frame: TrackingFrame) -> Result<Self, OracleError> {
-        let world = tracking_frame == TrackingFrame::World;
+    pub fn new(sequence: &Sequence, tracking_frame: CoordinateFrame) -> Result<Self, OracleError> {
+        let world = tracking_frame == CoordinateFrame::World;
         if !world && sequence.has_ego_pose() {
             return Err(OracleError::VehicleFrameWithPoses { sequence: sequence.name.clone() });
         }
@@ -320,7 +320,7 @@ mod tests {
 
     #[test]
     fn the_true_motion_is_interpolated_between_and_extrapolated_after_the_samples() {
-        let truth = SequenceTruth::new(&sequence(false), TrackingFrame::World).unwrap();
+        let truth = SequenceTruth::new(&sequence(false), CoordinateFrame::World).unwrap();
         // Anchor: the measurement of frame 2 (t = 0.2), at (22.5, 5).
         let step = request(DVec2::new(22.5, 5.0), 0.2, 0.2, 0.25);
         assert!(truth.displacement(&step).unwrap().abs_diff_eq(DVec2::new(0.5, 0.0), 1e-12));
@@ -336,19 +336,19 @@ mod tests {
 
     #[test]
     fn in_the_world_frame_positions_and_motion_follow_the_ego_pose() {
-        let truth = SequenceTruth::new(&sequence(true), TrackingFrame::World).unwrap();
+        let truth = SequenceTruth::new(&sequence(true), CoordinateFrame::World).unwrap();
         // The vehicle-frame measurement (22.5, 5) seen from (100, 0) turned by 90 degrees.
         let anchor = DVec2::new(100.0 - 5.0, 22.5);
         let motion = truth.displacement(&request(anchor, 0.2, 0.2, 0.3)).unwrap();
         assert!(motion.abs_diff_eq(DVec2::new(0.0, 1.0), 1e-9), "{motion}");
         assert_eq!(
-            SequenceTruth::new(&sequence(true), TrackingFrame::Vehicle).unwrap_err(),
+            SequenceTruth::new(&sequence(true), CoordinateFrame::Vehicle).unwrap_err(),
             OracleError::VehicleFrameWithPoses { sequence: "oracle".into() }
         );
         let mut blind = sequence(false);
         blind.frames.iter_mut().flat_map(|f| f.measurements.iter_mut()).for_each(|m| m.true_position = None);
         assert_eq!(
-            SequenceTruth::new(&blind, TrackingFrame::World).unwrap_err(),
+            SequenceTruth::new(&blind, CoordinateFrame::World).unwrap_err(),
             OracleError::NoTruth { sequence: "oracle".into() }
         );
     }
@@ -362,7 +362,7 @@ mod tests {
         let mut answers = [Some(Displacement::new(DVec2::ONE)); 2];
         handed_over.predict(&requests, &mut answers);
         assert_eq!(answers, [None, None], "no truth set yet");
-        oracle.set_truth(SequenceTruth::new(&sequence(false), TrackingFrame::World).unwrap());
+        oracle.set_truth(SequenceTruth::new(&sequence(false), CoordinateFrame::World).unwrap());
         handed_over.predict(&requests, &mut answers);
         assert!(answers[0].unwrap().mean_m.abs_diff_eq(DVec2::new(1.0, 0.0), 1e-12));
         assert_eq!(answers[0].unwrap().covariance_m2, None);
@@ -373,7 +373,7 @@ mod tests {
 
     #[test]
     fn a_noisy_oracle_repeats_itself_and_has_the_asked_spread() {
-        let truth = SequenceTruth::new(&sequence(false), TrackingFrame::World).unwrap();
+        let truth = SequenceTruth::new(&sequence(false), CoordinateFrame::World).unwrap();
         let mut noisy = DisplacementOracle::with_noise(0.2, 7);
         noisy.set_truth(truth.clone());
         let mut again = DisplacementOracle::with_noise(0.2, 7);

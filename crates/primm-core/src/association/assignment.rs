@@ -551,18 +551,30 @@ impl AugmentingPathWorkspace {
                 v[col] -= path_length - distance[col];
             }
 
-            // Flip the matching along the path back from the sink to `start`.
-            let mut col = sink;
-            loop {
-                let row = predecessor[col];
-                row_for_col[col] = row;
-                let previous = col_for_row[row];
-                col_for_row[row] = col;
-                if row == start {
-                    break;
-                }
-                col = previous;
-            }
+            augment(start, sink, predecessor, col_for_row, row_for_col);
         }
+    }
+}
+
+/// Flips the matching along the shortest path found from the free row `start` back from its
+/// free column `sink`: every column on it takes its predecessor row.
+#[inline]
+fn augment(
+    start: usize,
+    sink: usize,
+    predecessor: &[usize],
+    col_for_row: &mut [usize],
+    row_for_col: &mut [usize],
+) {
+    let mut col = sink;
+    loop {
+        let row = predecessor[col];
+        row_for_col[col] = row;
+        let previous = col_for_row[row];
+        col_for_row[row] = col;
+        if row == start {
+            break;
+        }
+        col = previous;
     }
 }

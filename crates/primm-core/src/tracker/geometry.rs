@@ -3,12 +3,12 @@
 //! the tracking frame.
 
 use super::{ScanningSensor, Tracker, MAX_DETECTION_PROBABILITY};
+use crate::coordinates::CoordinateFrame;
 use crate::existence::FieldOfView;
 use crate::measurement::FrameView;
 use crate::measurement::{Measurement, ObjectClass};
 use crate::pose::EgoPose;
 use crate::predictor::DisplacementPredictor;
-use crate::tracking_frame::TrackingFrame;
 use glam::DVec2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
@@ -17,21 +17,22 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// this frame's pose (the tracks' vehicle frame is taken as this frame's, which is off by
     /// the ego motion since the last frame), back into the vehicle frame of the last pose.
     pub(super) fn enter_tracking_frame(&mut self, pose: Option<EgoPose>, dt_s: f64) {
-        let world = self.config.frame.tracking_frame == TrackingFrame::World;
+        let world = self.config.frame.tracking_frame == CoordinateFrame::World;
         self.step_pose = pose.filter(|_| world);
         self.follow_odometry_reset(dt_s);
-        let step_frame = if self.step_pose.is_some() { TrackingFrame::World } else { TrackingFrame::Vehicle };
+        let step_frame =
+            if self.step_pose.is_some() { CoordinateFrame::World } else { CoordinateFrame::Vehicle };
         self.last_step.tracking_frame = step_frame;
         if world && pose.is_none() {
             self.stats.frames_without_ego_pose += 1;
         }
-        if step_frame == TrackingFrame::World {
+        if step_frame == CoordinateFrame::World {
             self.stats.frames_in_world_frame += 1;
         }
         if step_frame != self.tracks_frame && !self.table.is_empty() {
             let transform = match (step_frame, self.step_pose, self.last_pose) {
-                (TrackingFrame::World, Some(pose), _) => Some(pose.vehicle_to_world()),
-                (TrackingFrame::Vehicle, _, Some(last)) => Some(last.world_to_vehicle()),
+                (CoordinateFrame::World, Some(pose), _) => Some(pose.vehicle_to_world()),
+                (CoordinateFrame::Vehicle, _, Some(last)) => Some(last.world_to_vehicle()),
                 _ => None,
             };
             if let Some(transform) = transform {
@@ -52,7 +53,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// vehicle: into its frame with the last pose, back out with this one.
     pub(super) fn follow_odometry_reset(&mut self, dt_s: f64) {
         let (Some(pose), Some(last)) = (self.step_pose, self.last_pose) else { return };
-        if self.tracks_frame != TrackingFrame::World {
+        if self.tracks_frame != CoordinateFrame::World {
             return;
         }
         let tracker = &self.config.tracker;
@@ -106,7 +107,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)).map(|m| m.position());
             let in_vehicle = mount.unwrap_or(DVec2::ZERO);
             let position = match self.step_pose {
-                Some(pose) => pose.car_to_world(in_vehicle),
+                Some(pose) => pose.point_to_world(in_vehicle),
                 None => in_vehicle,
             };
             self.measurement_sensors[index] = (position, mount.is_some());
@@ -119,7 +120,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     pub(super) fn sensor_position(&mut self, measurement: &Measurement) -> DVec2 {
         let Some(pose) = self.step_pose else { return DVec2::ZERO };
         match measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)) {
-            Some(mount) => pose.car_to_world(mount.position()),
+            Some(mount) => pose.point_to_world(mount.position()),
             None => {
                 self.last_step.initiations_from_unknown_sensor += 1;
                 pose.position()

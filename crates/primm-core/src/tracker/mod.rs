@@ -11,6 +11,7 @@
 use crate::association::assignment::AssignmentError;
 use crate::association::associator::{AssociationStats, Associator};
 use crate::config::{Config, ConfigError};
+use crate::coordinates::CoordinateFrame;
 use crate::duplicates::DuplicateView;
 use crate::existence::{FieldOfView, Lifecycle};
 use crate::imm::ImmPrior;
@@ -26,7 +27,6 @@ use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput};
 use crate::track_loops::{self, ClassImms};
 use crate::track_table::{TrackTable, MAX_TRACKS};
-use crate::tracking_frame::TrackingFrame;
 use crate::validated_frame::ValidatedFrame;
 use crate::validation::FrameError;
 use alloc::boxed::Box;
@@ -47,7 +47,7 @@ use output::report;
 pub use stats::{StepSummary, TrackerStats};
 
 /// Why a step failed. The tracker's tracks are exactly as before the frame (after an
-/// association failure, up to a change of their frame; see [`TrackingFrame`]).
+/// association failure, up to a change of their frame; see [`CoordinateFrame`]).
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum StepError {
     /// The frame was rejected by validation.
@@ -105,7 +105,7 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// What the latest step did.
     last_step: StepSummary,
     /// The frame the live tracks are in.
-    tracks_frame: TrackingFrame,
+    tracks_frame: CoordinateFrame,
     /// The ego pose of the current step when it tracks in the world frame, else `None`.
     step_pose: Option<EgoPose>,
     /// The ego pose of the latest step tracked in the world frame.
@@ -173,7 +173,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             last_timestamp_s: None,
             stats: TrackerStats::default(),
             last_step: StepSummary::default(),
-            tracks_frame: TrackingFrame::Vehicle,
+            tracks_frame: CoordinateFrame::Vehicle,
             step_pose: None,
             last_pose: None,
             requests: Box::new(ArrayVec::new()),

@@ -2,6 +2,7 @@
 //! to a later time that change nothing.
 
 use super::{RowRecord, Tracker};
+use crate::coordinates::CoordinateFrame;
 use crate::existence;
 use crate::imm::ImmPrior;
 use crate::pose::{EgoPose, RigidTransform};
@@ -10,7 +11,6 @@ use crate::predictor::DisplacementPredictor;
 use crate::track::TrackOutput;
 use crate::track_loops::ClassImms;
 use crate::track_table::TrackTable;
-use crate::tracking_frame::TrackingFrame;
 use glam::DVec2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
@@ -45,7 +45,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if dt_s > max_s {
             return Err(PredictError::TooFarAhead { timestamp_s, ahead_s: dt_s, max_s });
         }
-        let world = self.tracks_frame == TrackingFrame::World;
+        let world = self.tracks_frame == CoordinateFrame::World;
         let to_vehicle = if world {
             ego_pose.filter(|pose| pose.is_valid()).or(self.last_pose).map(|pose| pose.world_to_vehicle())
         } else {

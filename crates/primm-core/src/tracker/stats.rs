@@ -1,8 +1,8 @@
 //! What the tracker counts: [`TrackerStats`] since it was built, [`StepSummary`] per step, and
 //! the bookkeeping that turns each rejection reason into its counter.
 
+use crate::coordinates::CoordinateFrame;
 use crate::displacement_check::DisplacementRejection;
-use crate::tracking_frame::TrackingFrame;
 use crate::validation::{FrameError, MeasurementRejection};
 
 /// Counters of everything the tracker did or refused, since it was built.
@@ -23,7 +23,7 @@ pub struct TrackerStats {
     /// tracking in the world frame; see [`EgoPose::is_valid`]).
     pub frames_rejected_invalid_ego_pose: u64,
     /// Frames tracked in the world frame (they carried an ego pose and the configuration asks
-    /// for [`TrackingFrame::World`]).
+    /// for [`CoordinateFrame::World`]).
     pub frames_in_world_frame: u64,
     /// Frames tracked in the vehicle frame although the configuration asks for the world
     /// frame, because they carried no ego pose.
@@ -139,7 +139,7 @@ pub struct StepSummary {
     /// Confirmed tracks among the live ones.
     pub confirmed_tracks: usize,
     /// The frame the step tracked in.
-    pub tracking_frame: TrackingFrame,
+    pub tracking_frame: CoordinateFrame,
     /// Whether the live tracks were moved into another frame at the start of the step.
     pub tracking_frame_changed: bool,
     /// Tracks started by a measurement whose sensor has no configured mount (world frame only).

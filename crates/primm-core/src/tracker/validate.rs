@@ -2,9 +2,9 @@
 //! ([`TrackerStats`](super::TrackerStats) keeps one counter per reason).
 
 use super::{MeasurementFate, StepError, Tracker};
+use crate::coordinates::CoordinateFrame;
 use crate::measurement::FrameView;
 use crate::predictor::DisplacementPredictor;
-use crate::tracking_frame::TrackingFrame;
 use crate::validation::{validate_frame, validate_measurement, FrameError};
 
 impl<P: DisplacementPredictor> Tracker<P> {
@@ -37,7 +37,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// The frame-level checks: a usable ego pose when tracking in the world frame, then the
     /// timestamp, interval and size (`crate::validation`); the interval, s.
     fn check_frame(&self) -> Result<f64, FrameError> {
-        if self.config.frame.tracking_frame == TrackingFrame::World {
+        if self.config.frame.tracking_frame == CoordinateFrame::World {
             if let Some(pose) = self.validated.ego_pose().filter(|pose| !pose.is_valid()) {
                 return Err(FrameError::InvalidEgoPose {
                     x_m: pose.x_m,

@@ -24,7 +24,7 @@
 //! stay as they were written.
 
 use super::recording::Sequence;
-use primm_core::config::TrackingFrame;
+use primm_core::config::CoordinateFrame;
 use primm_core::track::TrackOutput;
 use std::io::Write;
 
@@ -92,8 +92,12 @@ impl<W: Write> TrackCsvWriter<W> {
 
     /// The writer for a file tracked with `tracking_frame` from `sequence`: with the world-frame
     /// columns when the tracker keeps world-frame tracks and the sequence carries ego poses.
-    pub fn for_sequence(out: W, sequence: &Sequence, tracking_frame: TrackingFrame) -> std::io::Result<Self> {
-        if tracking_frame == TrackingFrame::World && sequence.has_ego_pose() {
+    pub fn for_sequence(
+        out: W,
+        sequence: &Sequence,
+        tracking_frame: CoordinateFrame,
+    ) -> std::io::Result<Self> {
+        if tracking_frame == CoordinateFrame::World && sequence.has_ego_pose() {
             Self::with_world_columns(out)
         } else {
             Self::new(out)
