@@ -39,6 +39,7 @@ mod common;
 
 use common::service::{spawn_serve, unique_prefix, TestClient};
 use hdrhistogram::Histogram;
+use primm_core::measurement::Frame;
 use primm_service::clock::monotonic_ns;
 use primm_service::latency_files::{LatencyFiles, StageDescription};
 use primm_service::ServiceNames;
@@ -76,21 +77,14 @@ fn measure(
 ) -> Vec<Histogram<u64>> {
     let prefix = unique_prefix(&format!("bench-{mode}"));
     let client = TestClient::new(&ServiceNames::new(&prefix));
-    let mut extra = vec!["--method", method, "--latency-every", latency_every];
     let busy = mode == "busy-poll";
+    let directory = latency_out.map(|directory| directory.join(mode));
+    let mut extra = vec!["--method", method, "--latency-every", latency_every];
+    let options = [("--model", model), ("--inference-threads", inference_threads), ("--engine", engine)];
+    extra.extend(options.into_iter().filter_map(|(name, value)| value.map(|value| [name, value])).flatten());
     if busy {
         extra.push("--busy-poll");
     }
-    if let Some(model) = model {
-        extra.extend(["--model", model]);
-    }
-    if let Some(threads) = inference_threads {
-        extra.extend(["--inference-threads", threads]);
-    }
-    if let Some(engine) = engine {
-        extra.extend(["--engine", engine]);
-    }
-    let directory = latency_out.map(|directory| directory.join(mode));
     let directory_text = directory.as_ref().map(|directory| directory.display().to_string());
     if let Some(directory) = &directory_text {
         extra.extend(["--latency-out", directory.as_str()]);
@@ -104,19 +98,7 @@ fn measure(
     let mut histograms: Vec<Histogram<u64>> =
         LEGS.iter().map(|_| Histogram::<u64>::new_with_bounds(1, 60_000_000_000, 3).unwrap()).collect();
     let warm_up = 500;
-    let mut files = directory.as_ref().map(|directory| {
-        let stages: Vec<StageDescription> =
-            LEGS.iter().zip(LEG_FILES).map(|(leg, file)| StageDescription::new(file, *leg)).collect();
-        LatencyFiles::create(
-            directory,
-            "client",
-            &stages,
-            &histograms[0],
-            Duration::from_secs(1),
-            monotonic_ns(),
-        )
-        .expect("the latency files can be created")
-    });
+    let mut files = directory.as_ref().map(|directory| client_latency_files(directory, &histograms[0]));
     let mut frame = scene[0].clone();
     for k in 0..warm_up + frames {
         let source = &scene[k % scene.len()];
@@ -125,27 +107,9 @@ fn measure(
         // The scene repeats every 500 frames; each repetition starts a new stream, so the
         // tracker resets instead of seeing every object jump back (a burst of new tracks).
         let flags = if k % scene.len() == 0 { primm_wire::FRAME_FLAG_STREAM_START } else { 0 };
-        client.send(&frame, k as u64, flags);
-        let read = |answer: &primm_wire::TrackFrame| {
-            (answer.input_publish_time_ns, answer.receive_time_ns, answer.publish_time_ns)
-        };
-        let answer = if busy {
-            client.next_answer_spinning(Duration::from_secs(10), read)
-        } else {
-            client.next_answer(Duration::from_secs(10), read)
-        };
-        let (sent_ns, receive_ns, publish_ns) = answer.expect("the tracker answers");
-        let received_ns = monotonic_ns();
+        let (sent_ns, receive_ns, publish_ns, received_ns) = send_and_wait(&client, &frame, k, flags, busy);
         if k >= warm_up {
-            let round_trip = received_ns.saturating_sub(sent_ns);
-            let compute = publish_ns.saturating_sub(receive_ns);
-            let values = [
-                round_trip,
-                receive_ns.saturating_sub(sent_ns),
-                compute,
-                received_ns.saturating_sub(publish_ns),
-                round_trip.saturating_sub(compute),
-            ];
+            let values = leg_values(sent_ns, receive_ns, publish_ns, received_ns);
             for (histogram, value) in histograms.iter_mut().zip(values) {
                 histogram.saturating_record(value.max(1));
             }
@@ -174,6 +138,50 @@ fn measure(
         eprintln!("{mode}: {line}");
     }
     histograms
+}
+
+/// Sends frame number `k` and waits for its answer (spinning with `busy`); the send, the
+/// tracker's receive and publish, and the client's receive times, ns.
+fn send_and_wait(
+    client: &TestClient,
+    frame: &Frame,
+    k: usize,
+    flags: u32,
+    busy: bool,
+) -> (u64, u64, u64, u64) {
+    client.send(frame, k as u64, flags);
+    let read = |answer: &primm_wire::TrackFrame| {
+        (answer.input_publish_time_ns, answer.receive_time_ns, answer.publish_time_ns)
+    };
+    let answer = if busy {
+        client.next_answer_spinning(Duration::from_secs(10), read)
+    } else {
+        client.next_answer(Duration::from_secs(10), read)
+    };
+    let (sent_ns, receive_ns, publish_ns) = answer.expect("the tracker answers");
+    (sent_ns, receive_ns, publish_ns, monotonic_ns())
+}
+
+/// The client's latency files of the legs (`--latency-out`), in `directory`.
+fn client_latency_files(directory: &Path, first: &Histogram<u64>) -> LatencyFiles {
+    let stages: Vec<StageDescription> =
+        LEGS.iter().zip(LEG_FILES).map(|(leg, file)| StageDescription::new(file, *leg)).collect();
+    LatencyFiles::create(directory, "client", &stages, first, Duration::from_secs(1), monotonic_ns())
+        .expect("the latency files can be created")
+}
+
+/// Each leg's latency of one frame, ns, in the order of [`LEGS`]: from the send, the tracker's
+/// receive and publish times and the client's receive time.
+fn leg_values(sent_ns: u64, receive_ns: u64, publish_ns: u64, received_ns: u64) -> [u64; 5] {
+    let round_trip = received_ns.saturating_sub(sent_ns);
+    let compute = publish_ns.saturating_sub(receive_ns);
+    [
+        round_trip,
+        receive_ns.saturating_sub(sent_ns),
+        compute,
+        received_ns.saturating_sub(publish_ns),
+        round_trip.saturating_sub(compute),
+    ]
 }
 
 fn argument(name: &str) -> Option<String> {

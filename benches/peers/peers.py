@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Python trackers that a team would otherwise pick, run on primm's measurement CSV files.
 
-Two peers share one tracking loop that mirrors primm's (``crates/primm-core/src/tracker.rs``): per class, the
+Two peers share one tracking loop that mirrors primm's (``crates/primm-core/src/tracker/``): per class, the
 association cost of ``eq:association_cost`` (distance to the predicted position plus
 ``velocity_weight_s * min(|dv_r|, velocity_cap_mps)``), the class gate, an optimal assignment
 that first maximises the number of pairs and then minimises the cost, and primm's track

@@ -303,34 +303,10 @@ fn step(input: &mut Input, session: &mut Session) -> Option<()> {
     let advance_ms = input.u8()?;
     let timestamp_s =
         if advance_ms == 255 { input.f64()? } else { session.clocks[slot] + f64::from(advance_ms) * 1e-3 };
-    let pose = match input.u8()? % 3 {
-        0 => None,
-        1 => Some(PrimmEgoPose {
-            x_m: f64::from(input.i16()?) * 0.01,
-            y_m: f64::from(input.i16()?) * 0.01,
-            yaw_rad: f64::from(input.i16()?) * 1e-3,
-        }),
-        _ => Some(PrimmEgoPose { x_m: input.f64()?, y_m: input.f64()?, yaw_rad: input.f64()? }),
-    };
+    let pose = read_pose(input)?;
     let count = usize::from(input.u8()?);
     let mode = input.u8()? % 4;
-    let mut measurements = Vec::with_capacity(count);
-    for _ in 0..count {
-        measurements.push(read_measurement(input)?);
-    }
-    if mode == 2 {
-        // More than a frame may carry: rejected as a whole.
-        let filler = measurements.last().copied().unwrap_or(PrimmMeasurement {
-            x_m: 10.0,
-            y_m: 0.0,
-            radial_velocity_mps: 0.0,
-            rcs_dbsm: 0.0,
-            ground_truth_id: -1,
-            sensor_id: -1,
-            class_code: 0,
-        });
-        measurements.resize(PRIMM_MAX_MEASUREMENTS_PER_FRAME + 1 + count, filler);
-    }
+    let measurements = read_measurements(input, count, mode == 2)?;
     let (pointer, length) =
         if mode == 1 { (null(), count) } else { (measurements.as_ptr(), measurements.len()) };
     let mut summary = PrimmStepSummary { track_count: usize::MAX, ..Default::default() };
@@ -382,6 +358,42 @@ fn step(input: &mut Input, session: &mut Session) -> Option<()> {
     }
     assert_eq!(copied_tracks(tracker), live.tracks, "tracks after a step with status {status:?}");
     Some(())
+}
+
+/// An ego pose: none, a plausible one, or any eight bytes per value.
+fn read_pose(input: &mut Input) -> Option<Option<PrimmEgoPose>> {
+    Some(match input.u8()? % 3 {
+        0 => None,
+        1 => Some(PrimmEgoPose {
+            x_m: f64::from(input.i16()?) * 0.01,
+            y_m: f64::from(input.i16()?) * 0.01,
+            yaw_rad: f64::from(input.i16()?) * 1e-3,
+        }),
+        _ => Some(PrimmEgoPose { x_m: input.f64()?, y_m: input.f64()?, yaw_rad: input.f64()? }),
+    })
+}
+
+/// `count` measurements; with `too_many`, padded to more than a frame may carry (the frame is
+/// then rejected as a whole).
+fn read_measurements(input: &mut Input, count: usize, too_many: bool) -> Option<Vec<PrimmMeasurement>> {
+    let mut measurements = Vec::with_capacity(count);
+    for _ in 0..count {
+        measurements.push(read_measurement(input)?);
+    }
+    if too_many {
+        // More than a frame may carry: rejected as a whole.
+        let filler = measurements.last().copied().unwrap_or(PrimmMeasurement {
+            x_m: 10.0,
+            y_m: 0.0,
+            radial_velocity_mps: 0.0,
+            rcs_dbsm: 0.0,
+            ground_truth_id: -1,
+            sensor_id: -1,
+            class_code: 0,
+        });
+        measurements.resize(PRIMM_MAX_MEASUREMENTS_PER_FRAME + 1 + count, filler);
+    }
+    Some(measurements)
 }
 
 fn copy_tracks(input: &mut Input, session: &mut Session) -> Option<()> {

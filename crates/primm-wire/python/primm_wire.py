@@ -37,7 +37,7 @@ STATUS_NAMES = {
 }
 CLASS_NAMES = {0: "car", 1: "pedestrian", 2: "two_wheeler"}
 
-# Service names and the QoS every primm program opens them with (src/service/catalog.rs).
+# Service names and the QoS every primm program opens them with (crates/primm-ipc/src/catalog.rs).
 MEASUREMENTS = "primm/measurements"
 TRACKS = "primm/tracks"
 LATENCY = "primm/latency"
