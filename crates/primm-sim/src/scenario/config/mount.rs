@@ -5,6 +5,7 @@
 //! `half_fov_deg`) or, like the tracker's configuration, in radians (`yaw_rad`,
 //! `half_fov_rad`); a mount is written out in radians, so that it reads back bit for bit.
 
+use primm_core::coordinates::CoordinatesConfig;
 use primm_core::pose::SensorMount;
 use serde::{Deserialize, Serialize};
 
@@ -107,6 +108,7 @@ impl From<RadarMount> for RadarMountFields {
 
 /// The layout of a sensor whose boresight and half field of view are given in degrees,
 /// converted as a scenario file's `yaw_deg` and `half_fov_deg` are.
+#[cfg(test)]
 fn layout_in_degrees(
     id: u16,
     x_m: f64,
@@ -130,20 +132,22 @@ fn layout_in_degrees(
 impl RadarMount {
     /// The four-sensor layout used by default, modelled on RadarScenes: two front sensors
     /// turned 25° outwards and two side sensors turned 85° outwards, all on the front bumper,
-    /// each with ±60° field of view and 100 m range. The tracker's default `frame.sensors`
-    /// describe the same sensors.
+    /// each with ±60° field of view and 100 m range: the tracker's default `frame.sensors`
+    /// (`CoordinatesConfig::default`), with each sensor's azimuth errors.
     pub fn default_layout() -> Vec<RadarMount> {
-        let mount = |id, x_m, y_m, yaw_deg, azimuth_bias_deg, azimuth_noise_scale| RadarMount {
-            layout: layout_in_degrees(id, x_m, y_m, yaw_deg, 60.0, 100.0),
-            azimuth_bias_deg,
-            azimuth_noise_scale,
-        };
-        vec![
-            mount(1, 3.66, -0.87, -85.0, 0.25, 1.2),
-            mount(2, 3.86, -0.70, -25.0, -0.1, 1.0),
-            mount(3, 3.86, 0.70, 25.0, 0.15, 0.9),
-            mount(4, 3.66, 0.87, 85.0, -0.3, 1.3),
-        ]
+        // The sensors are the tracker's default layout (one copy of it); the generator adds
+        // each sensor's own errors.
+        let errors = [(0.25, 1.2), (-0.1, 1.0), (0.15, 0.9), (-0.3, 1.3)];
+        CoordinatesConfig::default()
+            .sensors
+            .iter()
+            .zip(errors)
+            .map(|(&layout, (azimuth_bias_deg, azimuth_noise_scale))| RadarMount {
+                layout,
+                azimuth_bias_deg,
+                azimuth_noise_scale,
+            })
+            .collect()
     }
 }
 
