@@ -14,6 +14,7 @@ use crate::common;
 use common::{lanes, measurement, scene_frames};
 use glam::DVec2;
 use primm_core::config::Config;
+use primm_core::extent::ExpectedReflection;
 use primm_core::gaussian::{RadialVelocityOutcome, UpdateError};
 use primm_core::imm::ImmPrior;
 use primm_core::measurement::{Measurement, ObjectClass};
@@ -130,6 +131,14 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             .collect();
         let sensors: Vec<DVec2> =
             (0..tracks.len()).map(|i| DVec2::new(3.7, -0.9 + 0.6 * (i % 4) as f64)).collect();
+        // The reflections the tracker computes once per frame and hands to the loop.
+        let reflections: Vec<ExpectedReflection> = tracks
+            .iter()
+            .enumerate()
+            .map(|(i, track)| {
+                models[track.class.index()].expected_reflection(&plain[i].object_prior(), sensors[i])
+            })
+            .collect();
         let mut dispatched_tracks = tracks.clone();
         let mut outcomes = vec![Err(UpdateError); tracks.len()];
         track_loops::update(
@@ -139,6 +148,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             &dispatched,
             &measurements,
             &sensors,
+            &reflections,
             true,
             &mut outcomes,
         );
@@ -175,6 +185,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             &baseline,
             &measurements,
             &sensors,
+            &reflections,
             true,
             &mut baseline_outcomes,
         );

@@ -97,7 +97,9 @@ pub type UpdateOutcome = Result<Option<RadialVelocityOutcome>, UpdateError>;
 
 /// The IMM update of every track that has a measurement in `measurements` (same order as
 /// `tracks`), of the centre through the expected reflection for a class tracked as an extended
-/// object (`crate::extent`), with the radial-velocity row where the class asks for it, seen from
+/// object (`crate::extent`; `reflections[i]` is track `i`'s expected reflection for its
+/// measurement, computed by the caller once per frame, [`ExpectedReflection::POINT`] for a point
+/// class), with the radial-velocity row where the class asks for it, seen from
 /// `sensor_positions_m[i]` (the tracking frame) and only with `radial_velocity_rows` (the
 /// tracker passes whether the step tracks in the world frame); `outcomes[i]` is the result for track `i`
 /// (`Ok(None)` for tracks without measurement, which are left untouched). A failed update
@@ -110,6 +112,7 @@ pub fn update(
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
     sensor_positions_m: &[DVec2],
+    reflections: &[ExpectedReflection],
     radial_velocity_rows: bool,
     outcomes: &mut [UpdateOutcome],
 ) {
@@ -120,6 +123,7 @@ pub fn update(
         priors,
         measurements,
         sensor_positions_m,
+        reflections,
         radial_velocity_rows,
         outcomes,
     );
@@ -133,20 +137,18 @@ fn update_loop(
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
     sensor_positions_m: &[DVec2],
+    reflections: &[ExpectedReflection],
     radial_velocity_rows: bool,
     outcomes: &mut [UpdateOutcome],
 ) {
-    for ((((track, prior), measurement), sensor_position_m), outcome) in
-        tracks.iter_mut().zip(priors).zip(measurements).zip(sensor_positions_m).zip(outcomes.iter_mut())
+    let per_track = tracks.iter_mut().zip(priors).zip(measurements).zip(sensor_positions_m).zip(reflections);
+    for (((((track, prior), measurement), sensor_position_m), reflection), outcome) in
+        per_track.zip(outcomes.iter_mut())
     {
         *outcome = match measurement {
             Some(z) => {
                 let class = track.class.index();
                 let models = &models[class];
-                let reflection = match models.extent {
-                    Some(_) => models.expected_reflection(&prior.object_prior(), *sensor_position_m),
-                    None => ExpectedReflection::POINT,
-                };
                 let radial_velocity = models
                     .radial_velocity_observation(z, *sensor_position_m)
                     .filter(|_| radial_velocity_rows);
@@ -235,6 +237,7 @@ pub mod baseline {
         priors: &[ImmPrior],
         measurements: &[Option<Measurement>],
         sensor_positions_m: &[DVec2],
+        reflections: &[ExpectedReflection],
         radial_velocity_rows: bool,
         outcomes: &mut [UpdateOutcome],
     ) {
@@ -245,6 +248,7 @@ pub mod baseline {
             priors,
             measurements,
             sensor_positions_m,
+            reflections,
             radial_velocity_rows,
             outcomes,
         );

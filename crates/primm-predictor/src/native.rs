@@ -5,7 +5,8 @@
 //! packed one at a time, element-wise operators run one element or row at a time
 //! (`docs/BENCHMARKS.md`, section 1). [`NativeModel`] computes the same function directly: one
 //! sample at a time, every tensor a stack array whose size is a constant, the linear layers as
-//! fixed-size loops the compiler vectorises (dispatched at run time to AVX2 or AVX-512 where
+//! fixed-size loops the compiler vectorises, two tokens at a time where a layer has two to
+//! apply (each weight row loaded once for both, each output summed in the same order) (dispatched at run time to AVX2 or AVX-512 where
 //! the CPU has them, with the portable build as the fallback), and no allocation at all.
 //!
 //! It reads its weights from the ONNX file's initializers, by the names
@@ -151,6 +152,41 @@ impl<const IN: usize, const OUT: usize> Linear<IN, OUT> {
             }
         }
         output
+    }
+
+    /// [`apply`](Self::apply) to two inputs at once: each weight row is loaded once for both,
+    /// and the two sums are independent, so they overlap instead of waiting on each other.
+    /// Each output is summed in the same order as by `apply`, so the values are identical.
+    #[inline(always)]
+    fn apply_pair(&self, first: &[f32; IN], second: &[f32; IN]) -> [[f32; OUT]; 2] {
+        let (mut output_a, mut output_b) = (self.bias, self.bias);
+        for ((a, b), row) in first.iter().zip(second).zip(&self.weight) {
+            for ((out_a, out_b), weight) in output_a.iter_mut().zip(output_b.iter_mut()).zip(row) {
+                *out_a += a * weight;
+                *out_b += b * weight;
+            }
+        }
+        [output_a, output_b]
+    }
+}
+
+/// Applies `linear` to the inputs `inputs[i]` for `i` in `indices`, two at a time, writing
+/// `outputs[i]`.
+#[inline(always)]
+fn apply_to<const IN: usize, const OUT: usize, const N: usize>(
+    linear: &Linear<IN, OUT>,
+    inputs: &[[f32; IN]; N],
+    indices: &[usize],
+    outputs: &mut [[f32; OUT]; N],
+) {
+    let mut pairs = indices.chunks_exact(2);
+    for pair in &mut pairs {
+        let [a, b] = linear.apply_pair(&inputs[pair[0]], &inputs[pair[1]]);
+        outputs[pair[0]] = a;
+        outputs[pair[1]] = b;
+    }
+    if let [last] = pairs.remainder() {
+        outputs[*last] = linear.apply(&inputs[*last]);
     }
 }
 
@@ -482,20 +518,25 @@ impl Layer {
         key_weight: &[f32; TOKENS],
         first_query: usize,
     ) {
+        // The tokens that take part (non-zero key weight), and those of them updated here.
+        let mut active = [0usize; TOKENS];
+        let mut active_count = 0;
+        let mut normed = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        for token in 0..TOKENS {
+            if key_weight[token] != 0.0 {
+                normed[token] = self.norm_attention.apply(&tokens[token]);
+                active[active_count] = token;
+                active_count += 1;
+            }
+        }
+        let active = &active[..active_count];
+        let updated = &active[active.partition_point(|&token| token < first_query)..];
         let mut keys = [[0.0f32; MODEL_WIDTH]; TOKENS];
         let mut values = [[0.0f32; MODEL_WIDTH]; TOKENS];
         let mut queries = [[0.0f32; MODEL_WIDTH]; TOKENS];
-        for token in 0..TOKENS {
-            if key_weight[token] == 0.0 {
-                continue;
-            }
-            let normed = self.norm_attention.apply(&tokens[token]);
-            keys[token] = self.key.apply(&normed);
-            values[token] = self.value.apply(&normed);
-            if token >= first_query {
-                queries[token] = self.query.apply(&normed);
-            }
-        }
+        apply_to(&self.key, &normed, active, &mut keys);
+        apply_to(&self.value, &normed, active, &mut values);
+        apply_to(&self.query, &normed, updated, &mut queries);
         // Keys channel-major, the tokens along a row of LANES (masked and empty lanes zero): a
         // head's scores for one query are LANES-wide products summed over its 8 channels.
         let mut keys_by_channel = [[0.0f32; LANES]; MODEL_WIDTH];
@@ -506,26 +547,42 @@ impl Layer {
         }
         let mut key_weights = [0.0f32; LANES];
         key_weights[..TOKENS].copy_from_slice(key_weight);
-        for query in first_query..TOKENS {
-            if key_weight[query] == 0.0 {
-                continue;
-            }
-            let mut mixed = [0.0f32; MODEL_WIDTH];
+        // Every query attends to the keys and values above, none to another's update, so the
+        // queries' attention is computed first and their updates two at a time.
+        let mut mixed = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        for &query in updated {
             for head in 0..HEADS {
-                attend_head(head, &queries[query], &keys_by_channel, &key_weights, &values, &mut mixed);
+                attend_head(
+                    head,
+                    &queries[query],
+                    &keys_by_channel,
+                    &key_weights,
+                    &values,
+                    &mut mixed[query],
+                );
             }
-            let attended = self.output.apply(&mixed);
+        }
+        let mut attended = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        apply_to(&self.output, &mixed, updated, &mut attended);
+        let mut normed = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        for &query in updated {
             let token = &mut tokens[query];
-            for (value, add) in token.iter_mut().zip(&attended) {
+            for (value, add) in token.iter_mut().zip(&attended[query]) {
                 *value += add;
             }
-            let normed = self.norm_feed_forward.apply(token);
-            let mut hidden = self.feed_forward_in.apply(&normed);
-            for value in &mut hidden {
+            normed[query] = self.norm_feed_forward.apply(token);
+        }
+        let mut hidden = [[0.0f32; FEED_FORWARD_WIDTH]; TOKENS];
+        apply_to(&self.feed_forward_in, &normed, updated, &mut hidden);
+        for &query in updated {
+            for value in &mut hidden[query] {
                 *value = value.max(0.0);
             }
-            let out = self.feed_forward_out.apply(&hidden);
-            for (value, add) in token.iter_mut().zip(&out) {
+        }
+        let mut out = [[0.0f32; MODEL_WIDTH]; TOKENS];
+        apply_to(&self.feed_forward_out, &hidden, updated, &mut out);
+        for &query in updated {
+            for (value, add) in tokens[query].iter_mut().zip(&out[query]) {
                 *value += add;
             }
         }

@@ -14,6 +14,7 @@ use crate::config::{Config, ConfigError};
 use crate::coordinates::CoordinateFrame;
 use crate::duplicates::DuplicateView;
 use crate::existence::{FieldOfView, Lifecycle};
+use crate::extent::ExpectedReflection;
 use crate::imm::ImmPrior;
 use crate::limits::MAX_SENSORS;
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
@@ -127,6 +128,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     assigned_measurements: Box<[Option<Measurement>; MAX_TRACKS]>,
     /// Where the radar of each track's assigned measurement is, in the tracking frame.
     assigned_sensor_positions: Box<[DVec2; MAX_TRACKS]>,
+    /// The expected reflection of each track's object for its assigned measurement's radar
+    /// (computed once per frame, used by the Kalman update and the existence likelihood).
+    assigned_reflections: Box<[ExpectedReflection; MAX_TRACKS]>,
     /// Where the radar of each measurement of the current frame is, in the tracking frame (its
     /// mount; the vehicle's reference point when it has none), and whether it had a mount.
     measurement_sensors: Box<[(DVec2, bool); MAX_MEASUREMENTS_PER_FRAME]>,
@@ -185,6 +189,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             track_to_measurement: Box::new([None; MAX_TRACKS]),
             assigned_measurements: Box::new([None; MAX_TRACKS]),
             assigned_sensor_positions: Box::new([DVec2::ZERO; MAX_TRACKS]),
+            assigned_reflections: Box::new([ExpectedReflection::POINT; MAX_TRACKS]),
             measurement_sensors: Box::new([(DVec2::ZERO, false); MAX_MEASUREMENTS_PER_FRAME]),
             update_outcomes: Box::new([Ok(None); MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),

@@ -57,6 +57,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             };
             let (sensor_m, mounted) = self.measurement_sensors[usize::from(index)];
             self.assigned_sensor_positions[i] = sensor_m;
+            let reflection = self.expected_reflection(i, sensor_m);
+            self.assigned_reflections[i] = reflection;
             let models = &self.models[measurement.class.index()];
             if !mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
                 self.last_step.updates_from_unknown_sensor += 1;
@@ -69,6 +71,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             &self.priors[..count],
             &self.assigned_measurements[..count],
             &self.assigned_sensor_positions[..count],
+            &self.assigned_reflections[..count],
             // Radial velocities are over ground: they measure the velocity of world-frame
             // tracks, not of vehicle-frame tracks of an ego whose motion is unknown.
             self.step_pose.is_some(),
@@ -88,7 +91,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }
                 let class = self.table.tracks()[i].class;
                 let (detection, clutter) = self.detection_and_clutter(class, measurement.sensor_id);
-                let reflection = self.expected_reflection(i, self.assigned_sensor_positions[i]);
+                let reflection = self.assigned_reflections[i];
                 let prior = &self.priors[i].fused;
                 let likelihood = existence::gaussian_density_per_m2(
                     measurement.position() - reflection.offset_m - prior.mean,
