@@ -213,3 +213,61 @@ fn tracks_far_apart_are_paired_without_the_solver() {
     assert_eq!(associator.stats().solved_clusters, 0);
     assert_eq!(associator.stats().allowed_pairs, 50);
 }
+
+#[test]
+fn each_assigned_car_gets_the_reflection_of_its_measurements_sensor_exactly_as_the_model_computes_it() {
+    use primm_core::config::AssociationCost;
+    use primm_core::extent::expected_reflection;
+    for cost in [AssociationCost::Likelihood, AssociationCost::Paper] {
+        let mut config = Config::default();
+        config.association.cost = cost;
+        assert!(config.classes.car.extent.enabled && !config.classes.pedestrian.extent.enabled);
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut associator = Associator::new();
+        let (mut cars, mut pedestrians) = (0, 0);
+        for _ in 0..40 {
+            let scene = scene(&mut rng, &config);
+            // Six radar positions, so that a track's memo (four) overflows now and then.
+            let radars: Vec<DVec2> =
+                (0..6).map(|k| DVec2::new(3.0 * k as f64 - 6.0, [0.9, -0.9][k % 2])).collect();
+            let sensors: Vec<(DVec2, bool)> = (0..scene.accepted.len())
+                .map(|_| (radars[rng.random_range(0..radars.len())], true))
+                .collect();
+            let mut track_to_measurement = vec![None; scene.tracks.len()];
+            associator
+                .associate(
+                    &scene.tracks,
+                    &scene.priors,
+                    &scene.frame,
+                    &scene.accepted,
+                    &sensors,
+                    &config,
+                    &mut track_to_measurement,
+                )
+                .unwrap();
+            for (i, assigned) in track_to_measurement.iter().enumerate() {
+                let shared = associator.assigned_reflection(i);
+                let Some(index) = assigned else {
+                    assert_eq!(shared, None, "an unassigned track has none");
+                    continue;
+                };
+                if scene.tracks[i].class == ObjectClass::Pedestrian {
+                    assert_eq!(shared, None, "pedestrians are points");
+                    pedestrians += 1;
+                    continue;
+                }
+                let expected = expected_reflection(
+                    &config.classes.car.extent,
+                    &scene.priors[i].object_prior(),
+                    sensors[usize::from(*index)].0,
+                );
+                // The memo may not hold it (more sensors than it keeps); if it does, exactly.
+                if let Some(shared) = shared {
+                    assert_eq!(shared, expected, "track {i}");
+                    cars += 1;
+                }
+            }
+        }
+        assert!(cars > 100 && pedestrians > 20, "{cost:?}: {cars} cars, {pedestrians} pedestrians checked");
+    }
+}

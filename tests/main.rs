@@ -42,6 +42,7 @@ mod predictor_allocation;
 mod predictor_classes;
 mod predictor_native;
 mod predictor_onnx;
+mod predictor_remembered;
 mod predictor_request;
 mod predictor_split;
 mod predictor_threaded;

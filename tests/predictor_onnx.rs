@@ -3,7 +3,9 @@
 
 use glam::DVec2;
 use primm_config::InferenceEngine;
-use primm_core::predictor::{DisplacementPredictor, HistoryEntry, PredictionRequest, FEATURES, MAX_HISTORY};
+use primm_core::predictor::{
+    DisplacementPredictor, HistoryEntry, PredictionRequest, RememberedDisplacement, FEATURES, MAX_HISTORY,
+};
 use primm_predictor::onnx::{InputRotation, ModelError, OnnxPredictor, PrModel};
 use std::path::{Path, PathBuf};
 
@@ -274,6 +276,37 @@ fn a_track_measured_in_the_previous_frame_gets_the_model_output_and_a_coasting_t
     let direct = run_one(&mut model, &PredictionRequest::from_history(&entries, 0.135));
     assert!((total - direct).length() < 1e-4, "{total} vs {direct}");
     assert_eq!(predictor.stats().rows, 3 + 1);
+}
+
+#[test]
+fn a_coasting_track_with_the_previous_frames_answer_runs_one_row_and_gets_the_same_displacement() {
+    let mut predictor = OnnxPredictor::load(repo_path("models/pr.onnx")).unwrap();
+    let entries = history(&[(0.00, 20.0, 3.0), (0.03, 19.7, 3.0), (0.06, 19.4, 3.01), (0.09, 19.1, 3.0)]);
+    // Frame at 0.12: measured at 0.09, so one row, and the answer tells f(0.12).
+    let first = PredictionRequest::from_history(&entries, 0.12).with_step_start(0.09);
+    let mut out = [None];
+    predictor.predict(&[first], &mut out);
+    let first_answer = out[0].unwrap();
+    assert_eq!(first_answer.from_latest_m, Some(first_answer.mean_m));
+    let remembered = RememberedDisplacement::of(&first, &first_answer).unwrap();
+    // Frame at 0.135, still not measured: with and without the remembered f(0.12).
+    let coasting = PredictionRequest::from_history(&entries, 0.135).with_step_start(0.12);
+    let mut without = [None];
+    predictor.predict(&[coasting], &mut without);
+    assert_eq!(predictor.stats().rows, 1 + 2);
+    let mut with = [None];
+    predictor.predict(&[coasting.with_remembered_step_start(Some(&remembered))], &mut with);
+    assert_eq!(predictor.stats().rows, 1 + 2 + 1);
+    let (without, with) = (without[0].unwrap(), with[0].unwrap());
+    assert!((without.mean_m - with.mean_m).length() < 1e-5, "{} vs {}", without.mean_m, with.mean_m);
+    assert_eq!(without.from_latest_m, with.from_latest_m);
+    // A non-finite remembered value is not used: both rows run again.
+    let mut broken = coasting;
+    broken.step_start_displacement_m = Some(DVec2::new(f64::NAN, 0.0));
+    let mut again = [None];
+    predictor.predict(&[broken], &mut again);
+    assert_eq!(predictor.stats().rows, 1 + 2 + 1 + 2);
+    assert!((again[0].unwrap().mean_m - without.mean_m).length() < 1e-9);
 }
 
 #[test]

@@ -67,3 +67,43 @@ fn only_the_latest_five_measurements_are_used_and_positions_are_relative_to_the_
     assert_eq!(request.features[0][0], -4.0);
     assert!((request.features[0][4] + 0.45).abs() < 1e-6);
 }
+
+#[test]
+fn a_remembered_answer_serves_only_the_next_step_of_the_same_history() {
+    use glam::DVec2;
+    use primm_core::predictor::{Displacement, RememberedDisplacement};
+    let history = entries(&[1.0, 1.02]);
+    // The previous frame (t = 1.05) predicted f(1.05) from this history.
+    let previous = PredictionRequest::from_history(&history, 1.05).with_step_start(1.035);
+    let answer = Displacement::new(DVec2::new(0.1, 0.0)).with_from_latest(DVec2::new(0.3, -0.1));
+    let remembered = RememberedDisplacement::of(&previous, &answer).unwrap();
+    // This frame (t = 1.08), not measured since: f(1.05) is the step start's displacement.
+    let next = PredictionRequest::from_history(&history, 1.08).with_step_start(1.05);
+    assert_eq!(remembered.serves(&next), Some(DVec2::new(0.3, -0.1)));
+    assert_eq!(
+        next.with_remembered_step_start(Some(&remembered)).step_start_displacement_m,
+        Some(DVec2::new(0.3, -0.1))
+    );
+    assert_eq!(next.with_remembered_step_start(None).step_start_displacement_m, None);
+    // Another step start, a new measurement, another position or length: not the same.
+    assert_eq!(
+        remembered.serves(&PredictionRequest::from_history(&history, 1.11).with_step_start(1.08)),
+        None
+    );
+    let measured = entries(&[1.0, 1.02, 1.05]);
+    assert_eq!(
+        remembered.serves(&PredictionRequest::from_history(&measured, 1.08).with_step_start(1.05)),
+        None
+    );
+    let mut moved = history.clone();
+    moved[1].x_m += 0.5;
+    assert_eq!(remembered.serves(&PredictionRequest::from_history(&moved, 1.08).with_step_start(1.05)), None);
+    assert_eq!(
+        remembered.serves(&PredictionRequest::from_history(&history[1..], 1.08).with_step_start(1.05)),
+        None
+    );
+    // Measured in the previous frame: the step starts at the measurement, nothing to reuse.
+    let fresh = PredictionRequest::from_history(&measured, 1.08).with_step_start(1.05);
+    assert!(!fresh.step_starts_after_latest_measurement());
+    assert_eq!(RememberedDisplacement::of(&previous, &Displacement::new(DVec2::ONE)), None);
+}

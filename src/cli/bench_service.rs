@@ -26,6 +26,7 @@ use primm_service::latency::summarise;
 use primm_service::latency_files::{
     read_interval_log, LatencyFiles, LatencyFilesError, ReadLogError, StageDescription, OUTPUT_UNIT,
 };
+use primm_service::realtime::TrackerRealtimeArgs;
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::Sequence;
 use std::ffi::OsString;
@@ -50,6 +51,10 @@ pub struct TrackerSettings {
     /// Let the tracker spin on its input instead of sleeping until notified.
     #[arg(long)]
     pub busy_poll: bool,
+    /// The tracker's real-time settings (docs/realtime-tuning.md); the benchmark's own client
+    /// threads stay unpinned.
+    #[command(flatten)]
+    pub realtime: TrackerRealtimeArgs,
 }
 
 impl TrackerSettings {
@@ -63,6 +68,7 @@ impl TrackerSettings {
         if self.busy_poll {
             arguments.push("--busy-poll".into());
         }
+        arguments.extend(self.realtime.to_arguments().into_iter().map(OsString::from));
         arguments
     }
 
@@ -534,6 +540,7 @@ mod tests {
             tracker: TrackerArgs { engine: Some(InferenceEngine::Tract), ..TrackerArgs::default() },
             inference_threads: Some(2),
             busy_poll: true,
+            realtime: TrackerRealtimeArgs::default(),
         };
         let arguments: Vec<String> = settings
             .serve_arguments()
@@ -543,6 +550,45 @@ mod tests {
         assert_eq!(
             arguments,
             ["--method", "pr-imm", "--engine", "tract", "--inference-threads", "2", "--busy-poll"]
+        );
+    }
+
+    #[test]
+    fn real_time_settings_are_passed_on_to_the_tracker() {
+        let settings = TrackerSettings {
+            method: Method::Imm,
+            tracker: TrackerArgs::default(),
+            inference_threads: None,
+            busy_poll: false,
+            realtime: TrackerRealtimeArgs {
+                thread: primm_service::realtime::RealtimeArgs {
+                    cpu_affinity: Some("1".parse().unwrap()),
+                    realtime_priority: Some(50),
+                    lock_memory: true,
+                    require_realtime: true,
+                },
+                inference_cpu_affinity: Some("0-1".parse().unwrap()),
+            },
+        };
+        let arguments: Vec<String> = settings
+            .serve_arguments()
+            .iter()
+            .map(|argument| argument.to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(
+            arguments,
+            [
+                "--method",
+                "imm",
+                "--cpu-affinity",
+                "1",
+                "--inference-cpu-affinity",
+                "0,1",
+                "--realtime-priority",
+                "50",
+                "--lock-memory",
+                "--require-realtime"
+            ]
         );
     }
 }

@@ -208,16 +208,17 @@ fn box_over_heading(
     heading_std_rad: f64,
     position_variance_m2: f64,
 ) -> ExpectedReflection {
-    let at = |angle: f64| {
-        let (sin, cos) = math::sin_cos(angle);
-        let turned = DVec2::new(heading.x * cos - heading.y * sin, heading.x * sin + heading.y * cos);
-        box_reflection(extent, to_sensor, turned, position_variance_m2)
-    };
+    let centre = box_reflection(extent, to_sensor, heading, position_variance_m2);
     if !(heading_std_rad > 1e-9) {
-        return at(0.0);
+        return centre;
     }
-    let step = 1.732_050_807_568_877_2 * heading_std_rad;
-    mixture(&[(2.0 / 3.0, at(0.0)), (1.0 / 6.0, at(step)), (1.0 / 6.0, at(-step))])
+    // One sine and cosine serve both turns: sin(−a) = −sin(a), cos(−a) = cos(a).
+    let (sin, cos) = math::sin_cos(1.732_050_807_568_877_2 * heading_std_rad);
+    let turned = |sin: f64| {
+        let heading = DVec2::new(heading.x * cos - heading.y * sin, heading.x * sin + heading.y * cos);
+        box_reflection(extent, to_sensor, heading, position_variance_m2)
+    };
+    mixture(&[(2.0 / 3.0, centre), (1.0 / 6.0, turned(sin)), (1.0 / 6.0, turned(-sin))])
 }
 
 /// The mean and covariance (with the spread of the means) of a mixture of reflections.

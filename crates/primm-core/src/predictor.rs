@@ -17,6 +17,13 @@
 //! previous frame and `f(t_k) − f(t_{k−1})` otherwise, so the PR prior stays
 //! `z_latest + f(t_k)` however many frames the track coasts ([`PredictionRequest::at_time`]
 //! builds the input for `f(t_{k−1})`).
+//!
+//! That second prediction is not new work: a track that was not measured in the previous frame
+//! has the same history as then, and the previous frame asked for `f(t_{k−1})` already. A
+//! predictor that returns `f(t_k)` with its answer ([`Displacement::from_latest_m`]) gets it back
+//! the next frame as [`PredictionRequest::step_start_displacement_m`]: the tracker keeps it per
+//! track ([`RememberedDisplacement`]) while the history stays the same, and the predictor needs
+//! one model row for a coasting track instead of two.
 
 use alloc::boxed::Box;
 use alloc::string::String;
@@ -59,6 +66,12 @@ pub struct PredictionRequest {
     /// displacement is added to lives (not a model input). Never earlier than the latest
     /// history measurement; equal to it when the track was measured in the previous frame.
     pub step_start_s: f64,
+    /// The displacement from the latest measurement to `step_start_s`, `f(t_{k−1})`, as this
+    /// predictor answered it for the same track and history in the previous frame; `None` when
+    /// it is not known (not a model input). Set only when the step starts after the latest
+    /// measurement. A predictor of `f(t)` may answer `f(t_k)` minus this instead of predicting
+    /// `f(t_{k−1})` again; one that ignores it answers as without it.
+    pub step_start_displacement_m: Option<DVec2>,
 }
 
 impl PredictionRequest {
@@ -92,6 +105,13 @@ impl PredictionRequest {
         self
     }
 
+    /// The same request with `f(t_{k−1})` from `remembered`, if that is the previous frame's
+    /// answer for this history and step start ([`RememberedDisplacement::serves`]).
+    pub fn with_remembered_step_start(mut self, remembered: Option<&RememberedDisplacement>) -> Self {
+        self.step_start_displacement_m = remembered.and_then(|remembered| remembered.serves(&self));
+        self
+    }
+
     /// Whether the step starts after the latest measurement, i.e. the track was not measured in
     /// the previous frame and the displacement is a difference of two predictions.
     pub fn step_starts_after_latest_measurement(&self) -> bool {
@@ -121,17 +141,71 @@ pub struct Displacement {
     /// `predictor.process_noise = "learned"`, it is the PR mode's `Q_PR` of this track and step
     /// (`eq:pr_cov`); otherwise the configured constant `Q_PR` is used.
     pub covariance_m2: Option<DMat2>,
+    /// The displacement from the request's latest measurement to its prediction time, `f(t_k)`,
+    /// m, from a predictor that computes it (`None` otherwise): the tracker remembers it for the
+    /// next frame ([`RememberedDisplacement`]). Equal to `mean_m` when the step starts at the
+    /// latest measurement.
+    pub from_latest_m: Option<DVec2>,
 }
 
 impl Displacement {
     /// A displacement without an uncertainty.
     pub fn new(mean_m: DVec2) -> Self {
-        Self { mean_m, covariance_m2: None }
+        Self { mean_m, covariance_m2: None, from_latest_m: None }
     }
 
     /// A displacement with the model's covariance of its error.
     pub fn with_covariance(mean_m: DVec2, covariance_m2: DMat2) -> Self {
-        Self { mean_m, covariance_m2: Some(covariance_m2) }
+        Self { mean_m, covariance_m2: Some(covariance_m2), from_latest_m: None }
+    }
+
+    /// The same displacement, telling `f(t_k)` (see [`from_latest_m`](Self::from_latest_m)).
+    pub fn with_from_latest(mut self, from_latest_m: DVec2) -> Self {
+        self.from_latest_m = Some(from_latest_m);
+        self
+    }
+}
+
+/// A predictor's `f(t)` for one track, kept by the tracker for the next frame: the displacement
+/// from the latest measurement of a history to a prediction time, with what identifies that
+/// history. A small `Copy` value in each track.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RememberedDisplacement {
+    /// Time of the history's latest measurement, s.
+    pub anchor_time_s: f64,
+    /// Position of that measurement, m (in the tracking frame: a change of frame moves it, and
+    /// the remembered answer no longer serves).
+    pub anchor_m: DVec2,
+    /// Number of measurements in the history.
+    pub len: usize,
+    /// The time the displacement reaches, s.
+    pub prediction_time_s: f64,
+    /// The displacement from the latest measurement to `prediction_time_s`, m.
+    pub from_latest_m: DVec2,
+}
+
+impl RememberedDisplacement {
+    /// What `answer` tells about `request`'s history, if it tells `f(t_k)`.
+    pub fn of(request: &PredictionRequest, answer: &Displacement) -> Option<Self> {
+        let from_latest_m = answer.from_latest_m.filter(|d| d.is_finite())?;
+        Some(Self {
+            anchor_time_s: request.anchor_time_s,
+            anchor_m: request.anchor_m,
+            len: request.len,
+            prediction_time_s: request.prediction_time_s,
+            from_latest_m,
+        })
+    }
+
+    /// `f(t_{k−1})` for `request`: the remembered displacement, if `request` starts its step
+    /// after its latest measurement, at the time this one reaches, from the same history.
+    pub fn serves(&self, request: &PredictionRequest) -> Option<DVec2> {
+        let same = request.step_starts_after_latest_measurement()
+            && self.prediction_time_s == request.step_start_s
+            && self.anchor_time_s == request.anchor_time_s
+            && self.anchor_m == request.anchor_m
+            && self.len == request.len;
+        same.then_some(self.from_latest_m)
     }
 }
 

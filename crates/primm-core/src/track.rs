@@ -4,7 +4,7 @@
 use crate::imm::{ImmState, ModeProbabilities};
 use crate::measurement::{Measurement, ObjectClass};
 use crate::pose::RigidTransform;
-use crate::predictor::{HistoryEntry, MAX_HISTORY};
+use crate::predictor::{HistoryEntry, RememberedDisplacement, MAX_HISTORY};
 use glam::{DMat2, DMat4, DVec2};
 use heapless::HistoryBuf;
 
@@ -90,6 +90,9 @@ pub struct Track {
     pub duplicate_of: Option<u64>,
     /// See [`duplicate_of`](Self::duplicate_of).
     pub exclusive_updates: u32,
+    /// The learned predictor's latest `f(t)` for this track's history, reused as `f(t_{k−1})`
+    /// when the track is not measured (see [`crate::predictor`], "Which displacement").
+    pub remembered_displacement: Option<RememberedDisplacement>,
 }
 
 impl Track {
@@ -118,15 +121,18 @@ impl Track {
             ground_truth_id: measurement.ground_truth_id,
             duplicate_of: None,
             exclusive_updates: 0,
+            remembered_displacement: None,
         };
         track.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
         track
     }
 
     /// Moves the track into another frame: its state (see [`ImmState::transformed`]) and the
-    /// positions of its measurement history.
+    /// positions of its measurement history. The remembered learned displacement is dropped:
+    /// it was predicted in the old frame.
     pub fn transform(&mut self, transform: &RigidTransform) {
         self.estimate = self.estimate.transformed(transform);
+        self.remembered_displacement = None;
         let mut entries = [HistoryEntry::default(); MAX_HISTORY];
         let mut len = 0;
         for entry in self.history.oldest_ordered() {

@@ -150,6 +150,7 @@ impl FuzzDisplacement {
             covariance_m2: self.covariance.map(|[xx, yx, xy, yy]| {
                 DMat2::from_cols(DVec2::new(xx.value(), yx.value()), DVec2::new(xy.value(), yy.value()))
             }),
+            from_latest_m: None,
         }
     }
 }

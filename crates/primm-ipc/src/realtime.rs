@@ -456,6 +456,27 @@ impl TrackerRealtimeArgs {
             ..self.thread.settings()
         }
     }
+
+    /// The same options as command-line arguments (for starting a `primm serve` with them).
+    pub fn to_arguments(&self) -> Vec<String> {
+        let mut arguments = Vec::new();
+        if let Some(cpus) = &self.thread.cpu_affinity {
+            arguments.extend(["--cpu-affinity".to_string(), cpus.to_string()]);
+        }
+        if let Some(cpus) = &self.inference_cpu_affinity {
+            arguments.extend(["--inference-cpu-affinity".to_string(), cpus.to_string()]);
+        }
+        if let Some(priority) = self.thread.realtime_priority {
+            arguments.extend(["--realtime-priority".to_string(), priority.to_string()]);
+        }
+        if self.thread.lock_memory {
+            arguments.push("--lock-memory".to_string());
+        }
+        if self.thread.require_realtime {
+            arguments.push("--require-realtime".to_string());
+        }
+        arguments
+    }
 }
 
 #[cfg(test)]

@@ -41,8 +41,9 @@
 
 use super::assignment::{AssignmentError, AssignmentSolver};
 use super::cost::{association_cost, LikelihoodPrior};
+use super::reflection_memo::{ReflectionMemo, RowReflection, REFLECTION_MEMO_SENSORS};
 use crate::config::{AssociationCost, AssociationStages, Config};
-use crate::extent::{expected_reflection, ExpectedReflection, ExtentConfig, ObjectPrior};
+use crate::extent::{expected_reflection, ExpectedReflection, ExtentConfig};
 use crate::imm::ImmPrior;
 use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::track::Track;
@@ -104,6 +105,12 @@ pub struct Associator {
     row_to_column: Box<[Option<usize>]>,
     /// Whether each measurement of the frame was assigned in an earlier stage.
     taken: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// The expected reflections of each local row's track, per sensor position, of the
+    /// current stage (extended classes only).
+    row_reflections: Box<[ReflectionMemo<RowReflection, REFLECTION_MEMO_SENSORS>]>,
+    /// Per track of the table: the expected reflection of its assigned measurement's sensor,
+    /// where gating computed it.
+    assigned_reflections: Box<[Option<ExpectedReflection>]>,
     stats: AssociationStats,
 }
 
@@ -152,6 +159,8 @@ impl Associator {
             local_column: vec![0; MAX_MEASUREMENTS_PER_FRAME].into_boxed_slice(),
             row_to_column: vec![None; MAX_TRACKS].into_boxed_slice(),
             taken: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
+            row_reflections: vec![ReflectionMemo::new(); MAX_TRACKS].into_boxed_slice(),
+            assigned_reflections: vec![None; MAX_TRACKS].into_boxed_slice(),
             stats: AssociationStats::default(),
         }
     }
@@ -173,6 +182,7 @@ impl Associator {
         track_to_measurement: &mut [Option<u16>],
     ) -> Result<(), AssignmentError> {
         track_to_measurement[..tracks.len()].fill(None);
+        self.assigned_reflections[..tracks.len()].fill(None);
         self.stats = AssociationStats::default();
         self.taken[..frame.len()].fill(false);
         let stages: &[Stage] = match config.association.stages {
@@ -242,12 +252,26 @@ impl Associator {
         }
         self.cluster();
         self.solve_clusters(track_to_measurement)?;
-        for &track_index in self.rows.iter() {
-            if let Some(column) = track_to_measurement[usize::from(track_index)] {
-                self.taken[usize::from(column)] = true;
+        let extended = extent_of(config, class).is_some();
+        for (r, &track_index) in self.rows.iter().enumerate() {
+            if let Some(index) = track_to_measurement[usize::from(track_index)] {
+                self.taken[usize::from(index)] = true;
+                if extended {
+                    let sensor = sensors[usize::from(index)].0;
+                    self.assigned_reflections[usize::from(track_index)] =
+                        self.row_reflections[r].find(sensor).map(|entry| entry.reflection);
+                }
             }
         }
         Ok(())
+    }
+
+    /// The expected reflection of track `track`'s object for the sensor of the measurement
+    /// the last [`associate`](Self::associate) assigned to it, as gating computed it (exactly
+    /// [`expected_reflection`] of its prior); `None` for a point class, an unassigned track, or
+    /// a reflection the memo did not hold.
+    pub fn assigned_reflection(&self, track: usize) -> Option<ExpectedReflection> {
+        self.assigned_reflections.get(track).copied().flatten()
     }
 
     /// Statistics of the last call to [`associate`](Self::associate).
@@ -277,7 +301,7 @@ impl Associator {
             let prior = &priors[usize::from(track_index)];
             let centre = prior.fused.mean;
             let object = extent.map(|_| prior.object_prior());
-            let mut reflections = ReflectionMemo::new();
+            self.row_reflections[r] = ReflectionMemo::new();
             let first = self.sorted_x.partition_point(|&(x, _)| x < centre.x - window);
             for &(x, column) in &self.sorted_x[first..] {
                 if x > centre.x + window {
@@ -289,7 +313,12 @@ impl Associator {
                 };
                 let expected = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        centre + reflections.get(extent, object, sensors[index].0).offset_m
+                        let sensor = sensors[index].0;
+                        let entry = self.row_reflections[r].get(sensor, || RowReflection {
+                            reflection: expected_reflection(extent, object, sensor),
+                            prepared: None,
+                        });
+                        centre + entry.reflection.offset_m
                     }
                     _ => centre,
                 };
@@ -337,7 +366,7 @@ impl Associator {
             );
             let Some(prepared) = prepared else { continue };
             let object = extent.map(|_| priors[usize::from(track_index)].object_prior());
-            let mut reflections = ReflectionMemo::new();
+            self.row_reflections[r] = ReflectionMemo::new();
             let (x, half) = (
                 prepared.mean_m().x,
                 match extent {
@@ -358,8 +387,14 @@ impl Associator {
                 };
                 let cost = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        let reflection = reflections.get(extent, object, sensors[index].0);
-                        prepared.cost_of_reflection(&measurement, &reflection)
+                        let sensor = sensors[index].0;
+                        let entry = self.row_reflections[r].get(sensor, || {
+                            let reflection = expected_reflection(extent, object, sensor);
+                            RowReflection { reflection, prepared: prepared.prepare_reflection(&reflection) }
+                        });
+                        entry.prepared.and_then(|reflection| {
+                            prepared.cost_of_prepared_reflection(&measurement, &reflection)
+                        })
                     }
                     _ => prepared.cost(&measurement),
                 };
@@ -485,71 +520,4 @@ fn union(parent: &mut [u16], a: usize, b: usize) {
 fn extent_of(config: &Config, class: ObjectClass) -> Option<&ExtentConfig> {
     let extent = &config.classes.get(class).extent;
     extent.enabled.then_some(extent)
-}
-
-/// The expected reflections of one track, per sensor position: the reflection depends on the
-/// track's prior and the sensor, not on the measurement, so each is computed once per track and
-/// sensor instead of once per candidate pair. On the stack; with more sensor positions than it
-/// holds, the rest are computed per pair (the same values).
-struct ReflectionMemo {
-    entries: [(DVec2, ExpectedReflection); REFLECTION_MEMO_SENSORS],
-    len: usize,
-}
-
-/// Sensor positions [`ReflectionMemo`] holds (a car carries four to six radars).
-const REFLECTION_MEMO_SENSORS: usize = 8;
-
-impl ReflectionMemo {
-    fn new() -> Self {
-        ReflectionMemo {
-            entries: [(DVec2::ZERO, ExpectedReflection::default()); REFLECTION_MEMO_SENSORS],
-            len: 0,
-        }
-    }
-
-    /// [`expected_reflection`] of `object` seen from `sensor_m`, computed at most once per
-    /// position (compared bit for bit, so the answer is exactly the function's).
-    fn get(&mut self, extent: &ExtentConfig, object: &ObjectPrior, sensor_m: DVec2) -> ExpectedReflection {
-        let same = |position: DVec2| {
-            position.x.to_bits() == sensor_m.x.to_bits() && position.y.to_bits() == sensor_m.y.to_bits()
-        };
-        if let Some((_, reflection)) = self.entries[..self.len].iter().find(|(position, _)| same(*position)) {
-            return *reflection;
-        }
-        let reflection = expected_reflection(extent, object, sensor_m);
-        if self.len < REFLECTION_MEMO_SENSORS {
-            self.entries[self.len] = (sensor_m, reflection);
-            self.len += 1;
-        }
-        reflection
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::DMat2;
-
-    #[test]
-    fn the_reflection_memo_answers_exactly_what_the_model_computes_also_past_its_capacity() {
-        let extent = ExtentConfig { enabled: true, offset_scale: 0.5, ..ExtentConfig::default() };
-        let object = ObjectPrior {
-            centre_m: DVec2::new(20.0, 3.0),
-            centre_covariance_m2: DMat2::from_diagonal(DVec2::new(0.3, 0.2)),
-            velocity_mps: DVec2::new(8.0, 1.0),
-            velocity_covariance_m2: DMat2::from_diagonal(DVec2::new(0.5, 0.4)),
-        };
-        let mut memo = ReflectionMemo::new();
-        // Twelve sensor positions, each asked for three times in an interleaved order: more
-        // positions than the memo holds, and repeats both of held and of unheld ones.
-        let sensors: [DVec2; 12] =
-            core::array::from_fn(|k| DVec2::new(-2.0 + 0.4 * k as f64, [0.8, -0.8][k % 2]));
-        for round in 0..3 {
-            for k in 0..sensors.len() {
-                let sensor = sensors[(k + round * 5) % sensors.len()];
-                assert_eq!(memo.get(&extent, &object, sensor), expected_reflection(&extent, &object, sensor));
-            }
-        }
-        assert_eq!(memo.len, REFLECTION_MEMO_SENSORS);
-    }
 }

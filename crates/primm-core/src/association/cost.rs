@@ -36,6 +36,15 @@ pub struct LikelihoodPrior {
     x_half_window_m: f64,
 }
 
+/// An expected reflection prepared for one track's likelihood cost
+/// ([`LikelihoodPrior::prepare_reflection`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PreparedReflection {
+    offset_m: DVec2,
+    inverse_m2: DMat2,
+    log_determinant: f64,
+}
+
 impl LikelihoodPrior {
     /// The prepared prior of a track with fused prior `prior`, the class's measurement noise
     /// `measurement_noise_m2` and radial-velocity residual spread, and the χ² gate. `None` when
@@ -98,13 +107,38 @@ impl LikelihoodPrior {
         measurement: &Measurement,
         reflection: &ExpectedReflection,
     ) -> Option<f64> {
+        self.cost_of_prepared_reflection(measurement, &self.prepare_reflection(reflection)?)
+    }
+
+    /// What [`cost_of_reflection`](Self::cost_of_reflection) needs of a reflection whatever the
+    /// measurement: `S + C` inverted and its log-determinant, once per track and sensor instead
+    /// of once per pair. `None` when `S + C` is not positive definite.
+    pub fn prepare_reflection(&self, reflection: &ExpectedReflection) -> Option<PreparedReflection> {
         let covariance = self.innovation_covariance_m2 + reflection.covariance_m2;
         let determinant = covariance.determinant();
         if !(determinant > 0.0 && determinant.is_finite()) {
             return None;
         }
+        Some(PreparedReflection {
+            offset_m: reflection.offset_m,
+            inverse_m2: covariance.inverse(),
+            log_determinant: math::ln(determinant),
+        })
+    }
+
+    /// [`cost_of_reflection`](Self::cost_of_reflection) with the reflection prepared: the same
+    /// value, bit for bit.
+    pub fn cost_of_prepared_reflection(
+        &self,
+        measurement: &Measurement,
+        reflection: &PreparedReflection,
+    ) -> Option<f64> {
         let innovation = measurement.position() - self.mean_m - reflection.offset_m;
-        self.gated(measurement, innovation.dot(covariance.inverse() * innovation), math::ln(determinant))
+        self.gated(
+            measurement,
+            innovation.dot(reflection.inverse_m2 * innovation),
+            reflection.log_determinant,
+        )
     }
 
     /// The cost from the squared position distance: the radial-velocity term added, gated.

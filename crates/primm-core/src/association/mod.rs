@@ -3,3 +3,4 @@
 pub mod assignment;
 pub mod associator;
 pub mod cost;
+pub mod reflection_memo;

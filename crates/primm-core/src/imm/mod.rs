@@ -224,6 +224,7 @@ impl Imm {
         let displacement = context.displacement_m.map(|mean_m| Displacement {
             mean_m,
             covariance_m2: context.displacement_covariance_m2.as_ref().map(to_glam),
+            from_latest_m: None,
         });
         self.complete_prior_in_place(models, &mut prior, context.dt_s, displacement);
         prior

@@ -7,7 +7,7 @@ use crate::config::{LearnedProcessNoise, PredictorConfig};
 use crate::displacement_check::{check_answer, DisplacementRejection};
 use crate::existence;
 use crate::mode::Mode;
-use crate::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
+use crate::predictor::{Displacement, DisplacementPredictor, PredictionRequest, RememberedDisplacement};
 use crate::track_loops;
 
 impl<P: DisplacementPredictor> Tracker<P> {
@@ -30,8 +30,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
             window[..older.len()].copy_from_slice(older);
             window[older.len()..len].copy_from_slice(newer);
             let step_start = self.last_timestamp_s.unwrap_or(t);
-            self.requests
-                .push(PredictionRequest::from_history(&window[..len], t).with_step_start(step_start));
+            self.requests.push(
+                PredictionRequest::from_history(&window[..len], t)
+                    .with_step_start(step_start)
+                    .with_remembered_step_start(track.remembered_displacement.as_ref()),
+            );
             // The table holds at most MAX_TRACKS (512) rows, so the row fits in u16.
             self.requested_rows.push(row as u16);
         }
@@ -90,8 +93,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         self.last_step.predictions_missing = answers.iter().filter(|answer| answer.is_none()).count();
-        for (answer, &row) in answers.iter().zip(self.requested_rows.iter()) {
-            self.displacements[usize::from(row)] = *answer;
+        let tracks = self.table.tracks_mut();
+        for ((answer, request), &row) in
+            answers.iter().zip(self.requests.iter()).zip(self.requested_rows.iter())
+        {
+            let row = usize::from(row);
+            self.displacements[row] = *answer;
+            tracks[row].remembered_displacement =
+                answer.as_ref().and_then(|answer| RememberedDisplacement::of(request, answer));
         }
     }
 }

@@ -41,10 +41,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Kalman and mode-probability update of every assigned track.
-    pub(super) fn update(&mut self, t: f64) {
-        let count = self.table.len();
-        for i in 0..count {
+    /// Each assigned track's measurement, its radar's position and the expected reflection
+    /// there; a track whose measurement does not read back is left unassigned.
+    fn read_assignment(&mut self) {
+        for i in 0..self.table.len() {
             // An accepted measurement always reads back; if one did not, the track coasts rather
             // than keep a stale state.
             self.assigned_measurements[i] =
@@ -57,13 +57,23 @@ impl<P: DisplacementPredictor> Tracker<P> {
             };
             let (sensor_m, mounted) = self.measurement_sensors[usize::from(index)];
             self.assigned_sensor_positions[i] = sensor_m;
-            let reflection = self.expected_reflection(i, sensor_m);
+            // Gating computed it already, for the same prior and sensor.
+            let reflection = self
+                .associator
+                .assigned_reflection(i)
+                .unwrap_or_else(|| self.expected_reflection(i, sensor_m));
             self.assigned_reflections[i] = reflection;
             let models = &self.models[measurement.class.index()];
             if !mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
                 self.last_step.updates_from_unknown_sensor += 1;
             }
         }
+    }
+
+    /// Kalman and mode-probability update of every assigned track.
+    pub(super) fn update(&mut self, t: f64) {
+        let count = self.table.len();
+        self.read_assignment();
         track_loops::update(
             &self.imms,
             &self.models,

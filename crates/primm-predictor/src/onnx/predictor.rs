@@ -9,8 +9,11 @@
 //! The model answers `f(t)`: the displacement from a track's latest measurement to time `t`. The
 //! tracker needs the displacement over its step `[step_start_s, prediction_time_s]` (see the
 //! [`primm_core::predictor`] documentation): `f(t_k)` when the track was measured in the previous frame,
-//! `f(t_k) − f(t_{k−1})` otherwise. [`OnnxPredictor`] evaluates both rows in the same batch, so a
-//! frame in which `n` of `N` tracks coasted runs a batch of `N + n` rows. Each request's
+//! `f(t_k) − f(t_{k−1})` otherwise. Where the request brings `f(t_{k−1})` from the previous
+//! frame ([`PredictionRequest::step_start_displacement_m`]), [`OnnxPredictor`] subtracts that;
+//! otherwise it evaluates both rows in the same batch, so a frame in which `n` of `N` tracks
+//! coasted without it runs a batch of `N + n` rows. Every answer tells its `f(t_k)`
+//! ([`Displacement::from_latest_m`]), which the tracker hands back the next frame. Each request's
 //! positions go in rotated onto its latest motion ([`InputRotation`]), and its displacement
 //! comes out rotated back.
 
@@ -21,6 +24,17 @@ use primm_config::InferenceEngine;
 use primm_core::limits::MAX_TRACKS;
 use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest, FEATURES, MAX_HISTORY};
 use std::path::Path;
+
+/// Where a request's step starts, for turning `f(t_k)` into the step's displacement.
+#[derive(Debug, Clone, Copy)]
+enum StepStart {
+    /// At the latest measurement: the displacement is `f(t_k)`.
+    Latest,
+    /// Later, with `f(t_{k−1})` in this model row of the batch.
+    Row(usize),
+    /// Later, with `f(t_{k−1})` known from the previous frame (request frame), m.
+    Known(DVec2),
+}
 
 /// Counters of an [`OnnxPredictor`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
@@ -48,9 +62,9 @@ pub struct OnnxPredictor {
     output: Vec<f32>,
     /// The covariance output of the last batch (empty for a model without one).
     cholesky: Vec<f32>,
-    /// Model row of each request (`None`: refused), of its step-start row if it has one, and
-    /// the request's input rotation.
-    rows: Vec<(Option<usize>, Option<usize>, InputRotation)>,
+    /// Model row of each request (`None`: refused), where its step starts, and the request's
+    /// input rotation.
+    rows: Vec<(Option<usize>, StepStart, InputRotation)>,
     results: Vec<Option<Displacement>>,
     stats: OnnxPredictorStats,
     last_error: Option<InferenceError>,
@@ -110,6 +124,42 @@ impl OnnxPredictor {
         self.last_error.as_ref()
     }
 
+    /// Lays out the model rows of `requests` (see [`predict_batch`](Self::predict_batch)) in the
+    /// input buffers and `rows`; returns how many there are.
+    fn lay_out_rows(&mut self, requests: &[PredictionRequest]) -> usize {
+        self.features.clear();
+        self.valid.clear();
+        self.rows.clear();
+        let mut row_count = 0;
+        for request in requests {
+            let rotation = InputRotation::of(request);
+            let row = push_row(request, &rotation, &mut self.features, &mut self.valid).then(|| {
+                row_count += 1;
+                row_count - 1
+            });
+            self.stats.invalid_requests += u64::from(row.is_none());
+            self.rows.push((row, StepStart::Latest, rotation));
+        }
+        for (request, rows) in requests.iter().zip(self.rows.iter_mut()) {
+            if rows.0.is_none() || !request.step_starts_after_latest_measurement() {
+                continue;
+            }
+            if let Some(known) = request.step_start_displacement_m.filter(|known| known.is_finite()) {
+                rows.1 = StepStart::Known(known);
+                continue;
+            }
+            let shifted = request.at_time(request.step_start_s);
+            if push_row(&shifted, &rows.2, &mut self.features, &mut self.valid) {
+                rows.1 = StepStart::Row(row_count);
+                row_count += 1;
+            } else {
+                rows.0 = None;
+                self.stats.invalid_requests += 1;
+            }
+        }
+        row_count
+    }
+
     /// Runs the model on `requests` and writes each request's step displacement (see the
     /// [module documentation](self)) to `displacements` (same length): `None` for a refused
     /// request or a non-finite output. On an inference failure every entry is `None` and the
@@ -127,31 +177,7 @@ impl OnnxPredictor {
         displacements: &mut [Option<Displacement>],
     ) -> Result<(), InferenceError> {
         displacements.fill(None);
-        self.features.clear();
-        self.valid.clear();
-        self.rows.clear();
-        let mut row_count = 0;
-        for request in requests {
-            let rotation = InputRotation::of(request);
-            let row = push_row(request, &rotation, &mut self.features, &mut self.valid).then(|| {
-                row_count += 1;
-                row_count - 1
-            });
-            self.stats.invalid_requests += u64::from(row.is_none());
-            self.rows.push((row, None, rotation));
-        }
-        for (request, rows) in requests.iter().zip(self.rows.iter_mut()) {
-            if rows.0.is_some() && request.step_starts_after_latest_measurement() {
-                let shifted = request.at_time(request.step_start_s);
-                if push_row(&shifted, &rows.2, &mut self.features, &mut self.valid) {
-                    rows.1 = Some(row_count);
-                    row_count += 1;
-                } else {
-                    rows.0 = None;
-                    self.stats.invalid_requests += 1;
-                }
-            }
-        }
+        let row_count = self.lay_out_rows(requests);
         if row_count == 0 {
             return Ok(());
         }
@@ -179,15 +205,18 @@ impl OnnxPredictor {
         };
         for (out, &(row, start_row, rotation)) in displacements.iter_mut().zip(&self.rows) {
             let Some(row) = row else { continue };
-            let displacement = rotation.from_model(match start_row {
-                Some(start_row) => at(row) - at(start_row),
-                None => at(row),
-            });
-            if displacement.is_finite() {
+            let from_latest = rotation.from_model(at(row));
+            let displacement = match start_row {
+                StepStart::Latest => from_latest,
+                StepStart::Row(start_row) => rotation.from_model(at(row) - at(start_row)),
+                StepStart::Known(known) => from_latest - known,
+            };
+            if displacement.is_finite() && from_latest.is_finite() {
                 *out = Some(Displacement {
                     mean_m: displacement,
                     covariance_m2: covariance_at(row)
                         .map(|covariance| rotation.covariance_from_model(covariance)),
+                    from_latest_m: Some(from_latest),
                 });
                 self.stats.predictions += 1;
             } else {
