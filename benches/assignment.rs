@@ -92,7 +92,14 @@ fn association_scene(
         };
         let mut prior = imm.predict(&models, &state, &context);
         prior.fused.mean = glam::DVec2::new(measurement.x_m + 0.3, measurement.y_m - 0.2);
-        tracks.push(primm_core::track::Track::new(i as u64, &measurement, 0.0, state, 0.5));
+        tracks.push(primm_core::track::Track::new(
+            i as u64,
+            &measurement,
+            glam::DVec2::ZERO,
+            0.0,
+            state,
+            0.5,
+        ));
         priors.push(prior);
         frame.measurements.push(measurement);
     }

@@ -92,6 +92,7 @@ fn predictor_frame_on(c: &mut Criterion, engine: InferenceEngine) {
                         radial_velocity_mps: -6.0,
                         rcs_dbsm: 7.0,
                         timestamp_s: t - 0.02 - 0.03 * (MAX_HISTORY - 1 - l) as f64,
+                        ..Default::default()
                     })
                     .collect();
                 let step_start = if i % 2 == 0 { t - 0.02 } else { t - 0.01 };

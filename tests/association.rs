@@ -55,7 +55,7 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
             &PredictContext { dt_s: 0.05, displacement_m: None, displacement_covariance_m2: None },
         );
         prior.fused.mean = measurement(rng, spots[i % spots.len()], spread, class).position();
-        tracks.push(Track::new(i as u64, &first, 0.0, state, 0.5));
+        tracks.push(Track::new(i as u64, &first, glam::DVec2::ZERO, 0.0, state, 0.5));
         priors.push(prior);
     }
     let mut frame = Frame::new(0.05);
@@ -190,7 +190,7 @@ fn tracks_far_apart_are_paired_without_the_solver() {
             &PredictContext { dt_s: 0.05, displacement_m: None, displacement_covariance_m2: None },
         );
         prior.fused.mean = position;
-        tracks.push(Track::new(i, &first, 0.0, state, 0.5));
+        tracks.push(Track::new(i, &first, glam::DVec2::ZERO, 0.0, state, 0.5));
         priors.push(prior);
         frame.measurements.push(Measurement {
             radial_velocity_mps: 1.0,

@@ -6,7 +6,7 @@ use primm_config::InferenceEngine;
 use primm_core::predictor::{
     DisplacementPredictor, HistoryEntry, PredictionRequest, RememberedDisplacement, FEATURES, MAX_HISTORY,
 };
-use primm_predictor::onnx::{InputRotation, ModelError, OnnxPredictor, PrModel};
+use primm_predictor::onnx::{InputFrame, InputRotation, ModelError, OnnxPredictor, PrModel};
 use std::path::{Path, PathBuf};
 
 fn repo_path(relative: &str) -> PathBuf {
@@ -180,7 +180,15 @@ fn the_valid_rows_matter() {
     moved[0][0] -= 2.0; // the oldest measurement 2 m further back along x
     let mut out = [0.0f32; 2];
     model.run(moved.as_flattened(), &mask, &mut out).unwrap();
-    assert!((out[0] - base[0]).abs() > 1e-3, "prediction ignores the history: {base:?} vs {out:?}");
+    // The change is small for the shipped model, whose latest radial velocity along its line of
+    // sight carries most of the motion, but far above the engines' rounding (1e-6 m).
+    let change = (out[0] - base[0]).hypot(out[1] - base[1]);
+    assert!(change > 1e-4, "prediction ignores the history: {base:?} vs {out:?}");
+    // The latest row's radial velocity (x is its line of sight) moves the x displacement.
+    let mut faster = sample;
+    faster[MAX_HISTORY - 1][2] += 2.0;
+    model.run(faster.as_flattened(), &mask, &mut out).unwrap();
+    assert!(out[0] - base[0] > 1e-3, "2 m/s more along the line of sight: {base:?} vs {out:?}");
 }
 
 fn history(points: &[(f64, f64, f64)]) -> Vec<HistoryEntry> {
@@ -192,14 +200,15 @@ fn history(points: &[(f64, f64, f64)]) -> Vec<HistoryEntry> {
             radial_velocity_mps: -3.0,
             rcs_dbsm: 5.0,
             timestamp_s: t,
+            ..Default::default()
         })
         .collect()
 }
 
-/// The model's displacement for one request, with the request rotated onto its latest motion
-/// and the output rotated back, as `OnnxPredictor` does.
+/// The model's displacement for one request, with the request rotated into the model's input
+/// axes and the output rotated back, as `OnnxPredictor` does.
 fn run_one(model: &mut PrModel, request: &PredictionRequest) -> DVec2 {
-    let rotation = InputRotation::of(request);
+    let rotation = InputRotation::of(request, model.input_frame());
     let mut features = request.features;
     for row in &mut features[..request.len] {
         let position = rotation.to_model(DVec2::new(f64::from(row[0]), f64::from(row[1])));
@@ -246,9 +255,80 @@ fn a_rotated_history_gets_the_rotated_displacement() {
         let difference = covariance.abs_diff_eq(expected_covariance, 1e-5);
         assert!(difference, "at {angle} rad: {covariance} vs {expected_covariance}");
     }
-    // Without a direction of motion (one measurement) the input goes in unrotated.
+    // One measurement has a line of sight but no direction of motion; a measurement at its
+    // radar has neither.
     let single = PredictionRequest::from_history(&history(&points[..1]), 0.03);
-    assert_eq!(InputRotation::of(&single), InputRotation::IDENTITY);
+    assert_ne!(InputRotation::of(&single, InputFrame::LineOfSight), InputRotation::IDENTITY);
+    assert_eq!(InputRotation::of(&single, InputFrame::LatestMotion), InputRotation::IDENTITY);
+    let at_radar = PredictionRequest { sensor_m: single.anchor_m, ..single };
+    assert_eq!(InputRotation::of(&at_radar, InputFrame::LineOfSight), InputRotation::IDENTITY);
+}
+
+#[test]
+fn the_shipped_model_takes_its_input_along_the_line_of_sight() {
+    assert_eq!(model().input_frame(), InputFrame::LineOfSight);
+}
+
+#[test]
+fn the_line_of_sight_runs_from_the_radar_to_the_latest_measurement() {
+    let mut entries = history(&[(0.00, 20.0, 3.0), (0.05, 20.0, 3.5)]);
+    // The latest measurement seen by a radar 4 m ahead of it along +y: the line of sight
+    // points along −y whatever the motion (+y here).
+    (entries[1].sensor_x_m, entries[1].sensor_y_m) = (20.0, 7.5);
+    let request = PredictionRequest::from_history(&entries, 0.1);
+    assert_eq!(request.sensor_m, DVec2::new(20.0, 7.5));
+    let along = InputRotation::of(&request, InputFrame::LineOfSight);
+    assert!((along.to_model(DVec2::new(0.0, -1.0)) - DVec2::X).length() < 1e-12);
+    let motion = InputRotation::of(&request, InputFrame::LatestMotion);
+    assert!((motion.to_model(DVec2::new(0.0, 1.0)) - DVec2::X).length() < 1e-12);
+}
+
+/// The answer of a contract fixture (`0.1 ·` the sum of all features on both axes, in its
+/// input axes) for `request`, rotated back from `rotation`.
+fn fixture_answer(request: &PredictionRequest, rotation: InputRotation) -> DVec2 {
+    let mut sum = 0.0;
+    for row in &request.features[..request.len] {
+        let position = rotation.to_model(DVec2::new(f64::from(row[0]), f64::from(row[1])));
+        sum += position.x + position.y + f64::from(row[2]) + f64::from(row[3]) + f64::from(row[4]);
+    }
+    rotation.from_model(DVec2::splat(0.1 * sum))
+}
+
+#[test]
+fn a_request_goes_into_the_input_axes_its_model_names() {
+    let mut entries = history(&[(0.00, 20.0, 3.0), (0.05, 20.4, 3.2), (0.10, 20.8, 3.5)]);
+    (entries[2].sensor_x_m, entries[2].sensor_y_m) = (3.8, 0.7);
+    let request = PredictionRequest::from_history(&entries, 0.15);
+    for (file, frame) in [
+        ("pr_line_of_sight.onnx", InputFrame::LineOfSight),
+        ("pr_latest_motion.onnx", InputFrame::LatestMotion),
+    ] {
+        let mut predictor = OnnxPredictor::load(repo_path(&format!("tests/fixtures/{file}"))).unwrap();
+        assert_eq!(predictor.model().input_frame(), frame, "{file}");
+        let mut out = [None];
+        predictor.predict(&[request], &mut out);
+        let got = out[0].expect("the fixture answers").mean_m;
+        let expected = fixture_answer(&request, InputRotation::of(&request, frame));
+        assert!((got - expected).length() < 1e-4, "{file}: {got} vs {expected}");
+        let other = match frame {
+            InputFrame::LineOfSight => InputFrame::LatestMotion,
+            InputFrame::LatestMotion => InputFrame::LineOfSight,
+        };
+        let wrong = fixture_answer(&request, InputRotation::of(&request, other));
+        assert!((got - wrong).length() > 1e-2, "{file}: the axes make a difference ({got} vs {wrong})");
+    }
+}
+
+#[test]
+fn a_model_naming_an_unknown_input_frame_is_rejected() {
+    let error = PrModel::load(repo_path("tests/fixtures/pr_unknown_input_frame.onnx")).unwrap_err();
+    let ModelError::InputFrame { value, .. } = &error else { panic!("{error:?}") };
+    assert_eq!(value, "sideways");
+    let message = error.to_string();
+    assert!(
+        message.contains("pr_unknown_input_frame.onnx") && message.contains("primm.input_frame"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -12,6 +12,7 @@ fn entries(times: &[f64]) -> Vec<HistoryEntry> {
             radial_velocity_mps: 1.5,
             rcs_dbsm: -3.0,
             timestamp_s: t,
+            ..Default::default()
         })
         .collect()
 }

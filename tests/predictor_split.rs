@@ -145,6 +145,7 @@ fn model_requests(count: usize) -> Vec<PredictionRequest> {
                         radial_velocity_mps: speed * 0.8,
                         rcs_dbsm: 5.0 + (i % 3) as f64,
                         timestamp_s: t,
+                        ..Default::default()
                     }
                 })
                 .collect();

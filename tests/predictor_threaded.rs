@@ -286,6 +286,7 @@ fn the_threaded_onnx_predictor_gives_the_synchronous_results() {
                         radial_velocity_mps: -5.0 + i as f64 * 0.1,
                         rcs_dbsm: 8.0,
                         timestamp_s: t - 0.03 * (5 - l) as f64,
+                        ..Default::default()
                     })
                     .collect();
                 PredictionRequest::from_history(&history, t).with_step_start(t - 0.015)

@@ -15,6 +15,8 @@ use std::path::Path;
 /// One object's measurements in time order: (history entry, true centre), in the world frame.
 fn objects(sequence: &Sequence) -> BTreeMap<u64, Vec<(HistoryEntry, DVec2, ObjectClass)>> {
     let mut objects: BTreeMap<u64, Vec<_>> = BTreeMap::new();
+    // The generator mounts the radars where the tracker's default configuration has them.
+    let coordinates = primm_core::coordinates::CoordinatesConfig::default();
     for frame in &sequence.frames {
         let pose = frame.ego_pose.expect("generated frames carry the ego pose");
         for recorded in &frame.measurements {
@@ -24,6 +26,11 @@ fn objects(sequence: &Sequence) -> BTreeMap<u64, Vec<(HistoryEntry, DVec2, Objec
             };
             let m = &recorded.measurement;
             let position = pose.point_to_world(m.position());
+            let mount = m
+                .sensor_id
+                .and_then(|id| coordinates.sensor(id))
+                .map_or(DVec2::ZERO, |mount| mount.position());
+            let sensor = pose.point_to_world(mount);
             objects.entry(id).or_default().push((
                 HistoryEntry {
                     x_m: position.x,
@@ -31,6 +38,8 @@ fn objects(sequence: &Sequence) -> BTreeMap<u64, Vec<(HistoryEntry, DVec2, Objec
                     radial_velocity_mps: m.radial_velocity_mps,
                     rcs_dbsm: m.rcs_dbsm,
                     timestamp_s: frame.timestamp_s,
+                    sensor_x_m: sensor.x,
+                    sensor_y_m: sensor.y,
                 },
                 pose.point_to_world(truth),
                 m.class,

@@ -56,7 +56,7 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
             &PredictContext { dt_s, displacement_m: None, displacement_covariance_m2: None },
         );
         prior.fused.mean = measurement(rng, spots[i % spots.len()], spread, class).position();
-        let mut track = Track::new(i as u64, &first, 0.0, state, 0.5);
+        let mut track = Track::new(i as u64, &first, glam::DVec2::ZERO, 0.0, state, 0.5);
         if rng.random_bool(0.65) {
             track.status = if rng.random_bool(0.8) { TrackStatus::Confirmed } else { TrackStatus::Coasting };
         }
@@ -254,7 +254,7 @@ fn a_tentative_track_cannot_take_the_measurement_a_confirmed_track_needs() {
         let state = imm.initiate(&models, &first);
         let mut prior = imm.predict(&models, &state, &context);
         prior.fused.mean = DVec2::new(x, 0.0);
-        let mut track = Track::new(id, &first, 0.0, state, 0.5);
+        let mut track = Track::new(id, &first, glam::DVec2::ZERO, 0.0, state, 0.5);
         track.status = status;
         tracks.push(track);
         priors.push(prior);

@@ -14,9 +14,18 @@ carry a pose (``frame="vehicle"`` keeps the vehicle frame; rows without a pose s
 Each window is laid out exactly like ``PredictionRequest`` (``eq:pr_input``): rows ``0..len``
 hold ``[x_l - x_j, y_l - y_j, v_r_l, RCS_l, t_l - tau]``, rows ``len..`` are zero (right
 padding), and ``valid`` marks the rows ``0..len``. Windows are kept in the world frame; before a
-window goes into the model, :func:`motion_frames` and :func:`to_model_frame` rotate it into the
-frame of its latest motion (primm-predictor's ``InputRotation``), and displacements are rotated the
-same way.
+window goes into the model, :func:`input_frames` and :func:`to_model_frame` rotate it into the
+model's input axes (primm-predictor's ``InputRotation``), and displacements are rotated the same
+way. The axes are those of the latest measurement's line of sight (x from the radar that took it
+to the measured position, :func:`line_of_sight_frames`), where the latest radial velocity is the
+velocity's x component, or, for models trained before that, those of the latest motion
+(:func:`motion_frames`).
+
+Each row's radar position comes from its ``sensor_id`` and the sensor mounts of the tracker's
+configuration (``config/primm.toml``, ``[[frame.sensors]]``), mapped with the row's ego pose as
+the tracker maps it; a row without a known mount is seen from the vehicle's reference point.
+An object measured more than once in a scan (an extended object's several reflections) keeps its
+first measurement of that scan: a track is updated by one measurement a frame.
 
 Two displacement labels are kept per window:
 
@@ -35,12 +44,35 @@ from dataclasses import dataclass
 
 import numpy as np
 
+try:
+    import tomllib
+except ModuleNotFoundError:  # Python < 3.11
+    tomllib = None
+
 MAX_HISTORY = 5
 FEATURES = 5
 # Shortest distance between a window's last two measurements that gives it a direction of motion,
 # m (primm-predictor's MIN_HEADING_DISTANCE_M).
 MIN_HEADING_DISTANCE_M = 0.01
 CLASSES = {"car": 0, "pedestrian": 1, "two_wheeler": 2}
+# Shortest distance from a radar to a measurement that gives the measurement a line of sight, m
+# (primm-predictor's MIN_LINE_OF_SIGHT_DISTANCE_M).
+MIN_LINE_OF_SIGHT_DISTANCE_M = 0.01
+# The model input axes a model can be trained in (primm-predictor's InputFrame; the ONNX file
+# names its own in the metadata entry onnx_graph.INPUT_FRAME_KEY).
+INPUT_FRAMES = ("line_of_sight", "latest_motion")
+DEFAULT_CONFIG = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config", "primm.toml")
+
+
+def read_sensor_mounts(path: str = DEFAULT_CONFIG) -> dict[int, tuple[float, float]]:
+    """The position of every configured radar on the vehicle, ``{sensor id: (x_m, y_m)}``, from
+    the ``[[frame.sensors]]`` tables of a tracker configuration file."""
+    if tomllib is None:
+        raise RuntimeError("reading the sensor mounts needs Python 3.11 or newer (tomllib)")
+    with open(path, "rb") as handle:
+        config = tomllib.load(handle)
+    sensors = config.get("frame", {}).get("sensors", [])
+    return {int(s["id"]): (float(s.get("x_m", 0.0)), float(s.get("y_m", 0.0))) for s in sensors}
 
 
 @dataclass
@@ -57,6 +89,7 @@ class Windows:
     previous_measured: np.ndarray  # [N, 2] float32, z_j - z_{j-1} (m), NaN for length 1
     previous_dt_s: np.ndarray  # [N] float64, t_j - t_{j-1}, NaN for length 1
     object_class: np.ndarray  # [N] int64, CLASSES code
+    line_of_sight: np.ndarray  # [N, 2] float64, unit vector from the radar to m_j, NaN if none
     frames_ahead: np.ndarray  # [N] int64, frames (radar scans) from m_j to m_{j+h}
     sequence: np.ndarray  # [N] int64, index of the file in the sorted file list
 
@@ -84,19 +117,38 @@ def to_world(row: dict, x: float, y: float) -> tuple[float, float]:
     return float(row["ego_x"]) + c * x - s * y, float(row["ego_y"]) + s * x + c * y
 
 
-def read_objects(path: str, frame: str = "world") -> list[np.ndarray]:
+def sensor_position(row: dict, mounts: dict[int, tuple[float, float]], frame: str) -> tuple[float, float]:
+    """Where the radar of ``row`` is, as the tracker places it: its mount (the vehicle's
+    reference point without a known mount), in the world frame of the row's pose (``frame="world"``
+    and a pose) or in the vehicle frame."""
+    sensor = row.get("sensor_id", "")
+    x, y = mounts.get(int(sensor), (0.0, 0.0)) if sensor not in ("", None) else (0.0, 0.0)
+    return to_world(row, x, y) if frame == "world" else (x, y)
+
+
+def read_objects(
+    path: str, frame: str = "world", mounts: dict[int, tuple[float, float]] | None = None
+) -> list[np.ndarray]:
     """Per ground-truth object, its measurements in time order as rows
-    ``[t, x, y, vr, rcs, true_x, true_y, class, frame]``, positions in the world frame (or the
-    vehicle frame with ``frame="vehicle"``). Rows without a ground-truth id or a true position
-    are skipped."""
+    ``[t, x, y, vr, rcs, true_x, true_y, class, frame, sensor_x, sensor_y]``, positions (the
+    radar's too) in the world frame (or the vehicle frame with ``frame="vehicle"``), one
+    measurement per object and scan (the first). Rows without a ground-truth id or a true
+    position are skipped. ``mounts`` defaults to :func:`read_sensor_mounts`."""
+    if mounts is None:
+        mounts = read_sensor_mounts()
     objects: dict[int, list[list[float]]] = {}
+    seen: set[tuple[int, str]] = set()
     with open(path, newline="") as handle:
         rows = csv.DictReader(line for line in handle if not line.startswith("#"))
         for row in rows:
             gt = row.get("gt_id", "")
             if gt in ("", "-1") or row.get("x", "") == "" or row.get("true_x", "") == "":
                 continue
+            if (int(gt), row["frame"]) in seen:
+                continue
+            seen.add((int(gt), row["frame"]))
             x, y = float(row["x"]), float(row["y"])
+            sensor_x, sensor_y = sensor_position(row, mounts, frame)
             true_x, true_y = float(row["true_x"]), float(row["true_y"])
             if frame == "world":
                 x, y = to_world(row, x, y)
@@ -112,6 +164,8 @@ def read_objects(path: str, frame: str = "world") -> list[np.ndarray]:
                     true_y,
                     float(CLASSES[row["class"]]),
                     float(row["frame"]),
+                    sensor_x,
+                    sensor_y,
                 ]
             )
     result = []
@@ -163,20 +217,38 @@ def object_windows(m: np.ndarray, max_horizon: int, max_horizon_s: float, max_ga
                 out["previous_measured"].append([np.nan, np.nan])
                 out["previous_dt_s"].append(np.nan)
             out["object_class"].append(int(m[j, 7]))
+            out["line_of_sight"].append(unit_line_of_sight(m[j, 1:3] - m[j, 9:11]))
             out["frames_ahead"].append(int(m[j + h, 8] - m[j, 8]))
     return out
 
 
+def unit_line_of_sight(offset: np.ndarray) -> list[float]:
+    """The unit vector of ``offset`` (radar to measurement), NaN when it is shorter than
+    ``MIN_LINE_OF_SIGHT_DISTANCE_M`` or not finite."""
+    length = float(np.hypot(offset[0], offset[1]))
+    if not (length >= MIN_LINE_OF_SIGHT_DISTANCE_M and np.isfinite(length)):
+        return [np.nan, np.nan]
+    return [float(offset[0]) / length, float(offset[1]) / length]
+
+
 def load_split(
-    directory: str, max_horizon: int, max_horizon_s: float, max_gap_s: float = 1.0, frame: str = "world"
+    directory: str,
+    max_horizon: int,
+    max_horizon_s: float,
+    max_gap_s: float = 1.0,
+    frame: str = "world",
+    mounts: dict[int, tuple[float, float]] | None = None,
 ) -> tuple[Windows, list[str]]:
-    """Windows of every ``*.csv`` file in ``directory`` (sorted by name), positions in ``frame``."""
+    """Windows of every ``*.csv`` file in ``directory`` (sorted by name), positions in ``frame``,
+    radars placed by ``mounts`` (default: :func:`read_sensor_mounts`)."""
+    if mounts is None:
+        mounts = read_sensor_mounts()
     files = sorted(glob.glob(os.path.join(directory, "*.csv")))
     if not files:
         raise FileNotFoundError(f"no measurement CSV files in {directory}")
     parts: dict[str, list] = {k: [] for k in Windows.__dataclass_fields__}
     for index, path in enumerate(files):
-        for m in read_objects(path, frame):
+        for m in read_objects(path, frame, mounts):
             windows = object_windows(m, max_horizon, max_horizon_s, max_gap_s)
             for key, values in windows.items():
                 parts[key].extend(values)
@@ -192,6 +264,7 @@ def load_split(
         "previous_measured": np.float32,
         "previous_dt_s": np.float64,
         "object_class": np.int64,
+        "line_of_sight": np.float64,
         "frames_ahead": np.int64,
         "sequence": np.int64,
     }
@@ -201,7 +274,7 @@ def load_split(
         arrays[key] = np.asarray(values, dtype=dtype)
     arrays["features"] = arrays["features"].reshape(-1, MAX_HISTORY, FEATURES)
     arrays["valid"] = arrays["valid"].reshape(-1, MAX_HISTORY)
-    for key in ("true_displacement", "measured_displacement", "previous_measured"):
+    for key in ("true_displacement", "measured_displacement", "previous_measured", "line_of_sight"):
         arrays[key] = arrays[key].reshape(-1, 2)
     return Windows(**arrays), files
 
@@ -243,6 +316,36 @@ def motion_frames(features: np.ndarray, length: np.ndarray, rng: np.random.Gener
         cos = np.where(has, cos, np.cos(angle))
         sin = np.where(has, sin, np.sin(angle))
     return cos, sin
+
+
+def line_of_sight_frames(line_of_sight: np.ndarray, rng: np.random.Generator | None = None):
+    """``(cos, sin)`` of each window's line of sight (``[N, 2]`` unit vectors from
+    :func:`load_split`). Windows without one (NaN) get the identity, or a random direction when
+    ``rng`` is given, as in :func:`motion_frames`."""
+    has = np.isfinite(line_of_sight).all(axis=1)
+    cos = np.where(has, line_of_sight[:, 0], 1.0)
+    sin = np.where(has, line_of_sight[:, 1], 0.0)
+    if rng is not None:
+        angle = rng.uniform(-np.pi, np.pi, len(has))
+        cos = np.where(has, cos, np.cos(angle))
+        sin = np.where(has, sin, np.sin(angle))
+    return np.nan_to_num(cos, nan=1.0), np.nan_to_num(sin)
+
+
+def input_frames(
+    input_frame: str,
+    features: np.ndarray,
+    length: np.ndarray,
+    line_of_sight: np.ndarray,
+    rng: np.random.Generator | None = None,
+):
+    """``(cos, sin)`` of each window's model input axes: :func:`line_of_sight_frames` for
+    ``"line_of_sight"``, :func:`motion_frames` for ``"latest_motion"``."""
+    if input_frame == "line_of_sight":
+        return line_of_sight_frames(line_of_sight, rng)
+    if input_frame == "latest_motion":
+        return motion_frames(features, length, rng)
+    raise ValueError(f"unknown input frame {input_frame!r}; expected one of {INPUT_FRAMES}")
 
 
 def to_model_frame(features: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> np.ndarray:

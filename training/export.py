@@ -58,7 +58,8 @@ def main() -> int:
         raise SystemExit("the weights read back do not reproduce the PyTorch outputs")
     metadata = json.loads(args.metadata.read_text()) if args.metadata.exists() else {}
     subtract_max = bool(metadata.get("format", {}).get("softmax_subtracts_row_max", False))
-    model = onnx_graph.build_graph(weights, args.heads, subtract_max=subtract_max)
+    input_frame = onnx_graph.input_frame_of(onnx.load(str(args.source)))
+    model = onnx_graph.build_graph(weights, args.heads, subtract_max=subtract_max, input_frame=input_frame)
     with tempfile.TemporaryDirectory() as scratch:
         candidate = Path(scratch) / "pr.onnx"
         onnx.save(model, candidate)

@@ -128,6 +128,8 @@ class PRModel(nn.Module):
         mean = torch.zeros(FEATURES) if feature_mean is None else torch.as_tensor(feature_mean, dtype=torch.float32)
         std = torch.ones(FEATURES) if feature_std is None else torch.as_tensor(feature_std, dtype=torch.float32)
         scale = torch.ones(QUERIES) if output_scale is None else torch.as_tensor(output_scale, dtype=torch.float32)
+        # The input axes the model is trained in (dataset.INPUT_FRAMES); train.py sets it.
+        self.input_frame = "latest_motion"
         self.register_buffer("feature_mean", mean.clone())
         self.register_buffer("feature_inv_std", 1.0 / std.clone())
         self.register_buffer("output_scale", scale.clone())

@@ -303,8 +303,22 @@ class GraphBuilder:
         return node("Add", [total, const("cholesky_floor", w["cholesky_floor"])], "displacement_cholesky")
 
 
-def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str = ""):
-    """The ONNX model (opset 17, symbolic batch axis ``batch``) of the trained ``weights``."""
+# The ONNX metadata entry that names the model's input axes (primm-predictor's InputFrame):
+# "line_of_sight" or "latest_motion"; a file without it was trained in "latest_motion".
+INPUT_FRAME_KEY = "primm.input_frame"
+
+
+def input_frame_of(model) -> str | None:
+    """The input axes an ONNX model declares in its metadata, ``None`` if it declares none."""
+    for entry in model.metadata_props:
+        if entry.key == INPUT_FRAME_KEY:
+            return entry.value
+    return None
+
+
+def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str = "", input_frame: str | None = None):
+    """The ONNX model (opset 17, symbolic batch axis ``batch``) of the trained ``weights``; with
+    ``input_frame``, the metadata entry ``INPUT_FRAME_KEY`` names the model's input axes."""
     g = GraphBuilder(fold_normalisations(weights))
     w, d, node, const = g.w, g.d, g.node, g.const
     dh = d // heads
@@ -349,7 +363,14 @@ def build_graph(weights: dict, heads: int, subtract_max: bool = False, doc: str 
         stacked_o = np.concatenate([wo * head_mask[h][:, None] for h in range(heads)], axis=0)  # [H*d, d]
         attended = g.linear(mixed, f"{p}.attention.output", f"{p}.attended", stacked_o, w[f"{p}.attention.output.bias"])
         tokens = g.feed_forward(tokens, attended, p)
-    return g.model(tokens, doc)
+    model = g.model(tokens, doc)
+    if input_frame is not None:
+        import onnx
+        from onnx import helper
+
+        helper.set_model_props(model, {INPUT_FRAME_KEY: input_frame})
+        onnx.checker.check_model(model, full_check=True)
+    return model
 
 
 def weights_from_onnx(path: str, heads: int) -> dict:

@@ -42,10 +42,13 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from dataset import (  # noqa: E402
     CLASSES,
+    DEFAULT_CONFIG,
+    INPUT_FRAMES,
     MAX_HISTORY,
+    read_sensor_mounts,
     Windows,
     load_split,
-    motion_frames,
+    input_frames,
     scale_time,
     to_model_frame,
     truncate,
@@ -54,6 +57,7 @@ from dataset import (  # noqa: E402
 )
 from model import CHOLESKY_FLOOR_M, ExportGraph, PRModel, score_bound  # noqa: E402
 import onnx_graph  # noqa: E402
+from onnx_graph import INPUT_FRAME_KEY  # noqa: E402
 
 OPSET = 17
 INPUT_NAMES = ["features", "valid"]
@@ -65,6 +69,22 @@ PARITY_SAMPLES = 64
 SCORE_BOUND_WITHOUT_MAX = 60.0
 # Squared Mahalanobis distance inside which a 2-D Gaussian holds 95 % of its mass: -2 ln(0.05).
 CHI2_2D_95 = -2.0 * math.log(0.05)
+# What each model input axes mean (primm-predictor's InputFrame), for pr.json.
+INPUT_FRAME_MEANING = {
+    "line_of_sight": (
+        "positions relative to the latest measurement, rotated so that the latest measurement's line of sight "
+        "(from the radar that took it, its mount mapped with the ego pose, to the measured position) points "
+        "along +x, so that the latest radial velocity is the velocity's x component; a measurement closer than "
+        "0.01 m to its radar unrotated (primm-predictor InputRotation); the output displacement is in the same "
+        "frame and is rotated back by the caller"
+    ),
+    "latest_motion": (
+        "positions relative to the latest measurement, rotated so that the latest motion (second-latest "
+        "to latest measurement) points along +x; histories of one measurement or whose last two are "
+        "closer than 0.01 m unrotated (primm-predictor InputRotation); the output displacement is in the "
+        "same frame and is rotated back by the caller"
+    ),
+}
 # The default preset's seed base (crates/primm-sim ScenarioConfig::default).
 DEFAULT_PRESET_SEED_BASE = 88314347343104
 
@@ -94,6 +114,18 @@ def parse_args(argv=None):
         type=int,
         default=88314347343104,
         help="the --seed-base the data was generated with (recorded in pr.json; default: the preset's)",
+    )
+    parser.add_argument(
+        "--input-frame",
+        choices=INPUT_FRAMES,
+        default="line_of_sight",
+        help="the model's input axes: along the latest measurement's line of sight (default) or along the "
+        "latest motion (the earlier models); written into the ONNX file's metadata as " + INPUT_FRAME_KEY,
+    )
+    parser.add_argument(
+        "--sensor-config",
+        default=DEFAULT_CONFIG,
+        help="tracker configuration whose [[frame.sensors]] place the radars (the line of sight starts there)",
     )
     parser.add_argument("--epochs", type=int, default=40)
     parser.add_argument("--patience", type=int, default=8, help="stop after this many epochs without improvement")
@@ -168,7 +200,9 @@ def parse_args(argv=None):
         help="share of windows mirrored across the motion axis (y -> -y of positions and label)",
     )
     parser.add_argument("--threads", type=int, default=1, help="PyTorch threads (1 is fastest on a busy 2-core machine)")
-    return parser.parse_args(argv)
+    args = parser.parse_args(argv)
+    args.mounts = read_sensor_mounts(args.sensor_config)
+    return args
 
 
 def seed_everything(seed: int) -> None:
@@ -189,10 +223,10 @@ def labels(windows: Windows, target: str) -> np.ndarray:
     return windows.true_displacement if target == "true" else windows.measured_displacement
 
 
-def normalisation(train: Windows, target: str, rng: np.random.Generator):
+def normalisation(train: Windows, target: str, rng: np.random.Generator, input_frame: str):
     """Mean and standard deviation of each feature over the valid rows, and the per-axis RMS of
     the displacement label, both in the model's input frame."""
-    cos, sin = motion_frames(train.features, train.length, rng)
+    cos, sin = input_frames(input_frame, train.features, train.length, train.line_of_sight, rng)
     rows = to_model_frame(train.features, cos, sin)[train.valid > 0]
     mean = rows.mean(axis=0).astype(np.float64)
     std = rows.std(axis=0).astype(np.float64)
@@ -202,12 +236,14 @@ def normalisation(train: Windows, target: str, rng: np.random.Generator):
     return mean, std, scale
 
 
-def predict_windows(model: PRModel, features: np.ndarray, valid: np.ndarray, length: np.ndarray):
+def predict_windows(
+    model: PRModel, features: np.ndarray, valid: np.ndarray, length: np.ndarray, line_of_sight: np.ndarray
+):
     """The model's displacements and covariances for windows given in the data's frame: each
-    window rotated into the frame of its latest motion, predicted, and the displacement rotated
-    back (what primm-predictor does). Returns ``(displacement [N, 2], covariance [N, 2, 2])`` in
-    the data's frame."""
-    cos, sin = motion_frames(features, length)
+    window rotated into the model's input axes (``model.input_frame``), predicted, and the
+    displacement rotated back (what primm-predictor does). Returns ``(displacement [N, 2],
+    covariance [N, 2, 2])`` in the data's frame."""
+    cos, sin = input_frames(model.input_frame, features, length, line_of_sight)
     displacement, cholesky = predict(model, to_model_frame(features, cos, sin), valid)
     return vectors_from_model_frame(displacement, cos, sin), covariance_from_model_frame(cholesky, cos, sin)
 
@@ -318,7 +354,7 @@ def baselines(windows: Windows) -> dict[str, np.ndarray]:
 def evaluate(model: PRModel, windows: Windows) -> dict:
     """Validation metrics of the model and of the baselines, against the true displacement, and
     the calibration of the model's covariance."""
-    prediction, predicted_cov = predict_windows(model, windows.features, windows.valid, windows.length)
+    prediction, predicted_cov = predict_windows(model, windows.features, windows.valid, windows.length, windows.line_of_sight)
     truth = windows.true_displacement.astype(np.float64)
     result = {"model": {}, "baselines": {}}
     one_step = windows.horizon == 1
@@ -346,7 +382,7 @@ def evaluate(model: PRModel, windows: Windows) -> dict:
         mask = one_step & (windows.length >= length)
         new_length = np.full(mask.sum(), length)
         f, v = truncate(windows.features[mask], windows.valid[mask], windows.length[mask], new_length)
-        by_length[str(length)] = rmse(predict_windows(model, f, v, new_length)[0] - truth[mask])
+        by_length[str(length)] = rmse(predict_windows(model, f, v, new_length, windows.line_of_sight[mask])[0] - truth[mask])
     result["model"]["one_step_by_history_length"] = by_length
     # Calibration of the predicted covariance, by group.
     result["calibration"] = {
@@ -375,7 +411,7 @@ def evaluate(model: PRModel, windows: Windows) -> dict:
 def evaluate_set(model: PRModel, windows: Windows) -> dict:
     """Short metrics of one data set's validation windows: RMSE one step and over all horizons,
     NLL and calibration."""
-    prediction, predicted_cov = predict_windows(model, windows.features, windows.valid, windows.length)
+    prediction, predicted_cov = predict_windows(model, windows.features, windows.valid, windows.length, windows.line_of_sight)
     error = prediction - windows.true_displacement.astype(np.float64)
     one_step = windows.horizon == 1
     result = {
@@ -398,7 +434,7 @@ class DataSet:
     def __init__(self, name: str, root: str, held_out: bool, args):
         self.name, self.held_out = name, held_out
         load = lambda split: load_split(  # noqa: E731
-            os.path.join(root, split), args.max_horizon, args.max_horizon_s, args.max_gap_s, args.frame
+            os.path.join(root, split), args.max_horizon, args.max_horizon_s, args.max_gap_s, args.frame, args.mounts
         )
         self.root = root
         self.train, self.train_files = (None, []) if held_out else load("train")
@@ -412,8 +448,11 @@ class DataSet:
                 "scenario_sha256": file_digest(scenario),
                 "seed_base": config.get("splits", {}).get("seed_base", DEFAULT_PRESET_SEED_BASE),
             }
-        else:
+        elif name == "default":
             self.source = {"preset": "default", "seed_base": args.data_seed_base}
+        else:
+            # A generator preset of that name, with its own seed base (primm generate --preset NAME).
+            self.source = {"preset": name, "seed_base": "the preset's own"}
 
     def describe(self) -> dict:
         entry = dict(self.source)
@@ -447,7 +486,7 @@ class Validation:
     """One validation split prepared for the per-epoch loss: windows in the model's frame."""
 
     def __init__(self, windows: Windows, args):
-        cos, sin = motion_frames(windows.features, windows.length)
+        cos, sin = input_frames(args.input_frame, windows.features, windows.length, windows.line_of_sight)
         self.features = torch.from_numpy(to_model_frame(windows.features, cos, sin))
         self.valid = torch.from_numpy(windows.valid)
         self.target = torch.from_numpy(vectors_to_model_frame(labels(windows, args.target), cos, sin))
@@ -486,8 +525,9 @@ def train(args) -> None:
     selection = next(d for d in training_sets if d.name == args.selection_set)
     train_windows = Windows.concatenate([d.train for d in training_sets])
     print(f"{len(train_windows)} training windows in all ({time.time() - started:.1f} s)", flush=True)
-    mean, std, scale = normalisation(train_windows, args.target, np.random.default_rng(args.seed + 2))
+    mean, std, scale = normalisation(train_windows, args.target, np.random.default_rng(args.seed + 2), args.input_frame)
     model = PRModel(args.d_model, args.heads, args.layers, args.d_ff, mean, std, scale)
+    model.input_frame = args.input_frame
     print(f"model: {model.parameter_count()} parameters", flush=True)
     optimiser = torch.optim.AdamW(model.parameters(), lr=args.learning_rate, weight_decay=args.weight_decay)
     steps_per_epoch = math.ceil(min(len(train_windows), args.samples_per_epoch) / args.batch_size)
@@ -518,8 +558,8 @@ def train(args) -> None:
         cut = rng.random(len(order)) < args.truncate_probability
         new_length[cut] = rng.integers(1, length[cut] + 1)
         features, valid = truncate(train_windows.features[order], train_windows.valid[order], length, new_length)
-        # Into the frame of each window's latest motion (random for windows without one).
-        cos, sin = motion_frames(features, new_length, rng)
+        # Into each window's model input axes (random for windows without a direction).
+        cos, sin = input_frames(args.input_frame, features, new_length, train_windows.line_of_sight[order], rng)
         features = to_model_frame(features, cos, sin)
         target = vectors_to_model_frame(train_labels[order], cos, sin)
         horizon = train_windows.dt_s[order].copy()
@@ -622,7 +662,7 @@ def export(model: PRModel, path: str, check: Windows) -> float:
     weights = {name: value.detach().cpu().numpy() for name, value in model.state_dict().items()}
     heads = model.layers[0].attention.heads
     f, v = check.features[:4096], check.valid[:4096]
-    cos, sin = motion_frames(f, check.length[:4096])
+    cos, sin = input_frames(model.input_frame, f, check.length[:4096], check.line_of_sight[:4096])
     f = to_model_frame(f, cos, sin)
     with torch.no_grad():
         trained, trained_cholesky = (t.numpy() for t in model(torch.from_numpy(f), torch.from_numpy(v)))
@@ -633,7 +673,7 @@ def export(model: PRModel, path: str, check: Windows) -> float:
           f"{difference_cholesky:.2e} m (Cholesky factor)", flush=True)
     if max(difference, difference_cholesky) > 1e-4:
         raise RuntimeError("the export graph does not compute the trained function")
-    onnx.save(onnx_graph.build_graph(weights, heads, subtract_max=subtract_max), path)
+    onnx.save(onnx_graph.build_graph(weights, heads, subtract_max=subtract_max, input_frame=model.input_frame), path)
     print(f"wrote {path} ({os.path.getsize(path)} bytes)", flush=True)
     return bound
 
@@ -644,11 +684,11 @@ def write_parity(model: PRModel, windows: Windows, path: str, seed: int) -> dict
     index = rng.choice(len(windows), PARITY_SAMPLES, replace=False)
     lengths = np.minimum(windows.length[index], 1 + np.arange(PARITY_SAMPLES) % MAX_HISTORY)
     features, valid = truncate(windows.features[index], windows.valid[index], windows.length[index], lengths)
-    cos, sin = motion_frames(features, lengths)
+    cos, sin = input_frames(model.input_frame, features, lengths, windows.line_of_sight[index])
     features = to_model_frame(features, cos, sin)
     output, cholesky = predict(model, features, valid)
     parity = {
-        "description": "PR model inputs (eq:pr_input rows, right padded, in the frame of the latest motion) "
+        "description": f"PR model inputs (eq:pr_input rows, right padded, in the model's input axes: {model.input_frame}) "
         "and the PyTorch outputs: displacement [dx, dy] (m) and cholesky [l_xx, l_yx, l_yy] (m), the "
         "lower-triangular factor of the displacement error covariance",
         "features": [[[float(v) for v in row] for row in sample] for sample in features],
@@ -721,12 +761,9 @@ def write_metadata(args, model, mean, std, scale, sets, selection, train_windows
                 "dtype": "float32",
                 "layout": "eq:pr_input rows oldest first; rows 0..len valid, rows len..5 zero (right padding)",
                 "features": FEATURE_NAMES,
-                "input_frame": (
-                    "positions relative to the latest measurement, rotated so that the latest motion (second-latest "
-                    "to latest measurement) points along +x; histories of one measurement or whose last two are "
-                    "closer than 0.01 m unrotated (primm-predictor InputRotation); the output displacement is in the "
-                    "same frame and is rotated back by the caller"
-                ),
+                "input_frame": args.input_frame,
+                "input_frame_meaning": INPUT_FRAME_MEANING[args.input_frame],
+                "input_frame_onnx_metadata": {INPUT_FRAME_KEY: args.input_frame},
                 "training_positions": (
                     "world frame (each measurement mapped with its frame's ego pose)"
                     if args.frame == "world"
@@ -768,6 +805,10 @@ def write_metadata(args, model, mean, std, scale, sets, selection, train_windows
                 if args.target == "true"
                 else "measured displacement z_{j+h} - z_j from the latest history measurement j"
             ),
+            "sensor_mounts": {
+                "file": os.path.relpath(os.path.abspath(args.sensor_config), os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                "mounts_m": {str(k): list(v) for k, v in sorted(args.mounts.items())},
+            },
             "horizons": f"the next 1..{args.max_horizon} measurements of the object, at most {args.max_horizon_s} s ahead",
             "loss": (
                 f"the first {args.mse_warmup_epochs} epoch(s): squared displacement error divided by output_scale "
@@ -785,7 +826,8 @@ def write_metadata(args, model, mean, std, scale, sets, selection, train_windows
                          f"split of `{selection.name}`",
             "augmentation": {
                 "truncate_probability": args.truncate_probability,
-                "random_orientation": "windows without a direction of motion get a random rotation every epoch",
+                "random_orientation": "windows without a direction (no line of sight, or no motion for "
+                "latest_motion) get a random rotation every epoch",
                 "time_scale": (
                     f"with probability {args.time_scale_probability}: times x k, radial velocities / k, log k "
                     f"uniform in [-log {args.time_scale}, log {args.time_scale}]; positions and label unchanged"
@@ -806,7 +848,7 @@ def write_metadata(args, model, mean, std, scale, sets, selection, train_windows
             "history": history,
         },
         "data": {
-            "generator": "primm generate (--preset default, or --scenario training/scenarios/NAME.toml)",
+            "generator": "primm generate (--preset NAME: default, turning, clutter, extended, robustness; or --scenario training/scenarios/NAME.toml)",
             "sets": {d.name: d.describe() for d in sets},
             "training_windows": len(train_windows),
             "selection_set": selection.name,

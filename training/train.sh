@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# Retrains the PR model from scratch: generates the training and validation data of the default
-# preset and of every scenario in training/scenarios/ with primm's scenario generator, trains on
-# all of them, and writes models/pr.onnx, models/pr.json and models/pr_parity.json.
+# Retrains the PR model from scratch: generates the training and validation data of the default,
+# turning, clutter and extended presets and of every scenario in training/scenarios/ with primm's
+# scenario generator, trains on all of them, and writes models/pr.onnx, models/pr.json and
+# models/pr_parity.json.
 #
 #   training/train.sh [DATA_DIR] [train.py options ...]     (default DATA_DIR: data)
 #
-# Scenario files named held_out_*.toml are held out: only their validation split is generated,
-# and train.py reports its loss without ever training on it. The default preset's validation
+# Scenario files named held_out_*.toml and the robustness preset are held out: only their
+# validation split is generated, and train.py reports its loss without ever training on it. The default preset's validation
 # split selects the epoch. No evaluation split is generated or read.
 #
 # PYTHON selects the interpreter (default: python3); it needs training/requirements.txt.
@@ -34,7 +35,14 @@ echo "== generating data into $data (${SECONDS} s)"
 generate default train --preset default --seed-base "$seed_base"
 generate default validation --preset default --seed-base "$seed_base"
 sets=(default)
-held_out=()
+# Presets with their own seed bases: other ego motion, false detections, extended vehicles.
+for preset in turning clutter extended; do
+  generate "$preset" train --preset "$preset"
+  generate "$preset" validation --preset "$preset"
+  sets+=("$preset")
+done
+generate robustness validation --preset robustness
+held_out=(robustness)
 for file in training/scenarios/*.toml; do
   name="$(basename "$file" .toml)"
   if [[ "$name" == held_out_* ]]; then

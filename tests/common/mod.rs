@@ -216,6 +216,7 @@ pub fn anchored_requests(frame: usize, count: usize) -> Vec<primm_core::predicto
                 radial_velocity_mps: 0.0,
                 rcs_dbsm: 0.0,
                 timestamp_s: frame as f64 * 0.02,
+                ..Default::default()
             };
             primm_core::predictor::PredictionRequest::from_history(&[entry], frame as f64 * 0.02 + 0.02)
         })

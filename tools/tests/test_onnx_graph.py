@@ -70,5 +70,12 @@ def test_the_shipped_model_rebuilds_byte_for_byte():
     weights = onnx_graph.weights_from_onnx(str(path), heads=4)
     metadata = json.loads((ROOT / "models" / "pr.json").read_text())
     subtract_max = bool(metadata.get("format", {}).get("softmax_subtracts_row_max", False))
-    model = onnx_graph.build_graph(weights, 4, subtract_max=subtract_max)
+    shipped = onnx.load(str(path))
+    input_frame = onnx_graph.input_frame_of(shipped)
+    assert input_frame == metadata["inputs"][0]["input_frame"] == "line_of_sight"
+    model = onnx_graph.build_graph(weights, 4, subtract_max=subtract_max, input_frame=input_frame)
     assert model.SerializeToString() == path.read_bytes()
+    # Without the entry the bytes differ, and the model reads as one of the latest motion.
+    plain = onnx_graph.build_graph(weights, 4, subtract_max=subtract_max)
+    assert plain.SerializeToString() != path.read_bytes()
+    assert onnx_graph.input_frame_of(plain) is None

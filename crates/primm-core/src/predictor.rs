@@ -46,6 +46,12 @@ pub struct HistoryEntry {
     pub rcs_dbsm: f64,
     /// Measurement time, s.
     pub timestamp_s: f64,
+    /// x position of the radar that took the measurement, in the same frame as `x_m`, m: where
+    /// its radial velocity's line of sight starts (the vehicle's reference point for a radar
+    /// without a configured mount).
+    pub sensor_x_m: f64,
+    /// y position of that radar, m.
+    pub sensor_y_m: f64,
 }
 
 /// A track's prediction input, laid out as `eq:pr_input`.
@@ -60,6 +66,10 @@ pub struct PredictionRequest {
     pub anchor_m: DVec2,
     /// Time of the latest measurement, s (not a model input).
     pub anchor_time_s: f64,
+    /// Where the radar that took the latest measurement was, in the frame of `anchor_m`, m (not
+    /// a model input): the latest measurement's line of sight runs from here to `anchor_m`, and
+    /// a predictor may take its input axes from it.
+    pub sensor_m: DVec2,
     /// Prediction time `t_k`, s (not a model input).
     pub prediction_time_s: f64,
     /// Start of the tracker step, s: the time of the previous frame, where the PR estimate the
@@ -84,6 +94,7 @@ impl PredictionRequest {
         if let Some(latest) = history.last() {
             request.anchor_m = DVec2::new(latest.x_m, latest.y_m);
             request.anchor_time_s = latest.timestamp_s;
+            request.sensor_m = DVec2::new(latest.sensor_x_m, latest.sensor_y_m);
             request.step_start_s = latest.timestamp_s;
             for (row, entry) in request.features.iter_mut().zip(history) {
                 *row = [

@@ -101,6 +101,7 @@ impl Track {
     pub fn new(
         id: u64,
         measurement: &Measurement,
+        sensor_m: DVec2,
         timestamp_s: f64,
         estimate: ImmState,
         existence_probability: f64,
@@ -123,7 +124,7 @@ impl Track {
             exclusive_updates: 0,
             remembered_displacement: None,
         };
-        track.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
+        track.history.write(HistoryEntry::from_measurement(measurement, sensor_m, timestamp_s));
         track
     }
 
@@ -137,7 +138,14 @@ impl Track {
         let mut len = 0;
         for entry in self.history.oldest_ordered() {
             let position = transform.apply_point(DVec2::new(entry.x_m, entry.y_m));
-            entries[len] = HistoryEntry { x_m: position.x, y_m: position.y, ..*entry };
+            let sensor = transform.apply_point(DVec2::new(entry.sensor_x_m, entry.sensor_y_m));
+            entries[len] = HistoryEntry {
+                x_m: position.x,
+                y_m: position.y,
+                sensor_x_m: sensor.x,
+                sensor_y_m: sensor.y,
+                ..*entry
+            };
             len += 1;
         }
         self.history.clear();
@@ -146,10 +154,10 @@ impl Track {
         }
     }
 
-    /// Records an associated measurement (a coasting track is confirmed again; confirming a
-    /// tentative one is the lifecycle's decision).
-    pub fn record_hit(&mut self, measurement: &Measurement, timestamp_s: f64) {
-        self.history.write(HistoryEntry::from_measurement(measurement, timestamp_s));
+    /// Records an associated measurement taken by the radar at `sensor_m` (a coasting track is
+    /// confirmed again; confirming a tentative one is the lifecycle's decision).
+    pub fn record_hit(&mut self, measurement: &Measurement, sensor_m: DVec2, timestamp_s: f64) {
+        self.history.write(HistoryEntry::from_measurement(measurement, sensor_m, timestamp_s));
         self.last_radial_velocity_mps = measurement.radial_velocity_mps;
         self.last_update_s = timestamp_s;
         self.hits = self.hits.saturating_add(1);
@@ -167,14 +175,16 @@ impl Track {
 }
 
 impl HistoryEntry {
-    /// The history entry of a measurement taken at `timestamp_s`.
-    pub fn from_measurement(measurement: &Measurement, timestamp_s: f64) -> Self {
+    /// The history entry of a measurement taken at `timestamp_s` by the radar at `sensor_m`.
+    pub fn from_measurement(measurement: &Measurement, sensor_m: DVec2, timestamp_s: f64) -> Self {
         HistoryEntry {
             x_m: measurement.x_m,
             y_m: measurement.y_m,
             radial_velocity_mps: measurement.radial_velocity_mps,
             rcs_dbsm: measurement.rcs_dbsm,
             timestamp_s,
+            sensor_x_m: sensor_m.x,
+            sensor_y_m: sensor_m.y,
         }
     }
 }

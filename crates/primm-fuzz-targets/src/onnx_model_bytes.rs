@@ -29,6 +29,7 @@ pub fn run(data: &[u8]) {
             radial_velocity_mps: 10.0,
             rcs_dbsm: 8.0,
             timestamp_s: 0.05 * k as f64,
+            ..Default::default()
         })
         .collect();
     let requests = [

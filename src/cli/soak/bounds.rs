@@ -166,7 +166,7 @@ mod tests {
         for i in 0..4 {
             state.constant_velocity.covariance[(i, i)] = 1.0;
         }
-        Track::new(1, &measurement, 0.0, state, 0.5)
+        Track::new(1, &measurement, glam::DVec2::ZERO, 0.0, state, 0.5)
     }
 
     fn modes() -> ModeSet {

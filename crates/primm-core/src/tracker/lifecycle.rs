@@ -27,6 +27,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 continue;
             }
             let sensor_position_m = self.sensor_position(&measurement);
+            // Where the history's line of sight starts: the radial-velocity row's radar position.
+            let line_of_sight_origin = self.measurement_sensors[index].0;
             let models = &self.models[measurement.class.index()];
             // An extended object starts at the centre behind its reflection (no heading yet:
             // the disc model of `crate::extent`), its position spread by the reflection's.
@@ -49,7 +51,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
             );
             estimate.add_position_covariance(&crate::gaussian::to_nalgebra(&reflection.covariance_m2));
             let tracker = &self.config.tracker;
-            match self.table.insert(|id| Track::new(id, &measurement, t, estimate, initial_existence)) {
+            match self.table.insert(|id| {
+                Track::new(id, &measurement, line_of_sight_origin, t, estimate, initial_existence)
+            }) {
                 Ok(track) => {
                     self.last_step.initiated += 1;
                     // A confirmation threshold of one hit (or an initial existence at the

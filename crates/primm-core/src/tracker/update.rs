@@ -117,7 +117,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     detection,
                     clutter,
                 );
-                track.record_hit(&measurement, t);
+                track.record_hit(&measurement, self.assigned_sensor_positions[i], t);
                 if track.status == TrackStatus::Tentative && confirms(track, tracker) {
                     track.status = TrackStatus::Confirmed;
                     self.last_step.newly_confirmed += 1;

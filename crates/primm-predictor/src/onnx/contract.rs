@@ -14,15 +14,26 @@
 //! Feature normalisation is part of the graph. The batch axis must be symbolic and is bound to a
 //! symbol named [`BATCH_SYMBOL`]; every other dimension must match exactly.
 //!
-//! # Input axes: aligned with the latest motion
+//! # Input axes: aligned with the line of sight, or with the latest motion
 //!
 //! The model never sees absolute headings. Before a request goes in, its relative positions
-//! are rotated into the axes whose x axis points along the latest motion, from the
-//! second-latest to the latest measurement ([`InputRotation`]); the displacement that comes out
-//! is rotated back. A history of one measurement, or whose last two measurements are closer
-//! than [`MIN_HEADING_DISTANCE_M`], has no such direction and goes in unrotated (the model is
-//! trained with such windows in random orientations). So tracks in the world frame, whose
-//! headings are arbitrary, and tracks in the vehicle frame are predicted alike.
+//! are rotated into the model's input axes ([`InputRotation`]); the displacement that comes out
+//! is rotated back. A model names its axes in the ONNX metadata entry [`INPUT_FRAME_KEY`]
+//! ([`InputFrame`]):
+//!
+//! * `line_of_sight` (the shipped model): the x axis points along the latest measurement's
+//!   line of sight, from the radar that took it ([`PredictionRequest::sensor_m`]) to the
+//!   measured position, so that the latest radial velocity is the x component of the object's
+//!   velocity. A measurement closer than [`MIN_LINE_OF_SIGHT_DISTANCE_M`] to its radar has no
+//!   line of sight and goes in unrotated.
+//! * `latest_motion` (models without the entry, trained before the line of sight): the x axis
+//!   points along the latest motion, from the second-latest to the latest measurement. A
+//!   history of one measurement, or whose last two measurements are closer than
+//!   [`MIN_HEADING_DISTANCE_M`], goes in unrotated.
+//!
+//! The model is trained with windows without a direction in random orientations. So tracks in
+//! the world frame, whose headings are arbitrary, and tracks in the vehicle frame are predicted
+//! alike.
 
 use glam::{DMat2, DVec2};
 use primm_core::predictor::{PredictionRequest, MAX_HISTORY};
@@ -34,8 +45,46 @@ use tract_onnx::prelude::TractError;
 /// of its latest motion, m.
 pub const MIN_HEADING_DISTANCE_M: f64 = 0.01;
 
+/// Shortest distance from a radar to its measurement that defines a line of sight, m.
+pub const MIN_LINE_OF_SIGHT_DISTANCE_M: f64 = 0.01;
+
+/// The ONNX metadata entry (`metadata_props` key) in which a model names its [`InputFrame`].
+pub const INPUT_FRAME_KEY: &str = "primm.input_frame";
+
+/// The axes a model takes its input positions and gives its displacement in (see the module
+/// documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputFrame {
+    /// x along the latest measurement's line of sight (metadata value `line_of_sight`).
+    LineOfSight,
+    /// x along the latest motion (metadata value `latest_motion`; also a model without the
+    /// entry).
+    LatestMotion,
+}
+
+impl InputFrame {
+    /// The metadata value of this frame.
+    pub fn name(self) -> &'static str {
+        match self {
+            InputFrame::LineOfSight => "line_of_sight",
+            InputFrame::LatestMotion => "latest_motion",
+        }
+    }
+
+    /// The frame a metadata value names, `None` for an unknown value.
+    pub fn from_name(name: &str) -> Option<Self> {
+        [InputFrame::LineOfSight, InputFrame::LatestMotion].into_iter().find(|frame| frame.name() == name)
+    }
+}
+
+impl fmt::Display for InputFrame {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// The rotation of a request into the model's input axes (see the module documentation):
-/// `(x, y) ↦ (c·x + s·y, −s·x + c·y)` with `(c, s)` the unit direction of the latest motion.
+/// `(x, y) ↦ (c·x + s·y, −s·x + c·y)` with `(c, s)` the unit direction of the axes' x axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InputRotation {
     cos: f64,
@@ -46,20 +95,40 @@ impl InputRotation {
     /// No rotation.
     pub const IDENTITY: InputRotation = InputRotation { cos: 1.0, sin: 0.0 };
 
+    /// The rotation of `request` into the axes of `frame`; [`IDENTITY`](Self::IDENTITY) where
+    /// the request has no such direction.
+    pub fn of(request: &PredictionRequest, frame: InputFrame) -> Self {
+        match frame {
+            InputFrame::LineOfSight => Self::onto_line_of_sight(request),
+            InputFrame::LatestMotion => Self::onto_latest_motion(request),
+        }
+    }
+
+    /// The rotation onto the latest measurement's line of sight, from its radar to the
+    /// measured position; [`IDENTITY`](Self::IDENTITY) without one.
+    pub fn onto_line_of_sight(request: &PredictionRequest) -> Self {
+        Self::onto(request.anchor_m - request.sensor_m, MIN_LINE_OF_SIGHT_DISTANCE_M)
+    }
+
     /// The rotation onto `request`'s latest motion; [`IDENTITY`](Self::IDENTITY) without one.
-    pub fn of(request: &PredictionRequest) -> Self {
+    pub fn onto_latest_motion(request: &PredictionRequest) -> Self {
         if request.len < 2 || request.len > MAX_HISTORY {
             return Self::IDENTITY;
         }
         // Positions are relative to the latest measurement, so the motion is minus the
         // second-latest row's position.
         let previous = request.features[request.len - 2];
-        let motion = DVec2::new(-f64::from(previous[0]), -f64::from(previous[1]));
-        let length = motion.length();
-        if !(length >= MIN_HEADING_DISTANCE_M && length.is_finite()) {
+        Self::onto(DVec2::new(-f64::from(previous[0]), -f64::from(previous[1])), MIN_HEADING_DISTANCE_M)
+    }
+
+    /// The rotation onto `direction`; [`IDENTITY`](Self::IDENTITY) if it is shorter than
+    /// `min_length` or not finite.
+    fn onto(direction: DVec2, min_length: f64) -> Self {
+        let length = direction.length();
+        if !(length >= min_length && length.is_finite()) {
             return Self::IDENTITY;
         }
-        InputRotation { cos: motion.x / length, sin: motion.y / length }
+        InputRotation { cos: direction.x / length, sin: direction.y / length }
     }
 
     /// A position or displacement in the model's axes.
@@ -167,6 +236,14 @@ pub enum ModelError {
         expected: String,
         /// The declared or inferred type and shape.
         found: String,
+    },
+    /// The model's [`INPUT_FRAME_KEY`] metadata entry names no [`InputFrame`].
+    #[error("PR model {model}: metadata entry {INPUT_FRAME_KEY} = `{value}` names no input frame (expected `line_of_sight` or `latest_motion`)")]
+    InputFrame {
+        /// The model.
+        model: ModelSource,
+        /// The entry's value.
+        value: String,
     },
     /// tract could not type the graph for a symbolic batch or optimise and plan it for the sizes
     /// of [`PLAN_BATCH_SIZES`](super::PLAN_BATCH_SIZES), or a trial run with one sample failed.

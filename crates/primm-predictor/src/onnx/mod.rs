@@ -22,9 +22,9 @@ pub mod predictor;
 pub mod tract_engine;
 
 pub use contract::{
-    covariance_from_cholesky, InferenceError, InputRotation, ModelError, ModelSource, BATCH_SYMBOL,
-    CHOLESKY_OUTPUT, CHOLESKY_VALUES, DISPLACEMENT_OUTPUT, FEATURES_INPUT, MIN_HEADING_DISTANCE_M,
-    VALID_INPUT,
+    covariance_from_cholesky, InferenceError, InputFrame, InputRotation, ModelError, ModelSource,
+    BATCH_SYMBOL, CHOLESKY_OUTPUT, CHOLESKY_VALUES, DISPLACEMENT_OUTPUT, FEATURES_INPUT, INPUT_FRAME_KEY,
+    MIN_HEADING_DISTANCE_M, MIN_LINE_OF_SIGHT_DISTANCE_M, VALID_INPUT,
 };
 pub use engine_choice::MAX_PROBE_DIFFERENCE_M;
 pub use model::PrModel;

@@ -2,7 +2,9 @@
 //! [engine choice](super::engine_choice) allows it, primm's native forward pass
 //! ([`native`](crate::native)), behind one `run`.
 
-use super::contract::{InferenceError, ModelError, ModelSource, CHOLESKY_VALUES};
+use super::contract::{
+    InferenceError, InputFrame, ModelError, ModelSource, CHOLESKY_VALUES, INPUT_FRAME_KEY,
+};
 use super::engine_choice::EngineChoice;
 use super::tract_engine::{ParsedModel, TractEngine};
 use crate::native::{NativeModel, Unsupported};
@@ -18,6 +20,8 @@ pub struct PrModel {
     source: ModelSource,
     /// Whether the model has the [`CHOLESKY_OUTPUT`](super::CHOLESKY_OUTPUT).
     has_uncertainty: bool,
+    /// The axes the model takes its input in (its [`INPUT_FRAME_KEY`] metadata entry).
+    input_frame: InputFrame,
     /// tract's plans.
     tract: TractEngine,
     /// The native forward pass, or why the model cannot have one, and the engine batches run on.
@@ -28,6 +32,7 @@ impl fmt::Debug for PrModel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("PrModel")
             .field("source", &self.source)
+            .field("input_frame", &self.input_frame)
             .field("batch_sizes", &self.tract.batch_sizes())
             .field("nodes", &self.tract.nodes())
             .field("engine", &self.choice.engine())
@@ -88,8 +93,16 @@ impl PrModel {
 
     fn prepare(bytes: &[u8], source: ModelSource) -> Result<Self, ModelError> {
         let ParsedModel { proto, has_uncertainty, tract } = TractEngine::parse(bytes, &source)?;
+        let input_frame = match proto.metadata_props.iter().find(|entry| entry.key == INPUT_FRAME_KEY) {
+            None => InputFrame::LatestMotion,
+            Some(entry) => InputFrame::from_name(&entry.value).ok_or_else(|| ModelError::InputFrame {
+                model: source.clone(),
+                value: entry.value.clone(),
+            })?,
+        };
         let native = NativeModel::from_proto(&proto, has_uncertainty);
-        let mut loaded = PrModel { source, has_uncertainty, tract, choice: EngineChoice::on_tract(native) };
+        let mut loaded =
+            PrModel { source, has_uncertainty, input_frame, tract, choice: EngineChoice::on_tract(native) };
         // A trial run: a model that loads but cannot run fails here, at start-up.
         let mut out = [0.0f32; 2];
         let mut factor = [0.0f32; CHOLESKY_VALUES];
@@ -112,6 +125,12 @@ impl PrModel {
         })?;
         loaded.set_engine(InferenceEngine::Native);
         Ok(loaded)
+    }
+
+    /// The axes the model takes its input positions and gives its displacement in, as its ONNX
+    /// metadata names them ([`InputFrame::LatestMotion`] for a model that names none).
+    pub fn input_frame(&self) -> InputFrame {
+        self.input_frame
     }
 
     /// Chooses the engine batches run on and returns the one in use: [`Native`] where the
@@ -141,6 +160,7 @@ impl PrModel {
         Ok(PrModel {
             source: self.source.clone(),
             has_uncertainty: self.has_uncertainty,
+            input_frame: self.input_frame,
             tract: self.tract.fork(&self.source)?,
             choice: self.choice.clone(),
         })

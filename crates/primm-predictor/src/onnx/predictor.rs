@@ -14,8 +14,9 @@
 //! otherwise it evaluates both rows in the same batch, so a frame in which `n` of `N` tracks
 //! coasted without it runs a batch of `N + n` rows. Every answer tells its `f(t_k)`
 //! ([`Displacement::from_latest_m`]), which the tracker hands back the next frame. Each request's
-//! positions go in rotated onto its latest motion ([`InputRotation`]), and its displacement
-//! comes out rotated back.
+//! positions go in rotated into the input axes its model names ([`InputRotation`]: along the
+//! latest measurement's line of sight for the shipped model), and its displacement comes out
+//! rotated back.
 
 use super::contract::{covariance_from_cholesky, InferenceError, InputRotation, ModelError, CHOLESKY_VALUES};
 use super::model::PrModel;
@@ -132,7 +133,7 @@ impl OnnxPredictor {
         self.rows.clear();
         let mut row_count = 0;
         for request in requests {
-            let rotation = InputRotation::of(request);
+            let rotation = InputRotation::of(request, self.model.input_frame());
             let row = push_row(request, &rotation, &mut self.features, &mut self.valid).then(|| {
                 row_count += 1;
                 row_count - 1
