@@ -1,4 +1,5 @@
-//! The request's step start and its re-timing for the start-of-step prediction.
+//! The request's step start and its re-timing for the start-of-step prediction, and where the line
+//! of sight of its latest measurement starts.
 
 use primm_core::predictor::{HistoryEntry, PredictionRequest, MAX_HISTORY};
 
@@ -107,4 +108,69 @@ fn a_remembered_answer_serves_only_the_next_step_of_the_same_history() {
     let fresh = PredictionRequest::from_history(&measured, 1.08).with_step_start(1.05);
     assert!(!fresh.step_starts_after_latest_measurement());
     assert_eq!(RememberedDisplacement::of(&previous, &Displacement::new(DVec2::ONE)), None);
+}
+
+/// Records every request and answers none (the PR mode sits out).
+struct Recording(std::sync::Arc<std::sync::Mutex<Vec<PredictionRequest>>>);
+
+impl primm_core::predictor::DisplacementPredictor for Recording {
+    fn submit(&mut self, requests: &[PredictionRequest]) {
+        self.0.lock().unwrap().extend_from_slice(requests);
+    }
+    fn collect(&mut self, displacements: &mut [Option<primm_core::predictor::Displacement>]) {
+        displacements.fill(None);
+    }
+}
+
+/// The requests of a PR-IMM tracker over the first frames of a generated default sequence, and
+/// the ego pose of every frame time.
+fn recorded_requests(
+    frame: primm_core::coordinates::CoordinateFrame,
+) -> (Vec<PredictionRequest>, Vec<(f64, primm_core::pose::EgoPose)>) {
+    use primm_sim::scenario::{Preset, ScenarioGenerator, Split};
+    let generated = ScenarioGenerator::from_preset(Preset::Default).generate(Split::Validation, 1);
+    let mut config =
+        primm_core::config::Config::default().with_modes(primm_core::mode::Method::PrImm.modes());
+    config.frame.tracking_frame = frame;
+    let requests = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let mut tracker =
+        primm_core::tracker::Tracker::with_predictor(config, Recording(requests.clone())).unwrap();
+    let mut poses = Vec::new();
+    for recorded in generated.sequence.frames.iter().take(300) {
+        poses.push((recorded.timestamp_s, recorded.ego_pose.expect("generated frames carry a pose")));
+        tracker.step(&recorded.to_frame().unwrap()).unwrap();
+    }
+    let requests = requests.lock().unwrap().clone();
+    (requests, poses)
+}
+
+#[test]
+fn every_request_starts_its_line_of_sight_at_the_radar_of_its_latest_measurement() {
+    use primm_core::coordinates::{CoordinateFrame, CoordinatesConfig};
+    let mounts: Vec<glam::DVec2> =
+        CoordinatesConfig::default().sensors.iter().map(|m| m.position()).collect();
+    // World frame: the mount of one of the radars, mapped with the pose of the measurement's frame.
+    let (requests, poses) = recorded_requests(CoordinateFrame::World);
+    assert!(requests.len() > 500, "only {} requests", requests.len());
+    for request in &requests {
+        let (_, pose) =
+            poses.iter().find(|(t, _)| *t == request.anchor_time_s).expect("a frame at the anchor time");
+        let distance = mounts
+            .iter()
+            .map(|m| (pose.point_to_world(*m) - request.sensor_m).length())
+            .fold(f64::MAX, f64::min);
+        assert!(
+            distance < 1e-9,
+            "radar at {} is no mount of the frame at {}",
+            request.sensor_m,
+            request.anchor_time_s
+        );
+        assert!((request.anchor_m - request.sensor_m).length() > 0.5, "a measurement at its radar");
+    }
+    // Vehicle frame: the mount itself.
+    let (requests, _) = recorded_requests(CoordinateFrame::Vehicle);
+    assert!(requests.len() > 500);
+    for request in &requests {
+        assert!(mounts.iter().any(|m| (*m - request.sensor_m).length() < 1e-12), "{}", request.sensor_m);
+    }
 }
