@@ -299,3 +299,43 @@ fn the_fused_prior_weights_mode_priors_by_the_prior_probabilities() {
         Mode::ALL[1..].iter().map(|m| c[m.index()] / others * prior.state.position(*m).mean).sum();
     assert!((prior.fused.mean - expected).length() < 1e-12);
 }
+
+#[test]
+fn a_pr_mode_sitting_out_takes_the_fused_physics_prior_and_keeps_its_probability() {
+    let config = Config::default();
+    let models = ModeModels::from_config(&config.classes.car);
+    let imm = Imm::new(&config.imm);
+    let mut state = imm.initiate(&models, &common::measurement(10.0, 0.0, 3.0));
+    state.probabilities = [0.1, 0.2, 0.3, 0.4];
+    // The PR mode's own position lags 2 m behind the others, as one nothing moved would.
+    state.learned.mean -= nalgebra::Vector2::new(2.0, 0.0);
+    let sitting_out = imm.predict(
+        &models,
+        &state,
+        &PredictContext { dt_s: 0.1, displacement_m: None, displacement_covariance_m2: None },
+    );
+    let learned = sitting_out.state.position(Mode::Learned);
+    assert!(
+        (learned.mean - sitting_out.fused.mean).length() < 1e-12,
+        "{} vs {}",
+        learned.mean,
+        sitting_out.fused.mean
+    );
+    assert!(learned.covariance.abs_diff_eq(sitting_out.fused.covariance, 1e-12));
+    // After the update the PR mode keeps exactly its prior probability (no evidence either way).
+    let posterior = imm.update(&models, &sitting_out, DVec2::new(10.3, 0.1)).unwrap();
+    let c_pr = sitting_out.state.probabilities[Mode::Learned.index()];
+    assert!((posterior.probabilities[Mode::Learned.index()] - c_pr).abs() < 1e-12);
+    // With a displacement the PR mode moves its own mixed position, not the fused prior.
+    let predicting = imm.predict(
+        &models,
+        &state,
+        &PredictContext {
+            dt_s: 0.1,
+            displacement_m: Some(DVec2::new(1.0, 0.0)),
+            displacement_covariance_m2: None,
+        },
+    );
+    let learned = predicting.state.position(Mode::Learned);
+    assert!((learned.mean - predicting.fused.mean).length() > 0.1, "{}", learned.mean);
+}

@@ -17,7 +17,9 @@
 //! own Kalman filter. If the learned predictor has no displacement for a step, the PR mode sits
 //! the step out: its prior probability is spread over the other modes for fusion and the mode
 //! update, and afterwards it gets back exactly its prior probability `c_PR` (no evidence either
-//! way), the others sharing `1 − c_PR`.
+//! way), the others sharing `1 − c_PR`. Its prior for that step is the fused prior of the other
+//! modes (it has no motion of its own to add), so its position stays current for the next
+//! mixing.
 
 use crate::config::ImmConfig;
 use crate::gaussian::{
@@ -295,6 +297,13 @@ impl Imm {
         }
         prior.available = available;
         prior.fused = fused_prior(state, available);
+        if available != self.modes && self.modes.contains(Mode::Learned) {
+            // Sitting out, the PR mode takes the fused physics prior instead of its own
+            // position of the previous step, which nothing moved: it stays current, and no
+            // stale position reaches the other modes through the next mixing.
+            let mean = nalgebra::Vector2::new(prior.fused.mean.x, prior.fused.mean.y);
+            state.learned = crate::gaussian::Gaussian::new(mean, to_nalgebra(&prior.fused.covariance));
+        }
     }
 
     /// Kalman update of every active mode with measurement `z`, tempered mode-probability
