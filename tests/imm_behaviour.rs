@@ -267,13 +267,20 @@ fn an_exact_predictor_takes_the_largest_share_and_the_smallest_error() {
     assert!(rmse(&with_oracle) < rmse(&without), "PR-IMM {} vs IMM {}", rmse(&with_oracle), rmse(&without));
 }
 
-#[test]
-fn the_fused_prior_weights_mode_priors_by_the_prior_probabilities() {
+/// The default car models and IMM, and a car track started at (10, 0) m with the given mode
+/// probabilities.
+fn car_track_with_probabilities(probabilities: [f64; 4]) -> (ModeModels, Imm, primm_core::imm::ImmState) {
     let config = Config::default();
     let models = ModeModels::from_config(&config.classes.car);
     let imm = Imm::new(&config.imm);
     let mut state = imm.initiate(&models, &common::measurement(10.0, 0.0, 3.0));
-    state.probabilities = [0.1, 0.2, 0.3, 0.4];
+    state.probabilities = probabilities;
+    (models, imm, state)
+}
+
+#[test]
+fn the_fused_prior_weights_mode_priors_by_the_prior_probabilities() {
+    let (models, imm, mut state) = car_track_with_probabilities([0.1, 0.2, 0.3, 0.4]);
     let prior = imm.predict(
         &models,
         &state,
@@ -302,11 +309,7 @@ fn the_fused_prior_weights_mode_priors_by_the_prior_probabilities() {
 
 #[test]
 fn a_pr_mode_sitting_out_takes_the_fused_physics_prior_and_keeps_its_probability() {
-    let config = Config::default();
-    let models = ModeModels::from_config(&config.classes.car);
-    let imm = Imm::new(&config.imm);
-    let mut state = imm.initiate(&models, &common::measurement(10.0, 0.0, 3.0));
-    state.probabilities = [0.1, 0.2, 0.3, 0.4];
+    let (models, imm, mut state) = car_track_with_probabilities([0.1, 0.2, 0.3, 0.4]);
     // The PR mode's own position lags 2 m behind the others, as one nothing moved would.
     state.learned.mean -= nalgebra::Vector2::new(2.0, 0.0);
     let sitting_out = imm.predict(
