@@ -280,7 +280,7 @@ fn car_track_with_probabilities(probabilities: [f64; 4]) -> (ModeModels, Imm, pr
 
 #[test]
 fn the_fused_prior_weights_mode_priors_by_the_prior_probabilities() {
-    let (models, imm, mut state) = car_track_with_probabilities([0.1, 0.2, 0.3, 0.4]);
+    let (models, imm, state) = car_track_with_probabilities([0.1, 0.2, 0.3, 0.4]);
     let prior = imm.predict(
         &models,
         &state,
