@@ -311,11 +311,16 @@ def motion_frames(features: np.ndarray, length: np.ndarray, rng: np.random.Gener
     safe = np.where(has, norm, 1.0)
     cos = np.where(has, motion[:, 0] / safe, 1.0)
     sin = np.where(has, motion[:, 1] / safe, 0.0)
-    if rng is not None:
-        angle = rng.uniform(-np.pi, np.pi, n)
-        cos = np.where(has, cos, np.cos(angle))
-        sin = np.where(has, sin, np.sin(angle))
-    return cos, sin
+    return randomised_where_missing(cos, sin, has, rng)
+
+
+def randomised_where_missing(cos: np.ndarray, sin: np.ndarray, has: np.ndarray, rng: np.random.Generator | None):
+    """``(cos, sin)`` with the windows without a direction (``has`` false) turned to a random
+    direction when ``rng`` is given (training), left as they are otherwise."""
+    if rng is None:
+        return cos, sin
+    angle = rng.uniform(-np.pi, np.pi, len(has))
+    return np.where(has, cos, np.cos(angle)), np.where(has, sin, np.sin(angle))
 
 
 def line_of_sight_frames(line_of_sight: np.ndarray, rng: np.random.Generator | None = None):
@@ -323,13 +328,9 @@ def line_of_sight_frames(line_of_sight: np.ndarray, rng: np.random.Generator | N
     :func:`load_split`). Windows without one (NaN) get the identity, or a random direction when
     ``rng`` is given, as in :func:`motion_frames`."""
     has = np.isfinite(line_of_sight).all(axis=1)
-    cos = np.where(has, line_of_sight[:, 0], 1.0)
-    sin = np.where(has, line_of_sight[:, 1], 0.0)
-    if rng is not None:
-        angle = rng.uniform(-np.pi, np.pi, len(has))
-        cos = np.where(has, cos, np.cos(angle))
-        sin = np.where(has, sin, np.sin(angle))
-    return np.nan_to_num(cos, nan=1.0), np.nan_to_num(sin)
+    cos = np.where(has, np.nan_to_num(line_of_sight[:, 0], nan=1.0), 1.0)
+    sin = np.where(has, np.nan_to_num(line_of_sight[:, 1]), 0.0)
+    return randomised_where_missing(cos, sin, has, rng)
 
 
 def input_frames(

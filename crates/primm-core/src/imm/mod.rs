@@ -301,8 +301,7 @@ impl Imm {
             // Sitting out, the PR mode takes the fused physics prior instead of its own
             // position of the previous step, which nothing moved: it stays current, and no
             // stale position reaches the other modes through the next mixing.
-            let mean = nalgebra::Vector2::new(prior.fused.mean.x, prior.fused.mean.y);
-            state.learned = crate::gaussian::Gaussian::new(mean, to_nalgebra(&prior.fused.covariance));
+            replace_position(&mut state.learned, &prior.fused);
         }
     }
 

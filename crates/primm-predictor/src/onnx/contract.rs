@@ -77,12 +77,6 @@ impl InputFrame {
     }
 }
 
-impl fmt::Display for InputFrame {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
 /// The rotation of a request into the model's input axes (see the module documentation):
 /// `(x, y) ↦ (c·x + s·y, −s·x + c·y)` with `(c, s)` the unit direction of the axes' x axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
