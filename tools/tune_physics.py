@@ -472,6 +472,9 @@ def parse_args(argv=None):
                              "pr-noise)")
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--idf1-weight", type=float, default=20.0, help="metres of RMSE per unit of IDF1 lost")
+    parser.add_argument("--velocity-weight-s", type=float, default=0.0,
+                        help="seconds: metres of RMSE per m/s of velocity RMSE in the objective (the horizon "
+                             "over which a velocity error becomes a position error; 0: positions only)")
     parser.add_argument("--false-track-weight", type=float, default=0.001,
                         help="--parameters tracks: objective per false confirmed track per minute")
     parser.add_argument("--guard-config", default=None,
@@ -615,7 +618,7 @@ def score(args, text: str) -> dict:
         config = os.path.join(tmp, "config.toml")
         with open(config, "w") as handle:
             handle.write(text)
-        result = {"rmse_xy": [], "idf1": []}
+        result = {"rmse_xy": [], "idf1": [], "velocity_rmse_mps": []}
         for data in args.data:
             report = os.path.join(tmp, "report.json")
             subprocess.run(
@@ -628,6 +631,7 @@ def score(args, text: str) -> dict:
                 scored = json.load(handle)["methods"][args.method.replace("-", "_")]
             result["rmse_xy"].append(scored["rmse_xy"])
             result["idf1"].append(scored["idf1"])
+            result["velocity_rmse_mps"].append((scored.get("velocity") or {}).get("rmse_mps") or 0.0)
             if args.parameters == "tracks":
                 confirmed = scored.get("confirmed_tracks") or {}
                 result.setdefault("confirmed_idf1", []).append(confirmed.get("idf1") or 0.0)
@@ -660,8 +664,9 @@ def objective(args, result: dict, start: dict) -> float:
     if args.parameters == "tracks":
         return track_objective(args, result, start)
     terms = [
-        rmse + args.idf1_weight * max(0.0, idf1_start - idf1)
-        for rmse, idf1, idf1_start in zip(result["rmse_xy"], result["idf1"], start["idf1"])
+        rmse + args.velocity_weight_s * velocity + args.idf1_weight * max(0.0, idf1_start - idf1)
+        for rmse, velocity, idf1, idf1_start in zip(
+            result["rmse_xy"], result["velocity_rmse_mps"], result["idf1"], start["idf1"])
     ]
     return sum(terms) / len(terms)
 

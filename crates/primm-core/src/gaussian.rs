@@ -325,6 +325,10 @@ pub struct RadialVelocityObservation {
     /// Largest normalised residual `|ν|/√S` for which the row is applied; larger ones are
     /// skipped (a radial velocity that the track cannot explain), dimensionless.
     pub gate_std: f64,
+    /// A fixed unit line of sight `û` (from the sensor to the detection, whose azimuth the
+    /// radar measured): the row is then linear, `h(x) = û·v`. `None`: `û` runs from the sensor
+    /// to the state's position (an extended Kalman row).
+    pub measured_line_of_sight: Option<DVec2>,
 }
 
 /// What [`radial_velocity_update_in_place`] did.
@@ -373,9 +377,14 @@ pub fn radial_velocity_update_in_place<const N: usize>(
     velocity: usize,
     observation: &RadialVelocityObservation,
 ) -> Result<RadialVelocityOutcome, UpdateError> {
-    let Some((predicted, jacobian)) =
-        radial_velocity_and_jacobian(&gaussian.mean, velocity, observation.sensor_position_m)
-    else {
+    let row = match observation.measured_line_of_sight {
+        Some(along) => {
+            let v = DVec2::new(gaussian.mean[velocity], gaussian.mean[velocity + 1]);
+            Some((along.dot(v), [0.0, 0.0, along.x, along.y]))
+        }
+        None => radial_velocity_and_jacobian(&gaussian.mean, velocity, observation.sensor_position_m),
+    };
+    let Some((predicted, jacobian)) = row else {
         return Ok(RadialVelocityOutcome::NoLineOfSight);
     };
     let columns = [X, Y, velocity, velocity + 1];
@@ -587,6 +596,7 @@ mod tests {
             sensor_position_m: sensor,
             variance_mps2: 0.09,
             gate_std: 1e9,
+            measured_line_of_sight: None,
         }
     }
 

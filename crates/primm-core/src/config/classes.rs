@@ -106,12 +106,39 @@ pub struct RadialVelocityUpdateConfig {
     /// Residuals beyond this many standard deviations of their innovation are not applied
     /// (counted): a radial velocity the track cannot explain, dimensionless.
     pub gate_std: f64,
+    /// Along which direction the radial velocity is taken to measure the velocity (absent:
+    /// `predicted`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub line_of_sight: RadialLineOfSight,
+}
+
+/// The direction `û` of the radial-velocity row `h(x) = û·v`
+/// (`classes.<class>.radial_velocity_update.line_of_sight`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum RadialLineOfSight {
+    /// From the sensor to the track's estimated position (the object's centre): an extended
+    /// Kalman row, whose Jacobian also reaches the position.
+    #[default]
+    Predicted,
+    /// From the sensor to the detection itself, whose azimuth the radar measured: where the
+    /// reflection that gave the radial velocity lies. Every point of a body that does not turn
+    /// moves with the same velocity, so the row is linear (`∂h/∂p = 0`) and exact for a
+    /// reflection off an extended object's contour, whose direction differs from the centre's.
+    Measured,
 }
 
 impl Default for RadialVelocityUpdateConfig {
-    /// Off; 0.5 m/s and a gate of 4 standard deviations when switched on.
+    /// Off; 0.5 m/s and a gate of 4 standard deviations when switched on, along the predicted
+    /// line of sight.
     fn default() -> Self {
-        RadialVelocityUpdateConfig { enabled: false, std_mps: 0.5, gate_std: 4.0 }
+        RadialVelocityUpdateConfig {
+            enabled: false,
+            std_mps: 0.5,
+            gate_std: 4.0,
+            line_of_sight: RadialLineOfSight::Predicted,
+        }
     }
 }
 

@@ -25,7 +25,7 @@ pub use constant_velocity::ConstantVelocity;
 pub use coordinated_turn::CoordinatedTurn;
 pub use learned::LearnedDisplacement;
 
-use crate::config::{ClassConfig, RadialVelocityUpdateConfig};
+use crate::config::{ClassConfig, RadialLineOfSight, RadialVelocityUpdateConfig};
 use crate::extent::{ExpectedReflection, ExtentConfig, ObjectPrior};
 use crate::gaussian::{Gaussian, RadialVelocityObservation};
 use crate::measurement::Measurement;
@@ -148,11 +148,26 @@ impl ModeModels {
         sensor_position_m: DVec2,
     ) -> Option<RadialVelocityObservation> {
         let update = &self.radial_velocity_update;
-        update.enabled.then(|| RadialVelocityObservation {
+        if !update.enabled {
+            return None;
+        }
+        let measured_line_of_sight = match update.line_of_sight {
+            RadialLineOfSight::Predicted => None,
+            RadialLineOfSight::Measured => {
+                let offset = DVec2::new(measurement.x_m, measurement.y_m) - sensor_position_m;
+                let range = offset.length();
+                if !(range >= crate::gaussian::MIN_LINE_OF_SIGHT_RANGE_M) {
+                    return None;
+                }
+                Some(offset / range)
+            }
+        };
+        Some(RadialVelocityObservation {
             radial_velocity_mps: measurement.radial_velocity_mps,
             sensor_position_m,
             variance_mps2: crate::math::square(update.std_mps),
             gate_std: update.gate_std,
+            measured_line_of_sight,
         })
     }
 }
