@@ -12,7 +12,9 @@ directory of ``--data`` (validation splits only: the script refuses a directory 
     mean over the directories of  RMSE_xy + idf1_weight * max(0, IDF1_start - IDF1)
 
 (RMSE_xy in metres against the true object centre; IDF1_start: the starting configuration's),
-i.e. prior accuracy, without giving up identity. The result is written as a complete TOML
+i.e. prior accuracy, without giving up identity. ``--velocity-weight-s W`` adds ``W * velocity
+RMSE`` to each directory's term (W in seconds: the horizon over which a velocity error becomes a
+position error; default 0, positions only), for users who plan on the tracks' velocities. The result is written as a complete TOML
 file (the input with the chosen values substituted, comments kept) and a JSON log of every run.
 
     target/release/primm generate --output out/tune/default --split validation
@@ -663,10 +665,10 @@ def scored_pr_probability(report: str, method: str):
 def objective(args, result: dict, start: dict) -> float:
     if args.parameters == "tracks":
         return track_objective(args, result, start)
+    velocities = result.get("velocity_rmse_mps") or [0.0] * len(result["rmse_xy"])
     terms = [
         rmse + args.velocity_weight_s * velocity + args.idf1_weight * max(0.0, idf1_start - idf1)
-        for rmse, velocity, idf1, idf1_start in zip(
-            result["rmse_xy"], result["velocity_rmse_mps"], result["idf1"], start["idf1"])
+        for rmse, velocity, idf1, idf1_start in zip(result["rmse_xy"], velocities, result["idf1"], start["idf1"])
     ]
     return sum(terms) / len(terms)
 

@@ -294,6 +294,23 @@ def test_an_idf1_loss_outweighs_a_small_rmse_gain(tmp_path, monkeypatch):
     assert tomllib.loads(out.read_text()) == tomllib.loads(shipped_text())
 
 
+def test_the_velocity_weight_prices_velocity_rmse_in_metres_per_metre_per_second(tmp_path):
+    """--velocity-weight-s adds that many metres of objective per m/s of velocity RMSE; without it
+    velocities do not count."""
+    out = str(tmp_path / "o.toml")
+    start = {"rmse_xy": [1.0, 2.0], "idf1": [0.9, 0.8], "velocity_rmse_mps": [1.5, 2.5]}
+    positions_only = tune_physics.parse_args(["--data", "a/validation", "--out", out])
+    assert abs(tune_physics.objective(positions_only, start, start) - 1.5) < 1e-12
+    weighted = tune_physics.parse_args(["--data", "a/validation", "--out", out, "--velocity-weight-s", "0.5"])
+    assert abs(tune_physics.objective(weighted, start, start) - (1.5 + 0.5 * 2.0)) < 1e-12
+    # A truer velocity is worth a little position error, but not lost identity.
+    truer_velocity = dict(start, rmse_xy=[1.01, 2.01], velocity_rmse_mps=[1.3, 2.3])
+    assert tune_physics.objective(weighted, truer_velocity, start) < tune_physics.objective(weighted, start, start)
+    assert tune_physics.objective(positions_only, truer_velocity, start) > 1.5
+    lost_identity = dict(truer_velocity, idf1=[0.89, 0.8])
+    assert tune_physics.objective(weighted, lost_identity, start) > tune_physics.objective(weighted, start, start)
+
+
 # --- imm-class: the PR mode's weight per class, in [classes.<class>.imm] ---
 
 def shipped_imm():
@@ -414,7 +431,8 @@ def test_the_oracle_flag_reaches_every_primm_eval_call(tmp_path, monkeypatch):
         args = tune_physics.parse_args(["--data", "a/validation", "b/validation", "--out", str(tmp_path / "o.toml"),
                                         "--parameters", "imm", "--method", "pr-imm"] + flag)
         commands.clear()
-        assert tune_physics.score(args, shipped_text()) == {"rmse_xy": [1.0, 1.0], "idf1": [0.9, 0.9]}
+        assert tune_physics.score(args, shipped_text()) == {"rmse_xy": [1.0, 1.0], "idf1": [0.9, 0.9],
+                                                            "velocity_rmse_mps": [0.0, 0.0]}
         assert len(commands) == 2
         assert all(("--displacement-oracle" in command) == expected for command in commands)
         noise = "0.1" in flag

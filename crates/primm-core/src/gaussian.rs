@@ -668,6 +668,65 @@ mod tests {
     }
 
     #[test]
+    fn a_row_along_the_measured_line_of_sight_is_the_linear_joseph_update_with_no_position_jacobian() {
+        for i in 0..40 {
+            let angle = f64::from(i) * 0.41;
+            let prior = Gaussian::new(
+                Vector4::new(10.0 * angle.cos(), 10.0 * angle.sin(), 2.0 * angle.sin(), -1.0),
+                spd4() * (0.5 + f64::from(i % 4)),
+            );
+            let along = DVec2::new((angle + 0.2).cos(), (angle + 0.2).sin());
+            let z = 1.5 * angle.cos();
+            let h = nalgebra::RowVector4::new(0.0, 0.0, along.x, along.y);
+            let predicted = (h * prior.mean)[(0, 0)];
+            let s = (h * prior.covariance * h.transpose())[(0, 0)] + 0.09;
+            let k = prior.covariance * h.transpose() / s;
+            let i_kh = Matrix4::identity() - k * h;
+            let covariance = i_kh * prior.covariance * i_kh.transpose() + k * 0.09 * k.transpose();
+            let mean = prior.mean + k * (z - predicted);
+            let mut ours = prior;
+            let observation = RadialVelocityObservation {
+                measured_line_of_sight: Some(along),
+                ..observation(z, DVec2::new(1.0, -0.5))
+            };
+            assert_eq!(
+                radial_velocity_update_in_place(&mut ours, 2, &observation),
+                Ok(RadialVelocityOutcome::Applied)
+            );
+            assert!((ours.mean - mean).abs().max() < 1e-12, "case {i}");
+            assert!((ours.covariance - covariance).abs().max() < 1e-12 * covariance.abs().max(), "case {i}");
+        }
+    }
+
+    #[test]
+    fn off_the_centre_the_measured_line_of_sight_explains_a_reflection_that_the_predicted_one_does_not() {
+        // A body crossing at 8 m/s, 10 m ahead of the sensor, measured at a reflection 1.5 m to
+        // the side of its centre: the radial velocity there is the velocity along that direction.
+        let velocity = DVec2::new(0.0, 8.0);
+        let reflection = DVec2::new(10.0, -1.5);
+        let along = reflection.normalize();
+        let measured = along.dot(velocity);
+        let prior = Gaussian::new(Vector4::new(10.0, 0.0, velocity.x, velocity.y), Matrix4::identity() * 4.0);
+        let mut exact = prior;
+        let row = RadialVelocityObservation {
+            measured_line_of_sight: Some(along),
+            ..observation(measured, DVec2::ZERO)
+        };
+        radial_velocity_update_in_place(&mut exact, 2, &row).unwrap();
+        assert!(
+            (exact.mean - prior.mean).abs().max() < 1e-12,
+            "the true state predicts the measurement exactly"
+        );
+        let mut towards_centre = prior;
+        radial_velocity_update_in_place(&mut towards_centre, 2, &observation(measured, DVec2::ZERO)).unwrap();
+        let pulled = (towards_centre.mean.fixed_rows::<2>(2) - prior.mean.fixed_rows::<2>(2)).norm();
+        assert!(
+            pulled > 0.5,
+            "along the centre's line of sight the same reading moves the velocity by {pulled} m/s"
+        );
+    }
+
+    #[test]
     fn gated_and_degenerate_radial_velocity_rows_leave_the_estimate_unchanged() {
         let prior = Gaussian::new(Vector4::new(10.0, 0.0, 0.0, 0.0), Matrix4::identity());
         let mut gated = prior;

@@ -87,10 +87,8 @@ fn car() -> ClassConfig {
         existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
         duplicate_distance_m: 3.0,
         duplicate_speed_difference_mps: 2.0,
-        // The detection's own line of sight, chosen on validation (`config/primm.toml`).
         radial_velocity_update: RadialVelocityUpdateConfig {
             enabled: true,
-            line_of_sight: RadialLineOfSight::Measured,
             ..RadialVelocityUpdateConfig::default()
         },
         extent: ExtentConfig {
@@ -99,7 +97,7 @@ fn car() -> ClassConfig {
             absorb_extra_detections: true,
             ..ExtentConfig::default()
         },
-        constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.5 },
+        constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 1.0 },
         constant_acceleration: ConstantAccelerationConfig {
             jerk_psd_m2_per_s5: 5.0,
             initial_acceleration_std_mps2: 2.0,
@@ -114,16 +112,15 @@ fn car() -> ClassConfig {
             process_noise_covariance_m2: diagonal(0.011, 0.011),
             measurement_noise_covariance_m2: diagonal(0.18, 0.18),
         },
-        // PR all but off for cars, and no entry into CA (it stays at the probability floor):
-        // the IMM of cars is CV and CT. Chosen on validation (`config/primm.toml`).
+        // PR all but OFF for cars, chosen on validation (`config/primm.toml`).
         imm: ClassImmConfig {
             transition: Some([
-                [0.52, 0.24, 0.0, 0.24],
-                [0.000625, 0.989375, 0.0, 0.01],
-                [0.000625, 0.499, 0.001, 0.499375],
-                [0.000625, 0.01, 0.0, 0.989375],
+                [0.52, 0.16, 0.16, 0.16],
+                [0.000625, 0.9791856, 0.0100947, 0.0100947],
+                [0.000625, 0.0100947, 0.9791856, 0.0100947],
+                [0.000625, 0.0100947, 0.0100947, 0.9791856],
             ]),
-            initial_mode_probabilities: Some([0.005182, 0.497409, 0.000001, 0.497408]),
+            initial_mode_probabilities: Some([0.005182, 0.331606, 0.331606, 0.331606]),
         },
     }
 }
@@ -141,18 +138,17 @@ fn pedestrian() -> ClassConfig {
         duplicate_speed_difference_mps: 1.0,
         radial_velocity_update: RadialVelocityUpdateConfig {
             enabled: true,
-            line_of_sight: RadialLineOfSight::Measured,
             ..RadialVelocityUpdateConfig::default()
         },
         extent: ExtentConfig::default(),
-        constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.125 },
+        constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
         constant_acceleration: ConstantAccelerationConfig {
             jerk_psd_m2_per_s5: 1.75,
             initial_acceleration_std_mps2: 1.0,
         },
         coordinated_turn: CoordinatedTurnConfig {
             acceleration_psd_m2_per_s3: 0.25,
-            turn_rate_psd_rad2_per_s3: 0.5,
+            turn_rate_psd_rad2_per_s3: 0.25,
             initial_turn_rate_std_radps: 0.5,
             max_turn_rate_radps: DEFAULT_MAX_TURN_RATE_RADPS,
         },
