@@ -235,17 +235,34 @@ fn for_extended_cars_the_detections_own_line_of_sight_gives_truer_velocities_tha
 }
 
 #[test]
-fn the_line_of_sight_key_reads_predicted_and_measured_and_defaults_to_predicted() {
+fn the_line_of_sight_key_reads_all_three_directions_and_defaults_to_predicted() {
     // The shipped file, with the car's key replaced (its first occurrence is in the car section).
     let shipped = primm_config::DEFAULT_CONFIG_TOML;
-    let key = "line_of_sight = \"predicted\"\n";
+    let key = "line_of_sight = \"measured\"\n";
     assert!(shipped.contains(key));
     let read = |replacement: &str| {
         primm_config::from_toml_str(&shipped.replacen(key, replacement, 1))
             .map(|config| config.classes.get(ObjectClass::Car).radial_velocity_update.line_of_sight)
     };
-    assert_eq!(read(key).unwrap(), RadialLineOfSight::Predicted);
+    assert_eq!(read(key).unwrap(), RadialLineOfSight::Measured);
     assert_eq!(read("").unwrap(), RadialLineOfSight::Predicted);
-    assert_eq!(read("line_of_sight = \"measured\"\n").unwrap(), RadialLineOfSight::Measured);
+    assert_eq!(read("line_of_sight = \"predicted\"\n").unwrap(), RadialLineOfSight::Predicted);
+    assert_eq!(read("line_of_sight = \"reflection\"\n").unwrap(), RadialLineOfSight::Reflection);
     assert!(read("line_of_sight = \"centre\"\n").is_err());
+}
+
+#[test]
+fn for_a_point_class_the_reflection_line_of_sight_is_the_predicted_one() {
+    let frames = frames(40, Some(3), 17);
+    let tracker_along = |line_of_sight: RadialLineOfSight| {
+        let mut config = config(true);
+        config.classes.get_mut(ObjectClass::Car).radial_velocity_update.line_of_sight = line_of_sight;
+        Tracker::new(config).unwrap()
+    };
+    let (mut predicted, mut reflection) =
+        (tracker_along(RadialLineOfSight::Predicted), tracker_along(RadialLineOfSight::Reflection));
+    for (frame, _) in &frames {
+        assert_eq!(predicted.step(frame).unwrap(), reflection.step(frame).unwrap());
+    }
+    assert!(predicted.stats().radial_velocity_updates > 100);
 }

@@ -157,9 +157,10 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             let expected = match measurements[i] {
                 Some(z) => {
                     let models = &models[track.class.index()];
-                    let radial_velocity = models.radial_velocity_observation(&z, sensors[i]);
-                    assert!(radial_velocity.is_some());
                     let reflection = models.expected_reflection(&plain[i].object_prior(), sensors[i]);
+                    let radial_velocity =
+                        models.radial_velocity_observation(&z, sensors[i], reflection.offset_m);
+                    assert!(radial_velocity.is_some());
                     assert_eq!(reflection.offset_m == DVec2::ZERO, track.class != ObjectClass::Car);
                     imms[track.class.index()].update_with_radial_velocity_into(
                         models,

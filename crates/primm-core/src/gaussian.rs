@@ -329,6 +329,15 @@ pub struct RadialVelocityObservation {
     /// radar measured): the row is then linear, `h(x) = û·v`. `None`: `û` runs from the sensor
     /// to the state's position (an extended Kalman row).
     pub measured_line_of_sight: Option<DVec2>,
+    /// Without a fixed line of sight: the offset of the reflection from the state's position,
+    /// m, so that `û` runs from the sensor to the state's position plus this offset (held fixed
+    /// in the Jacobian). Zero: to the state's position.
+    pub reflection_offset_m: DVec2,
+    /// Variance of the direction of `measured_line_of_sight`, rad²: the detection's position
+    /// noise across the line of sight over its range squared. A direction off by `δ` misreads
+    /// the velocity across the line of sight `v⊥` by `|v⊥|·δ`, so the row's variance grows by
+    /// `|v⊥|²` times this (at the state's velocity). Zero without a measured line of sight.
+    pub line_of_sight_variance_rad2: f64,
 }
 
 /// What [`radial_velocity_update_in_place`] did.
@@ -377,12 +386,21 @@ pub fn radial_velocity_update_in_place<const N: usize>(
     velocity: usize,
     observation: &RadialVelocityObservation,
 ) -> Result<RadialVelocityOutcome, UpdateError> {
+    let v = DVec2::new(gaussian.mean[velocity], gaussian.mean[velocity + 1]);
+    let mut variance = observation.variance_mps2;
     let row = match observation.measured_line_of_sight {
         Some(along) => {
-            let v = DVec2::new(gaussian.mean[velocity], gaussian.mean[velocity + 1]);
-            Some((along.dot(v), [0.0, 0.0, along.x, along.y]))
+            let radial = along.dot(v);
+            variance += (v - radial * along).length_squared() * observation.line_of_sight_variance_rad2;
+            Some((radial, [0.0, 0.0, along.x, along.y]))
         }
-        None => radial_velocity_and_jacobian(&gaussian.mean, velocity, observation.sensor_position_m),
+        // `p + o − s = p − (s − o)`: the reflection seen from the sensor is the state's position
+        // seen from the sensor moved back by the offset, with the same Jacobian in `p`.
+        None => radial_velocity_and_jacobian(
+            &gaussian.mean,
+            velocity,
+            observation.sensor_position_m - observation.reflection_offset_m,
+        ),
     };
     let Some((predicted, jacobian)) = row else {
         return Ok(RadialVelocityOutcome::NoLineOfSight);
@@ -394,8 +412,7 @@ pub fn radial_velocity_update_in_place<const N: usize>(
     for (row, value) in c.iter_mut().enumerate() {
         *value = columns.iter().zip(&jacobian).map(|(&column, h)| p[(row, column)] * h).sum();
     }
-    let s = columns.iter().zip(&jacobian).map(|(&column, h)| c[column] * h).sum::<f64>()
-        + observation.variance_mps2;
+    let s = columns.iter().zip(&jacobian).map(|(&column, h)| c[column] * h).sum::<f64>() + variance;
     if !(s > 0.0 && s.is_finite()) {
         return Err(UpdateError);
     }
@@ -420,7 +437,7 @@ pub fn radial_velocity_update_in_place<const N: usize>(
     for row in 0..N {
         for column in row..N {
             let a = p[(row, column)] - gain[row] * c[column];
-            let value = a - a_h[row] * gain[column] + observation.variance_mps2 * gain[row] * gain[column];
+            let value = a - a_h[row] * gain[column] + variance * gain[row] * gain[column];
             // Upper triangle of A − a kᵀ + σ² k kᵀ, mirrored (the Joseph product is symmetric).
             updated.covariance[(row, column)] = value;
             updated.covariance[(column, row)] = value;
@@ -597,6 +614,8 @@ mod tests {
             variance_mps2: 0.09,
             gate_std: 1e9,
             measured_line_of_sight: None,
+            reflection_offset_m: DVec2::ZERO,
+            line_of_sight_variance_rad2: 0.0,
         }
     }
 
@@ -724,6 +743,46 @@ mod tests {
             pulled > 0.5,
             "along the centre's line of sight the same reading moves the velocity by {pulled} m/s"
         );
+    }
+
+    #[test]
+    fn a_noisy_measured_direction_weighs_the_row_by_the_velocity_across_it() {
+        // The variance grows by |v⊥|² δ²: with no velocity across the line of sight the row is
+        // as without direction noise; with 4 m/s across it and δ² = 0.01 rad², S grows by 0.16.
+        let along = DVec2::X;
+        let row = |vy: f64, direction_variance: f64| {
+            let prior = Gaussian::new(Vector4::new(10.0, 0.0, 1.0, vy), Matrix4::identity());
+            let mut posterior = prior;
+            let observation = RadialVelocityObservation {
+                measured_line_of_sight: Some(along),
+                line_of_sight_variance_rad2: direction_variance,
+                ..observation(2.0, DVec2::ZERO)
+            };
+            radial_velocity_update_in_place(&mut posterior, 2, &observation).unwrap();
+            posterior
+        };
+        assert_eq!(row(0.0, 0.01), row(0.0, 0.0));
+        let (noisy, exact) = (row(4.0, 0.01), row(4.0, 0.0));
+        // Gain on vx: 1/(1 + 0.09 + extra).
+        assert!((exact.mean[2] - (1.0 + 1.0 / 1.09)).abs() < 1e-12);
+        assert!((noisy.mean[2] - (1.0 + 1.0 / 1.25)).abs() < 1e-12);
+        assert!(noisy.covariance[(2, 2)] > exact.covariance[(2, 2)]);
+    }
+
+    #[test]
+    fn a_reflection_offset_moves_the_line_of_sight_as_a_shifted_sensor_would() {
+        let prior = Gaussian::new(Vector4::new(10.0, 3.0, -2.0, 5.0), spd4());
+        let offset = DVec2::new(-1.0, 0.8);
+        let sensor = DVec2::new(1.0, -0.5);
+        let mut with_offset = prior;
+        let row = RadialVelocityObservation { reflection_offset_m: offset, ..observation(1.0, sensor) };
+        radial_velocity_update_in_place(&mut with_offset, 2, &row).unwrap();
+        let mut shifted = prior;
+        radial_velocity_update_in_place(&mut shifted, 2, &observation(1.0, sensor - offset)).unwrap();
+        assert_eq!(with_offset, shifted);
+        let mut centre = prior;
+        radial_velocity_update_in_place(&mut centre, 2, &observation(1.0, sensor)).unwrap();
+        assert!((centre.mean - with_offset.mean).abs().max() > 1e-3, "the offset changes the row");
     }
 
     #[test]

@@ -150,7 +150,7 @@ fn update_loop(
                 let class = track.class.index();
                 let models = &models[class];
                 let radial_velocity = models
-                    .radial_velocity_observation(z, *sensor_position_m)
+                    .radial_velocity_observation(z, *sensor_position_m, reflection.offset_m)
                     .filter(|_| radial_velocity_rows);
                 imms[class].update_with_radial_velocity_into(
                     models,

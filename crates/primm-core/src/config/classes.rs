@@ -126,7 +126,13 @@ pub enum RadialLineOfSight {
     /// reflection that gave the radial velocity lies. Every point of a body that does not turn
     /// moves with the same velocity, so the row is linear (`∂h/∂p = 0`) and exact for a
     /// reflection off an extended object's contour, whose direction differs from the centre's.
+    /// The direction carries the detection's position noise, which at short range is large.
     Measured,
+    /// From the sensor to the expected reflection: the track's estimated centre plus the
+    /// extended-object model's expected offset of the reflection (`crate::extent`), an extended
+    /// Kalman row like `predicted` (the offset held fixed in the Jacobian). For a point class the
+    /// offset is zero and this is `predicted`.
+    Reflection,
 }
 
 impl Default for RadialVelocityUpdateConfig {

@@ -87,8 +87,10 @@ fn car() -> ClassConfig {
         existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
         duplicate_distance_m: 3.0,
         duplicate_speed_difference_mps: 2.0,
+        // The detection's own line of sight, chosen on validation (`config/primm.toml`).
         radial_velocity_update: RadialVelocityUpdateConfig {
             enabled: true,
+            line_of_sight: RadialLineOfSight::Measured,
             ..RadialVelocityUpdateConfig::default()
         },
         extent: ExtentConfig {
@@ -138,6 +140,7 @@ fn pedestrian() -> ClassConfig {
         duplicate_speed_difference_mps: 1.0,
         radial_velocity_update: RadialVelocityUpdateConfig {
             enabled: true,
+            line_of_sight: RadialLineOfSight::Measured,
             ..RadialVelocityUpdateConfig::default()
         },
         extent: ExtentConfig::default(),

@@ -141,25 +141,34 @@ impl ModeModels {
     }
 
     /// The radial-velocity row for `measurement` seen by a radar at `sensor_position_m` (the
-    /// frame of the state), or `None` when this class's `radial_velocity_update` is off.
+    /// frame of the state), with the expected reflection's offset from the object's centre
+    /// `reflection_offset_m` (zero for a point), or `None` when this class's
+    /// `radial_velocity_update` is off.
     pub fn radial_velocity_observation(
         &self,
         measurement: &Measurement,
         sensor_position_m: DVec2,
+        reflection_offset_m: DVec2,
     ) -> Option<RadialVelocityObservation> {
         let update = &self.radial_velocity_update;
         if !update.enabled {
             return None;
         }
-        let measured_line_of_sight = match update.line_of_sight {
-            RadialLineOfSight::Predicted => None,
+        let (measured_line_of_sight, line_of_sight_variance_rad2) = match update.line_of_sight {
+            RadialLineOfSight::Predicted | RadialLineOfSight::Reflection => (None, 0.0),
             RadialLineOfSight::Measured => {
                 let offset = DVec2::new(measurement.x_m, measurement.y_m) - sensor_position_m;
                 let range = offset.length();
                 if !(range >= crate::gaussian::MIN_LINE_OF_SIGHT_RANGE_M) {
                     return None;
                 }
-                Some(offset / range)
+                let along = offset / range;
+                // The detection's noise across the line of sight, over the range: the
+                // direction's variance.
+                let across = Vector2::new(-along.y, along.x);
+                let noise = self.constant_velocity.measurement_noise();
+                let across_variance_m2 = (across.transpose() * noise * across)[(0, 0)];
+                (Some(along), across_variance_m2 / (range * range))
             }
         };
         Some(RadialVelocityObservation {
@@ -168,6 +177,11 @@ impl ModeModels {
             variance_mps2: crate::math::square(update.std_mps),
             gate_std: update.gate_std,
             measured_line_of_sight,
+            line_of_sight_variance_rad2,
+            reflection_offset_m: match update.line_of_sight {
+                RadialLineOfSight::Reflection => reflection_offset_m,
+                RadialLineOfSight::Predicted | RadialLineOfSight::Measured => DVec2::ZERO,
+            },
         })
     }
 }
