@@ -205,3 +205,42 @@ fn a_sensor_without_a_mount_is_seen_from_the_reference_point_and_counted() {
     assert!(velocity.perp_dot(line_of_sight).abs() < 1e-6, "{velocity} not along {line_of_sight}");
     assert!((velocity.dot(line_of_sight) - objects(0.0)[1].1.dot(line_of_sight)).abs() < 1e-9);
 }
+
+#[test]
+fn velocities_change_reference_with_the_frame_when_poses_stop_and_resume() {
+    // Poses for 1 s, none for 0.5 s, then poses again. Without poses the tracks learn the
+    // velocity relative to the ego (about 8 m/s here); in the frame where the poses return, the
+    // ego's velocity over the gap is added back, so the world velocities are about right at
+    // once instead of off by the ego's speed.
+    let mut tracker = Tracker::new(config(CoordinateFrame::World)).unwrap();
+    let with_pose = |k: usize| !(20..30).contains(&k);
+    let mut worst_after_return = 0.0f64;
+    for k in 0..31 {
+        let t = k as f64 * DT_S;
+        let outputs = tracker.step(&frame(t, &objects(t), with_pose(k))).unwrap().to_vec();
+        if k == 20 {
+            // Leaving the world frame: the parked car now moves against the moving, turning ego:
+            // −(v_ego + ω × (p − p_ego)) in the vehicle's axes.
+            let parked = outputs.iter().find(|o| o.ground_truth_id == Some(0)).unwrap();
+            let pose = ego_pose(t);
+            let offset = objects(t)[0].0 - pose.position();
+            let apparent = -(ego_velocity(t) + 0.4 * offset.perp());
+            let relative = pose.world_to_vehicle().apply_vector(apparent);
+            assert!((parked.velocity_mps - relative).length() < 1.5, "{} vs {relative}", parked.velocity_mps);
+        }
+        if k == 30 {
+            for output in &outputs {
+                let truth = objects(t)[output.ground_truth_id.unwrap() as usize].1;
+                let velocity = output.world_velocity_mps.expect("back in the world frame");
+                worst_after_return = worst_after_return.max((velocity - truth).length());
+            }
+        }
+    }
+    assert!(worst_after_return < 2.5, "world velocity error {worst_after_return} m/s where the poses return");
+}
+
+/// The ego's velocity over ground at `t`, m/s.
+fn ego_velocity(t: f64) -> DVec2 {
+    let step = 1e-3;
+    (ego_pose(t + step).position() - ego_pose(t - step).position()) / (2.0 * step)
+}

@@ -194,6 +194,41 @@ impl SensorMount {
     }
 }
 
+
+/// The ego's motion as consecutive poses tell it: when the latest pose was taken and the ego's
+/// velocity over ground between the two latest poses (world frame). The tracker uses it where
+/// its tracks change frame: a velocity estimated in the vehicle frame without poses is the
+/// object's velocity relative to the ego, and a velocity over ground is not.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EgoMotion {
+    /// Time of the latest pose, s.
+    pub pose_time_s: Option<f64>,
+    /// The ego's velocity over ground from the two latest poses, m/s (world frame).
+    pub velocity_mps: Option<DVec2>,
+    /// The ego's yaw rate from the two latest poses, rad/s (counter-clockwise positive).
+    pub yaw_rate_radps: Option<f64>,
+}
+
+/// The velocity field of a rigid motion in the plane: at a point `p`, `v + ω × (p − c)` with
+/// `v` the velocity of the point `c` and `ω` the yaw rate (`ω × r = ω·(−r_y, r_x)`). The
+/// apparent velocity of a point at rest, seen from a vehicle moving so, is minus this.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidVelocity {
+    /// Velocity of the reference point, m/s.
+    pub velocity_mps: DVec2,
+    /// Yaw rate, rad/s.
+    pub yaw_rate_radps: f64,
+    /// The reference point, m.
+    pub centre_m: DVec2,
+}
+
+impl RigidVelocity {
+    /// The velocity of the field at `point_m`, m/s.
+    pub fn at(&self, point_m: DVec2) -> DVec2 {
+        self.velocity_mps + self.yaw_rate_radps * (point_m - self.centre_m).perp()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

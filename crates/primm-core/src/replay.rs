@@ -41,6 +41,8 @@ pub(crate) struct TrackerSnapshot {
     pub tracks_frame: CoordinateFrame,
     /// The ego pose of the newest frame tracked in the world frame.
     pub last_pose: Option<EgoPose>,
+    /// The ego's motion as the poses tell it.
+    pub ego_motion: crate::pose::EgoMotion,
     /// The counters.
     pub stats: TrackerStats,
 }
@@ -53,6 +55,7 @@ impl TrackerSnapshot {
             last_timestamp_s: None,
             tracks_frame: CoordinateFrame::Vehicle,
             last_pose: None,
+            ego_motion: crate::pose::EgoMotion::default(),
             stats: TrackerStats::default(),
         }
     }

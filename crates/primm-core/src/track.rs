@@ -154,6 +154,14 @@ impl Track {
         }
     }
 
+    /// Adds the velocity field `field` times `sign` to every mode's velocity: the same motion
+    /// seen against another reference (the ego's motion, where the track changes between the
+    /// vehicle and the world frame).
+    pub fn add_velocity_field(&mut self, field: &crate::pose::RigidVelocity, sign: f64) {
+        self.estimate.add_velocity_field(field, sign);
+        self.remembered_displacement = None;
+    }
+
     /// Records an associated measurement taken by the radar at `sensor_m` (a coasting track is
     /// confirmed again; confirming a tentative one is the lifecycle's decision).
     pub fn record_hit(&mut self, measurement: &Measurement, sensor_m: DVec2, timestamp_s: f64) {

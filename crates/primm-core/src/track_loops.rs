@@ -36,6 +36,12 @@ pub fn class_imms(config: &crate::config::Config) -> ClassImms {
     ObjectClass::ALL.map(|class| Imm::new(&config.imm_for(class)))
 }
 
+/// Each class's IMM for steps whose ego motion is compensated
+/// ([`Config::compensated_imm_for`](crate::config::Config::compensated_imm_for)).
+pub fn class_compensated_imms(config: &crate::config::Config) -> ClassImms {
+    ObjectClass::ALL.map(|class| Imm::new(&config.compensated_imm_for(class)))
+}
+
 /// Mixing and the CV, CA and CT predictions of every track into `priors` (same order, at
 /// least as long as `tracks`).
 #[cfg_attr(feature = "std", multiversion(targets("x86_64+avx+avx2+fma")))]

@@ -114,7 +114,8 @@ fn car() -> ClassConfig {
             process_noise_covariance_m2: diagonal(0.011, 0.011),
             measurement_noise_covariance_m2: diagonal(0.18, 0.18),
         },
-        // PR all but OFF for cars, chosen on validation (`config/primm.toml`).
+        // PR all but OFF for cars, and CA entered rarely where the ego's motion is compensated:
+        // chosen on validation (`config/primm.toml`).
         imm: ClassImmConfig {
             transition: Some([
                 [0.52, 0.16, 0.16, 0.16],
@@ -123,6 +124,13 @@ fn car() -> ClassConfig {
                 [0.000625, 0.0100947, 0.0100947, 0.9791856],
             ]),
             initial_mode_probabilities: Some([0.005182, 0.331606, 0.331606, 0.331606]),
+            compensated_transition: Some([
+                [0.52, 0.16, 0.16, 0.16],
+                [0.000625, 0.987375, 0.002, 0.01],
+                [0.000625, 0.0100947, 0.9791856, 0.0100947],
+                [0.000625, 0.01, 0.002, 0.987375],
+            ]),
+            compensated_initial_mode_probabilities: Some([0.005182, 0.472409, 0.05, 0.472409]),
         },
     }
 }
@@ -168,6 +176,7 @@ fn pedestrian() -> ClassConfig {
                 [OFF, OFF, OFF, STAY],
             ]),
             initial_mode_probabilities: Some([0.04, 0.32, 0.32, 0.32]),
+            ..ClassImmConfig::default()
         },
     }
 }

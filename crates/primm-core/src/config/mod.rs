@@ -89,6 +89,13 @@ impl Config {
         self.imm.with_overrides(&self.classes.get(class).imm)
     }
 
+    /// The IMM settings of `class` in steps whose ego motion is compensated (a frame with an ego
+    /// pose, tracked in the world frame): [`imm_for`](Self::imm_for) with the class's
+    /// `compensated_*` keys applied.
+    pub fn compensated_imm_for(&self, class: ObjectClass) -> ImmConfig {
+        self.imm.with_compensated_overrides(&self.classes.get(class).imm)
+    }
+
     /// Checks every value; the error names the first offending key.
     pub fn validate(&self) -> Result<(), ConfigError> {
         validate_imm(&self.imm)?;

@@ -192,12 +192,25 @@ pub struct ClassImmConfig {
     /// Mode probabilities of a new track of this class (renormalised over the active modes).
     #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
     pub initial_mode_probabilities: Option<[f64; MODE_COUNT]>,
+    /// The transition matrix of this class in steps whose ego motion is compensated (the frame
+    /// has an ego pose and is tracked in the world frame; absent: `transition`). Without the
+    /// ego's motion the state follows the scene as the ego turns and brakes, which a manoeuvre
+    /// mode can follow; with it, the object's own motion remains.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub compensated_transition: Option<[[f64; MODE_COUNT]; MODE_COUNT]>,
+    /// The initial mode probabilities of a track started in such a step (absent:
+    /// `initial_mode_probabilities`).
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub compensated_initial_mode_probabilities: Option<[f64; MODE_COUNT]>,
 }
 
 impl ClassImmConfig {
     /// No override at all.
     pub fn is_empty(&self) -> bool {
-        self.transition.is_none() && self.initial_mode_probabilities.is_none()
+        self.transition.is_none()
+            && self.initial_mode_probabilities.is_none()
+            && self.compensated_transition.is_none()
+            && self.compensated_initial_mode_probabilities.is_none()
     }
 }
 
@@ -210,6 +223,19 @@ impl ImmConfig {
                 .initial_mode_probabilities
                 .unwrap_or(self.initial_mode_probabilities),
             ..self.clone()
+        }
+    }
+
+    /// These settings with a class's overrides for ego-motion-compensated steps applied (each
+    /// absent one falling back to [`with_overrides`](Self::with_overrides)'s).
+    pub fn with_compensated_overrides(&self, overrides: &ClassImmConfig) -> ImmConfig {
+        let plain = self.with_overrides(overrides);
+        ImmConfig {
+            transition: overrides.compensated_transition.unwrap_or(plain.transition),
+            initial_mode_probabilities: overrides
+                .compensated_initial_mode_probabilities
+                .unwrap_or(plain.initial_mode_probabilities),
+            ..plain
         }
     }
 }

@@ -76,6 +76,16 @@ pub(super) fn validate_class_imm(
     if let Some(initial) = &overrides.initial_mode_probabilities {
         validate_initial_probabilities(&format!("{prefix}.initial_mode_probabilities"), imm.modes, initial)?;
     }
+    if let Some(transition) = &overrides.compensated_transition {
+        validate_transition(&format!("{prefix}.compensated_transition"), imm.modes, transition)?;
+    }
+    if let Some(initial) = &overrides.compensated_initial_mode_probabilities {
+        validate_initial_probabilities(
+            &format!("{prefix}.compensated_initial_mode_probabilities"),
+            imm.modes,
+            initial,
+        )?;
+    }
     Ok(())
 }
 

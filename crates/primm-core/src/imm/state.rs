@@ -10,7 +10,7 @@ use crate::motion::coordinated_turn::index as ct;
 use crate::motion::{
     ConstantAcceleration, ConstantVelocity, CoordinatedTurn, LearnedDisplacement, ModeModels, MotionModel,
 };
-use crate::pose::RigidTransform;
+use crate::pose::{RigidTransform, RigidVelocity};
 use glam::DVec2;
 use nalgebra::Matrix2;
 
@@ -57,6 +57,21 @@ impl ImmState {
         add(&mut self.constant_velocity, covariance_m2);
         add(&mut self.constant_acceleration, covariance_m2);
         add(&mut self.coordinated_turn, covariance_m2);
+    }
+
+    /// Adds the velocity field `field` (times `sign`), taken at each mode's own position, to
+    /// every mode's velocity (PR: the velocity of its last displacement).
+    pub fn add_velocity_field(&mut self, field: &RigidVelocity, sign: f64) {
+        fn add<const N: usize>(gaussian: &mut Gaussian<N>, vx: usize, field: &RigidVelocity, sign: f64) {
+            let delta = sign * field.at(DVec2::new(gaussian.mean[0], gaussian.mean[1]));
+            gaussian.mean[vx] += delta.x;
+            gaussian.mean[vx + 1] += delta.y;
+        }
+        add(&mut self.constant_velocity, cv::VX, field, sign);
+        add(&mut self.constant_acceleration, ca::VX, field, sign);
+        add(&mut self.coordinated_turn, ct::VX, field, sign);
+        let learned = DVec2::new(self.learned.mean[0], self.learned.mean[1]);
+        self.learned_velocity_mps += sign * field.at(learned);
     }
 
     /// This state in another frame (see [`Gaussian::transformed`]): positions mapped,

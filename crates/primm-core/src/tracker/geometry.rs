@@ -7,7 +7,7 @@ use crate::coordinates::CoordinateFrame;
 use crate::existence::FieldOfView;
 use crate::measurement::FrameView;
 use crate::measurement::{Measurement, ObjectClass};
-use crate::pose::EgoPose;
+use crate::pose::{EgoPose, RigidVelocity};
 use crate::predictor::DisplacementPredictor;
 use glam::DVec2;
 
@@ -16,7 +16,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// moves the live tracks into it if they are in the other one: into the world frame with
     /// this frame's pose (the tracks' vehicle frame is taken as this frame's, which is off by
     /// the ego motion since the last frame), back into the vehicle frame of the last pose.
-    pub(super) fn enter_tracking_frame(&mut self, pose: Option<EgoPose>, dt_s: f64) {
+    /// Velocities change reference with the frame: a vehicle-frame track without poses has
+    /// learned its object's velocity relative to the moving, turning ego, so entering the world
+    /// frame adds the ego's motion over the gap (its mean velocity and yaw rate from the pose
+    /// before the gap and this one, `v + ω × (p − p_ego)`), and leaving it subtracts the ego's
+    /// latest motion (from its two latest poses).
+    pub(super) fn enter_tracking_frame(&mut self, pose: Option<EgoPose>, dt_s: f64, t: f64) {
         let world = self.config.frame.tracking_frame == CoordinateFrame::World;
         self.step_pose = pose.filter(|_| world);
         self.follow_odometry_reset(dt_s);
@@ -29,20 +34,51 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if step_frame == CoordinateFrame::World {
             self.stats.frames_in_world_frame += 1;
         }
+        // The ego's motion since the last pose (over a gap: its mean), unless the odometry
+        // was reset in between.
+        let motion_since_last = match (self.step_pose, self.last_pose, self.ego_motion.pose_time_s) {
+            (Some(pose), Some(last), Some(last_s)) if t > last_s && !self.last_step.odometry_reset => Some((
+                (pose.position() - last.position()) / (t - last_s),
+                crate::math::wrap_angle(pose.yaw_rad - last.yaw_rad) / (t - last_s),
+            )),
+            _ => None,
+        };
         if step_frame != self.tracks_frame && !self.table.is_empty() {
-            let transform = match (step_frame, self.step_pose, self.last_pose) {
-                (CoordinateFrame::World, Some(pose), _) => Some(pose.vehicle_to_world()),
-                (CoordinateFrame::Vehicle, _, Some(last)) => Some(last.world_to_vehicle()),
-                _ => None,
-            };
-            if let Some(transform) = transform {
-                self.table.tracks_mut().iter_mut().for_each(|track| track.transform(&transform));
-                self.last_step.tracking_frame_changed = true;
+            match (step_frame, self.step_pose, self.last_pose) {
+                (CoordinateFrame::World, Some(pose), _) => {
+                    let (velocity_mps, yaw_rate_radps) = motion_since_last.unwrap_or((DVec2::ZERO, 0.0));
+                    let ego = RigidVelocity { velocity_mps, yaw_rate_radps, centre_m: pose.position() };
+                    let transform = pose.vehicle_to_world();
+                    for track in self.table.tracks_mut() {
+                        track.transform(&transform);
+                        track.add_velocity_field(&ego, 1.0);
+                    }
+                    self.last_step.tracking_frame_changed = true;
+                }
+                (CoordinateFrame::Vehicle, _, Some(last)) => {
+                    let ego = RigidVelocity {
+                        velocity_mps: self.ego_motion.velocity_mps.unwrap_or(DVec2::ZERO),
+                        yaw_rate_radps: self.ego_motion.yaw_rate_radps.unwrap_or(0.0),
+                        centre_m: last.position(),
+                    };
+                    let transform = last.world_to_vehicle();
+                    for track in self.table.tracks_mut() {
+                        track.add_velocity_field(&ego, -1.0);
+                        track.transform(&transform);
+                    }
+                    self.last_step.tracking_frame_changed = true;
+                }
+                _ => {}
             }
         }
         self.tracks_frame = step_frame;
         if self.step_pose.is_some() {
             self.last_pose = self.step_pose;
+            self.ego_motion.pose_time_s = Some(t);
+            if let Some((velocity_mps, yaw_rate_radps)) = motion_since_last {
+                self.ego_motion.velocity_mps = Some(velocity_mps);
+                self.ego_motion.yaw_rate_radps = Some(yaw_rate_radps);
+            }
         }
     }
 

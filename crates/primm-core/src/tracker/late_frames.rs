@@ -118,6 +118,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         before.last_timestamp_s = self.last_timestamp_s;
         before.tracks_frame = self.tracks_frame;
         before.last_pose = self.last_pose;
+        before.ego_motion = self.ego_motion;
         before.stats = self.stats;
     }
 
@@ -128,6 +129,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.last_timestamp_s = before.last_timestamp_s;
         self.tracks_frame = before.tracks_frame;
         self.last_pose = before.last_pose;
+        self.ego_motion = before.ego_motion;
         self.stats.restore_tracked_counts(&before.stats);
     }
 

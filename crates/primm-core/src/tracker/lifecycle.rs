@@ -44,7 +44,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     self.last_step.updates_from_unknown_sensor += 1;
                 }
             }
-            let mut estimate = self.imms[measurement.class.index()].initiate_seen_from(
+            let imms = super::step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms);
+            let mut estimate = imms[measurement.class.index()].initiate_seen_from(
                 &self.models[measurement.class.index()],
                 &centre,
                 sensor_position_m,

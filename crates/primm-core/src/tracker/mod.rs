@@ -20,7 +20,7 @@ use crate::limits::MAX_SENSORS;
 use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::mode::ModeSet;
 use crate::motion::ModeModels;
-use crate::pose::EgoPose;
+use crate::pose::{EgoMotion, EgoPose};
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::recorded_frame::RecordedFrame;
 use crate::replay::ReplayRing;
@@ -97,6 +97,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     config: Config,
     /// Each class's IMM (`classes.<class>.imm` over `imm`), indexed by [`ObjectClass::index`].
     imms: ClassImms,
+    /// Each class's IMM in steps whose ego motion is compensated (the `compensated_*` keys of
+    /// `classes.<class>.imm`); the same mode set as `imms`.
+    compensated_imms: ClassImms,
     models: [ModeModels; ObjectClass::COUNT],
     predictor: P,
     table: TrackTable,
@@ -111,6 +114,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     step_pose: Option<EgoPose>,
     /// The ego pose of the latest step tracked in the world frame.
     last_pose: Option<EgoPose>,
+    /// When `last_pose` was taken and the ego's velocity over ground that the poses give.
+    ego_motion: EgoMotion,
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
     /// The table row of each request's track (`predictor.classes` may leave tracks out).
@@ -169,6 +174,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let ring = ReplayRing::new(config.tracker.replay_frames as usize, config.tracker.max_frame_delay_s);
         Ok(Self {
             imms: track_loops::class_imms(&config),
+            compensated_imms: track_loops::class_compensated_imms(&config),
             models: ObjectClass::ALL.map(|class| ModeModels::from_config(config.classes.get(class))),
             config,
             predictor,
@@ -180,6 +186,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             tracks_frame: CoordinateFrame::Vehicle,
             step_pose: None,
             last_pose: None,
+            ego_motion: EgoMotion::default(),
             requests: Box::new(ArrayVec::new()),
             requested_rows: Box::new(ArrayVec::new()),
             answers: Box::new([None; MAX_TRACKS]),
@@ -252,7 +259,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         observer.stage_finished(Stage::Validate);
         // From here on only the validated copy is read.
         let t = self.validated.timestamp_s();
-        self.enter_tracking_frame(self.validated.ego_pose(), dt_s);
+        self.enter_tracking_frame(self.validated.ego_pose(), dt_s, t);
         if let Some(vehicle_to_world) = self.step_pose.map(|pose| pose.vehicle_to_world()) {
             self.validated.move_positions(&vehicle_to_world);
         }
@@ -284,6 +291,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.ring.clear();
         self.last_timestamp_s = None;
         self.last_pose = None;
+        self.ego_motion = EgoMotion::default();
         self.step_pose = None;
         self.last_step = StepSummary::default();
         self.stats.resets += 1;
@@ -370,4 +378,16 @@ fn confirms(track: &Track, tracker: &crate::config::TrackerConfig) -> bool {
 fn covariance(value: &crate::config::Covariance2) -> DMat2 {
     let [[xx, xy], [yx, yy]] = *value;
     DMat2::from_cols(DVec2::new(xx, yx), DVec2::new(xy, yy))
+}
+
+/// The IMMs of a step: those for ego-motion-compensated steps when the step has an ego pose
+/// (tracked in the world frame), else the plain ones. The two share their mode set, so fusion
+/// and the report may use either.
+#[inline]
+pub(super) fn step_imms<'a>(compensated: bool, imms: &'a ClassImms, compensated_imms: &'a ClassImms) -> &'a ClassImms {
+    if compensated {
+        compensated_imms
+    } else {
+        imms
+    }
 }

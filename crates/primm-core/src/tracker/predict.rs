@@ -2,7 +2,7 @@
 //! existence probabilities are predicted meanwhile, then the learned displacements are checked
 //! and every track's prior is completed and fused (`eq:prior_fusion`).
 
-use super::Tracker;
+use super::{step_imms, Tracker};
 use crate::config::{LearnedProcessNoise, PredictorConfig};
 use crate::displacement_check::{check_answer, DisplacementRejection};
 use crate::existence;
@@ -45,7 +45,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     pub(super) fn predict_physics(&mut self, dt_s: f64) {
         self.dt_s = dt_s;
         track_loops::predict_physics(
-            &self.imms,
+            step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms),
             &self.models,
             self.table.tracks(),
             dt_s,
@@ -71,7 +71,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.collect_displacements();
         }
         track_loops::complete_priors(
-            &self.imms,
+            step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms),
             &self.models,
             self.table.tracks(),
             self.dt_s,

@@ -75,7 +75,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let count = self.table.len();
         self.read_assignment();
         track_loops::update(
-            &self.imms,
+            super::step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms),
             &self.models,
             self.table.tracks_mut(),
             &self.priors[..count],
