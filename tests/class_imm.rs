@@ -1,7 +1,8 @@
 //! Per-class IMM overrides (`classes.<class>.imm`): a class's transition matrix and initial mode
 //! probabilities reach that class's tracks only, a bad override is refused with its key, a
-//! configuration without overrides (or with overrides equal to `imm`) tracks exactly as before, and
-//! the shipped overrides leave the physics modes' switching (the `imm` method) as `imm` has it.
+//! configuration without overrides (or with overrides equal to `imm`) tracks exactly as before,
+//! the shipped overrides leave the physics modes' switching (the `imm` method) as `imm` has it, and
+//! the `compensated_*` keys govern the steps with an ego pose, and only those.
 
 use crate::common::{scene_frames, SceneObject};
 use primm_core::config::{Config, ConfigError, ImmConfig};
@@ -194,4 +195,66 @@ fn a_bad_override_is_refused_naming_its_key() {
         }
         other => panic!("expected an invalid key, got {other:?}"),
     }
+}
+
+#[test]
+fn the_compensated_keys_govern_the_steps_with_an_ego_pose_and_only_those() {
+    // Cars: CA never entered nor started in steps whose ego motion is compensated.
+    let mut config = without_overrides();
+    let mut without_ca = config.imm.transition;
+    for (i, row) in without_ca.iter_mut().enumerate() {
+        if i != 2 {
+            row[1] += row[2];
+            row[2] = 0.0;
+        }
+    }
+    config.classes.car.imm.compensated_transition = Some(without_ca);
+    config.classes.car.imm.compensated_initial_mode_probabilities = Some([0.1, 0.45, 0.0, 0.45]);
+    let frames = scene_frames(&scene(), 60, 0.05, 0.2, 11);
+    let posed: Vec<_> = frames
+        .iter()
+        .cloned()
+        .map(|mut frame| {
+            frame.ego_pose = Some(primm_core::pose::EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
+            frame
+        })
+        .collect();
+    let run = |config: &Config, frames: &[primm_core::measurement::Frame]| {
+        let mut tracker = Tracker::new(config.clone()).unwrap();
+        frames.iter().map(|frame| tracker.step(frame).unwrap().to_vec()).collect::<Vec<_>>()
+    };
+    // Without poses the keys change nothing.
+    assert_eq!(format!("{:?}", run(&config, &frames)), format!("{:?}", run(&without_overrides(), &frames)));
+    // With poses they reach the cars only: CA stays at the floor, from the first step on.
+    let (with_keys, without_keys) = (run(&config, &posed), run(&without_overrides(), &posed));
+    assert_eq!(
+        of_class(&with_keys, ObjectClass::Pedestrian),
+        of_class(&without_keys, ObjectClass::Pedestrian)
+    );
+    let floor = config.imm.mode_probability_floor;
+    let ca = |outputs: &[Vec<TrackOutput>]| {
+        outputs
+            .iter()
+            .flatten()
+            .filter(|o| o.class == ObjectClass::Car)
+            .map(|o| o.mode_probabilities[2])
+            .fold(0.0f64, f64::max)
+    };
+    assert!(ca(&with_keys) < 1.01 * floor, "CA {} with the keys", ca(&with_keys));
+    assert!(ca(&without_keys) > 0.1, "CA {} without them", ca(&without_keys));
+}
+
+#[test]
+fn a_bad_compensated_key_is_refused_naming_it() {
+    let mut config = Config::default();
+    let mut transition = config.imm.transition;
+    transition[1] = [0.0, 0.5, 0.0, 0.0];
+    config.classes.pedestrian.imm.compensated_transition = Some(transition);
+    assert_eq!(invalid_key(Tracker::new(config)), "classes.pedestrian.imm.compensated_transition[1]");
+    let mut config = Config::default();
+    config.classes.car.imm.compensated_initial_mode_probabilities = Some([0.1, -0.5, 0.0, 0.0]);
+    assert_eq!(
+        invalid_key(Tracker::new(config)),
+        "classes.car.imm.compensated_initial_mode_probabilities[1]"
+    );
 }

@@ -194,7 +194,6 @@ impl SensorMount {
     }
 }
 
-
 /// The ego's motion as consecutive poses tell it: when the latest pose was taken and the ego's
 /// velocity over ground between the two latest poses (world frame). The tracker uses it where
 /// its tracks change frame: a velocity estimated in the vehicle frame without poses is the

@@ -384,7 +384,11 @@ fn covariance(value: &crate::config::Covariance2) -> DMat2 {
 /// (tracked in the world frame), else the plain ones. The two share their mode set, so fusion
 /// and the report may use either.
 #[inline]
-pub(super) fn step_imms<'a>(compensated: bool, imms: &'a ClassImms, compensated_imms: &'a ClassImms) -> &'a ClassImms {
+pub(super) fn step_imms<'a>(
+    compensated: bool,
+    imms: &'a ClassImms,
+    compensated_imms: &'a ClassImms,
+) -> &'a ClassImms {
     if compensated {
         compensated_imms
     } else {
