@@ -244,3 +244,27 @@ fn ego_velocity(t: f64) -> DVec2 {
     let step = 1e-3;
     (ego_pose(t + step).position() - ego_pose(t - step).position()) / (2.0 * step)
 }
+
+#[test]
+fn a_pose_that_returns_beyond_the_egos_limits_adds_no_velocity() {
+    // After a gap the pose comes back 10 km away: no ego could have driven there, so its
+    // "velocity" over the gap is unknown and nothing is added to the tracks.
+    let mut tracker = Tracker::new(config(CoordinateFrame::World)).unwrap();
+    for k in 0..25 {
+        let t = k as f64 * DT_S;
+        tracker.step(&frame(t, &objects(t), k < 20)).unwrap();
+    }
+    let before: Vec<DVec2> = tracker.last_outputs().iter().map(|o| o.velocity_mps).collect();
+    let t = 25.0 * DT_S;
+    let mut far = frame(t, &objects(t), true);
+    far.ego_pose = far.ego_pose.map(|pose| EgoPose { x_m: pose.x_m + 10_000.0, ..pose });
+    let outputs = tracker.step(&far).unwrap();
+    assert_eq!(outputs.len(), before.len());
+    for (output, before) in outputs.iter().zip(&before) {
+        let velocity = output.world_velocity_mps.expect("in the world frame again");
+        assert!(
+            velocity.is_finite() && (velocity.length() - before.length()).abs() < 5.0,
+            "{velocity} after {before}"
+        );
+    }
+}

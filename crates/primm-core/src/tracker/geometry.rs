@@ -35,14 +35,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.stats.frames_in_world_frame += 1;
         }
         // The ego's motion since the last pose (over a gap: its mean), unless the odometry
-        // was reset in between.
+        // was reset in between or the poses imply a motion beyond the ego's limits
+        // (`tracker.max_ego_speed_mps`, `max_ego_yaw_rate_radps`): then it is unknown.
+        let limits = &self.config.tracker;
         let motion_since_last = match (self.step_pose, self.last_pose, self.ego_motion.pose_time_s) {
             (Some(pose), Some(last), Some(last_s)) if t > last_s && !self.last_step.odometry_reset => Some((
                 (pose.position() - last.position()) / (t - last_s),
                 crate::math::wrap_angle(pose.yaw_rad - last.yaw_rad) / (t - last_s),
             )),
             _ => None,
-        };
+        }
+        .filter(|(velocity, yaw_rate)| {
+            velocity.length() <= limits.max_ego_speed_mps && yaw_rate.abs() <= limits.max_ego_yaw_rate_radps
+        });
         if step_frame != self.tracks_frame && !self.table.is_empty() {
             match (step_frame, self.step_pose, self.last_pose) {
                 (CoordinateFrame::World, Some(pose), _) => {
