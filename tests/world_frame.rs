@@ -268,3 +268,39 @@ fn a_pose_that_returns_beyond_the_egos_limits_adds_no_velocity() {
         );
     }
 }
+
+#[test]
+fn an_ego_motion_that_would_make_a_track_implausibly_fast_leaves_it_as_it_was() {
+    // Far from an ego turning fast, the rotation term alone is 600 m/s: beyond any object.
+    let config = Config::default();
+    let imm = primm_core::imm::Imm::new(&config.imm_for(ObjectClass::Car));
+    let models = primm_core::motion::ModeModels::from_config(config.classes.get(ObjectClass::Car));
+    let track_at = |x_m: f64| {
+        let first = Measurement {
+            x_m,
+            y_m: 0.0,
+            radial_velocity_mps: 0.0,
+            rcs_dbsm: 10.0,
+            class: ObjectClass::Car,
+            sensor_id: None,
+            ground_truth_id: None,
+        };
+        let state = imm.initiate(&models, &first);
+        primm_core::track::Track::new(1, &first, DVec2::ZERO, 0.0, state, 0.5)
+    };
+    let turning = primm_core::pose::RigidVelocity {
+        velocity_mps: DVec2::ZERO,
+        yaw_rate_radps: 3.0,
+        centre_m: DVec2::ZERO,
+    };
+    let max_speed_mps = config.predictor.max_displacement_speed_mps;
+    let mut far = track_at(200.0);
+    let before = far.estimate;
+    assert!(!far.add_plausible_velocity_field(&turning, 1.0, max_speed_mps));
+    assert_eq!(far.estimate, before);
+    let mut near = track_at(5.0);
+    assert!(near.add_plausible_velocity_field(&turning, 1.0, max_speed_mps));
+    let velocity =
+        DVec2::new(near.estimate.constant_velocity.mean[2], near.estimate.constant_velocity.mean[3]);
+    assert!((velocity - DVec2::new(0.0, 15.0)).length() < 1e-9, "{velocity}");
+}

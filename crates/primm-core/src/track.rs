@@ -162,6 +162,26 @@ impl Track {
         self.remembered_displacement = None;
     }
 
+    /// [`add_velocity_field`](Self::add_velocity_field) where the CV velocity it leads to is no
+    /// faster than `max_speed_mps` (no object moves faster; far from a turning ego the field's
+    /// rotation term grows without bound); otherwise the track is left as it was. Returns whether
+    /// it was applied.
+    pub fn add_plausible_velocity_field(
+        &mut self,
+        field: &crate::pose::RigidVelocity,
+        sign: f64,
+        max_speed_mps: f64,
+    ) -> bool {
+        let cv = &self.estimate.constant_velocity.mean;
+        let position = DVec2::new(cv[0], cv[1]);
+        let velocity = DVec2::new(cv[2], cv[3]) + sign * field.at(position);
+        let plausible = velocity.length() <= max_speed_mps;
+        if plausible {
+            self.add_velocity_field(field, sign);
+        }
+        plausible
+    }
+
     /// Records an associated measurement taken by the radar at `sensor_m` (a coasting track is
     /// confirmed again; confirming a tentative one is the lifecycle's decision).
     pub fn record_hit(&mut self, measurement: &Measurement, sensor_m: DVec2, timestamp_s: f64) {

@@ -54,9 +54,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     let (velocity_mps, yaw_rate_radps) = motion_since_last.unwrap_or((DVec2::ZERO, 0.0));
                     let ego = RigidVelocity { velocity_mps, yaw_rate_radps, centre_m: pose.position() };
                     let transform = pose.vehicle_to_world();
+                    let max_speed_mps = self.config.predictor.max_displacement_speed_mps;
                     for track in self.table.tracks_mut() {
                         track.transform(&transform);
-                        track.add_velocity_field(&ego, 1.0);
+                        track.add_plausible_velocity_field(&ego, 1.0, max_speed_mps);
                     }
                     self.last_step.tracking_frame_changed = true;
                 }
@@ -67,8 +68,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
                         centre_m: last.position(),
                     };
                     let transform = last.world_to_vehicle();
+                    let max_speed_mps = self.config.predictor.max_displacement_speed_mps;
                     for track in self.table.tracks_mut() {
-                        track.add_velocity_field(&ego, -1.0);
+                        track.add_plausible_velocity_field(&ego, -1.0, max_speed_mps);
                         track.transform(&transform);
                     }
                     self.last_step.tracking_frame_changed = true;
