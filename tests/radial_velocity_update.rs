@@ -40,6 +40,19 @@ fn car(index: usize, t: f64) -> (DVec2, DVec2) {
 /// Frames of four crossing cars seen by sensor `sensor_id` (mounted at sensor 3's place), with
 /// 0.4 m position noise and 0.1 m/s radial-velocity noise (over ground).
 fn frames(count: usize, sensor_id: Option<u16>, seed: u64) -> Vec<(Frame, Vec<DVec2>)> {
+    measured_frames(count, sensor_id, seed, 0.4, |index, t, _| car(index, t))
+}
+
+/// Frames of the four cars at `detection(index, t, sensor's world position)`, the detected
+/// point and the car's velocity (world frame), seen by sensor `sensor_id` with `noise_m` of
+/// position noise and 0.1 m/s of radial-velocity noise along the line of sight to the detection.
+fn measured_frames(
+    count: usize,
+    sensor_id: Option<u16>,
+    seed: u64,
+    noise_m: f64,
+    detection: impl Fn(usize, f64, DVec2) -> (DVec2, DVec2),
+) -> Vec<(Frame, Vec<DVec2>)> {
     let mut rng = rng(seed);
     (0..count)
         .map(|k| {
@@ -50,12 +63,12 @@ fn frames(count: usize, sensor_id: Option<u16>, seed: u64) -> Vec<(Frame, Vec<DV
             frame.ego_pose = Some(pose);
             let mut velocities = Vec::new();
             for index in 0..4 {
-                let (position, velocity) = car(index, t);
+                let (position, velocity) = detection(index, t, sensor_world);
                 let vehicle = pose.world_to_car(position);
                 let line_of_sight = (position - sensor_world).normalize();
                 frame.measurements.push(Measurement {
-                    x_m: vehicle.x + 0.4 * standard_normal(&mut rng),
-                    y_m: vehicle.y + 0.4 * standard_normal(&mut rng),
+                    x_m: vehicle.x + noise_m * standard_normal(&mut rng),
+                    y_m: vehicle.y + noise_m * standard_normal(&mut rng),
                     radial_velocity_mps: velocity.dot(line_of_sight) + 0.1 * standard_normal(&mut rng),
                     rcs_dbsm: 10.0,
                     class: ObjectClass::Car,
@@ -179,43 +192,14 @@ fn without_a_pose_the_row_is_left_out_since_the_ego_motion_is_unknown() {
 /// `offset_scale`), with 0.2 m of position noise, and its radial velocity is measured along
 /// the line of sight to that detection (0.1 m/s noise).
 fn extended_frames(count: usize, seed: u64) -> Vec<(Frame, Vec<DVec2>)> {
-    let mut rng = rng(seed);
-    (0..count)
-        .map(|k| {
-            let t = k as f64 * DT_S;
-            let pose = ego_pose(t);
-            let sensor_world = pose.point_to_world(SENSOR_3_M);
-            let mut frame = Frame::new(t);
-            frame.ego_pose = Some(pose);
-            let mut velocities = Vec::new();
-            for index in 0..4 {
-                // The crossing cars of `car`, 20 m nearer: 8–20 m from the sensor.
-                let (far, velocity) = car(index, t);
-                let centre = far - DVec2::new(20.0, -16.0);
-                let nearest = primm_core::extent::nearest_point_of_box(
-                    4.5,
-                    1.8,
-                    centre,
-                    velocity.normalize(),
-                    sensor_world,
-                );
-                let reflection = centre + 0.5 * (nearest - centre);
-                let line_of_sight = (reflection - sensor_world).normalize();
-                let vehicle = pose.world_to_car(reflection);
-                frame.measurements.push(Measurement {
-                    x_m: vehicle.x + 0.2 * standard_normal(&mut rng),
-                    y_m: vehicle.y + 0.2 * standard_normal(&mut rng),
-                    radial_velocity_mps: velocity.dot(line_of_sight) + 0.1 * standard_normal(&mut rng),
-                    rcs_dbsm: 10.0,
-                    class: ObjectClass::Car,
-                    sensor_id: Some(3),
-                    ground_truth_id: Some(index as u64),
-                });
-                velocities.push(velocity);
-            }
-            (frame, velocities)
-        })
-        .collect()
+    measured_frames(count, Some(3), seed, 0.2, |index, t, sensor_world| {
+        // The crossing cars of `car`, 20 m nearer: 8–20 m from the sensor.
+        let (far, velocity) = car(index, t);
+        let centre = far - DVec2::new(20.0, -16.0);
+        let nearest =
+            primm_core::extent::nearest_point_of_box(4.5, 1.8, centre, velocity.normalize(), sensor_world);
+        (centre + 0.5 * (nearest - centre), velocity)
+    })
 }
 
 #[test]

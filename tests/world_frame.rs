@@ -296,10 +296,10 @@ fn an_ego_motion_that_would_make_a_track_implausibly_fast_leaves_it_as_it_was() 
     let max_speed_mps = config.predictor.max_displacement_speed_mps;
     let mut far = track_at(200.0);
     let before = far.estimate;
-    assert!(!far.add_plausible_velocity_field(&turning, 1.0, max_speed_mps));
+    assert!(!far.add_velocity_field(&turning, 1.0, max_speed_mps));
     assert_eq!(far.estimate, before);
     let mut near = track_at(5.0);
-    assert!(near.add_plausible_velocity_field(&turning, 1.0, max_speed_mps));
+    assert!(near.add_velocity_field(&turning, 1.0, max_speed_mps));
     let velocity =
         DVec2::new(near.estimate.constant_velocity.mean[2], near.estimate.constant_velocity.mean[3]);
     assert!((velocity - DVec2::new(0.0, 15.0)).length() < 1e-9, "{velocity}");

@@ -195,17 +195,16 @@ impl SensorMount {
 }
 
 /// The ego's motion as consecutive poses tell it: when the latest pose was taken and the ego's
-/// velocity over ground between the two latest poses (world frame). The tracker uses it where
-/// its tracks change frame: a velocity estimated in the vehicle frame without poses is the
-/// object's velocity relative to the ego, and a velocity over ground is not.
+/// motion over ground between the two latest poses (world frame, about the latest pose's
+/// position). The tracker uses it where its tracks change frame: a velocity estimated in the
+/// vehicle frame without poses is the object's velocity relative to the ego, and a velocity
+/// over ground is not.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct EgoMotion {
     /// Time of the latest pose, s.
     pub pose_time_s: Option<f64>,
-    /// The ego's velocity over ground from the two latest poses, m/s (world frame).
-    pub velocity_mps: Option<DVec2>,
-    /// The ego's yaw rate from the two latest poses, rad/s (counter-clockwise positive).
-    pub yaw_rate_radps: Option<f64>,
+    /// The ego's velocity and yaw rate from the two latest poses.
+    pub latest: Option<RigidVelocity>,
 }
 
 /// The velocity field of a rigid motion in the plane: at a point `p`, `v + ω × (p − c)` with

@@ -156,17 +156,11 @@ impl Track {
 
     /// Adds the velocity field `field` times `sign` to every mode's velocity: the same motion
     /// seen against another reference (the ego's motion, where the track changes between the
-    /// vehicle and the world frame).
-    pub fn add_velocity_field(&mut self, field: &crate::pose::RigidVelocity, sign: f64) {
-        self.estimate.add_velocity_field(field, sign);
-        self.remembered_displacement = None;
-    }
-
-    /// [`add_velocity_field`](Self::add_velocity_field) where the CV velocity it leads to is no
-    /// faster than `max_speed_mps` (no object moves faster; far from a turning ego the field's
-    /// rotation term grows without bound); otherwise the track is left as it was. Returns whether
-    /// it was applied.
-    pub fn add_plausible_velocity_field(
+    /// vehicle and the world frame). Only where the CV velocity it leads to is no faster than
+    /// `max_speed_mps` (no object moves faster; far from a turning ego the field's rotation term
+    /// grows without bound); otherwise the track is left as it was. Returns whether it was
+    /// applied.
+    pub fn add_velocity_field(
         &mut self,
         field: &crate::pose::RigidVelocity,
         sign: f64,
@@ -174,10 +168,10 @@ impl Track {
     ) -> bool {
         let cv = &self.estimate.constant_velocity.mean;
         let position = DVec2::new(cv[0], cv[1]);
-        let velocity = DVec2::new(cv[2], cv[3]) + sign * field.at(position);
-        let plausible = velocity.length() <= max_speed_mps;
+        let plausible = (DVec2::new(cv[2], cv[3]) + sign * field.at(position)).length() <= max_speed_mps;
         if plausible {
-            self.add_velocity_field(field, sign);
+            self.estimate.add_velocity_field(field, sign);
+            self.remembered_displacement = None;
         }
         plausible
     }

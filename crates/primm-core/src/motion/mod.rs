@@ -154,23 +154,25 @@ impl ModeModels {
         if !update.enabled {
             return None;
         }
-        let (measured_line_of_sight, line_of_sight_variance_rad2) = match update.line_of_sight {
-            RadialLineOfSight::Predicted | RadialLineOfSight::Reflection => (None, 0.0),
-            RadialLineOfSight::Measured => {
-                let offset = DVec2::new(measurement.x_m, measurement.y_m) - sensor_position_m;
-                let range = offset.length();
-                if !(range >= crate::gaussian::MIN_LINE_OF_SIGHT_RANGE_M) {
-                    return None;
+        let (measured_line_of_sight, line_of_sight_variance_rad2, reflection_offset_m) =
+            match update.line_of_sight {
+                RadialLineOfSight::Predicted => (None, 0.0, DVec2::ZERO),
+                RadialLineOfSight::Reflection => (None, 0.0, reflection_offset_m),
+                RadialLineOfSight::Measured => {
+                    let offset = DVec2::new(measurement.x_m, measurement.y_m) - sensor_position_m;
+                    let range = offset.length();
+                    if !(range >= crate::gaussian::MIN_LINE_OF_SIGHT_RANGE_M) {
+                        return None;
+                    }
+                    let along = offset / range;
+                    // The detection's noise across the line of sight, over the range: the
+                    // direction's variance.
+                    let across = Vector2::new(-along.y, along.x);
+                    let noise = self.constant_velocity.measurement_noise();
+                    let across_variance_m2 = (across.transpose() * noise * across)[(0, 0)];
+                    (Some(along), across_variance_m2 / (range * range), DVec2::ZERO)
                 }
-                let along = offset / range;
-                // The detection's noise across the line of sight, over the range: the
-                // direction's variance.
-                let across = Vector2::new(-along.y, along.x);
-                let noise = self.constant_velocity.measurement_noise();
-                let across_variance_m2 = (across.transpose() * noise * across)[(0, 0)];
-                (Some(along), across_variance_m2 / (range * range))
-            }
-        };
+            };
         Some(RadialVelocityObservation {
             radial_velocity_mps: measurement.radial_velocity_mps,
             sensor_position_m,
@@ -178,10 +180,7 @@ impl ModeModels {
             gate_std: update.gate_std,
             measured_line_of_sight,
             line_of_sight_variance_rad2,
-            reflection_offset_m: match update.line_of_sight {
-                RadialLineOfSight::Reflection => reflection_offset_m,
-                RadialLineOfSight::Predicted | RadialLineOfSight::Measured => DVec2::ZERO,
-            },
+            reflection_offset_m,
         })
     }
 }

@@ -34,59 +34,68 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if step_frame == CoordinateFrame::World {
             self.stats.frames_in_world_frame += 1;
         }
-        // The ego's motion since the last pose (over a gap: its mean), unless the odometry
-        // was reset in between or the poses imply a motion beyond the ego's limits
-        // (`tracker.max_ego_speed_mps`, `max_ego_yaw_rate_radps`): then it is unknown.
-        let limits = &self.config.tracker;
-        let motion_since_last = match (self.step_pose, self.last_pose, self.ego_motion.pose_time_s) {
-            (Some(pose), Some(last), Some(last_s)) if t > last_s && !self.last_step.odometry_reset => Some((
-                (pose.position() - last.position()) / (t - last_s),
-                crate::math::wrap_angle(pose.yaw_rad - last.yaw_rad) / (t - last_s),
-            )),
-            _ => None,
-        }
-        .filter(|(velocity, yaw_rate)| {
-            velocity.length() <= limits.max_ego_speed_mps && yaw_rate.abs() <= limits.max_ego_yaw_rate_radps
-        });
+        let motion_since_last = self.ego_motion_since_last_pose(t);
         if step_frame != self.tracks_frame && !self.table.is_empty() {
-            match (step_frame, self.step_pose, self.last_pose) {
+            // The ego's motion in world coordinates, added to the tracks where they are in the
+            // world frame: after the move in, before the move out.
+            let change = match (step_frame, self.step_pose, self.last_pose) {
                 (CoordinateFrame::World, Some(pose), _) => {
-                    let (velocity_mps, yaw_rate_radps) = motion_since_last.unwrap_or((DVec2::ZERO, 0.0));
-                    let ego = RigidVelocity { velocity_mps, yaw_rate_radps, centre_m: pose.position() };
-                    let transform = pose.vehicle_to_world();
-                    let max_speed_mps = self.config.predictor.max_displacement_speed_mps;
-                    for track in self.table.tracks_mut() {
-                        track.transform(&transform);
-                        track.add_plausible_velocity_field(&ego, 1.0, max_speed_mps);
-                    }
-                    self.last_step.tracking_frame_changed = true;
+                    Some((pose.vehicle_to_world(), motion_since_last, 1.0))
                 }
                 (CoordinateFrame::Vehicle, _, Some(last)) => {
-                    let ego = RigidVelocity {
-                        velocity_mps: self.ego_motion.velocity_mps.unwrap_or(DVec2::ZERO),
-                        yaw_rate_radps: self.ego_motion.yaw_rate_radps.unwrap_or(0.0),
-                        centre_m: last.position(),
-                    };
-                    let transform = last.world_to_vehicle();
-                    let max_speed_mps = self.config.predictor.max_displacement_speed_mps;
-                    for track in self.table.tracks_mut() {
-                        track.add_plausible_velocity_field(&ego, -1.0, max_speed_mps);
-                        track.transform(&transform);
-                    }
-                    self.last_step.tracking_frame_changed = true;
+                    Some((last.world_to_vehicle(), self.ego_motion.latest, -1.0))
                 }
-                _ => {}
+                _ => None,
+            };
+            if let Some((transform, ego, sign)) = change {
+                let max_speed_mps = self.config.predictor.max_displacement_speed_mps;
+                let entering = sign > 0.0;
+                let add_ego = |track: &mut crate::track::Track| {
+                    if let Some(ego) = &ego {
+                        track.add_velocity_field(ego, sign, max_speed_mps);
+                    }
+                };
+                for track in self.table.tracks_mut() {
+                    if !entering {
+                        add_ego(track);
+                    }
+                    track.transform(&transform);
+                    if entering {
+                        add_ego(track);
+                    }
+                }
+                self.last_step.tracking_frame_changed = true;
             }
         }
         self.tracks_frame = step_frame;
         if self.step_pose.is_some() {
             self.last_pose = self.step_pose;
             self.ego_motion.pose_time_s = Some(t);
-            if let Some((velocity_mps, yaw_rate_radps)) = motion_since_last {
-                self.ego_motion.velocity_mps = Some(velocity_mps);
-                self.ego_motion.yaw_rate_radps = Some(yaw_rate_radps);
+            if motion_since_last.is_some() {
+                self.ego_motion.latest = motion_since_last;
             }
         }
+    }
+
+    /// The ego's motion from the last pose to this step's (over a gap: its mean), about this
+    /// step's position; `None` without both poses, after an odometry reset, or where the poses
+    /// imply a motion beyond the ego's limits (`tracker.max_ego_speed_mps`,
+    /// `max_ego_yaw_rate_radps`).
+    fn ego_motion_since_last_pose(&self, t: f64) -> Option<RigidVelocity> {
+        let (Some(pose), Some(last), Some(last_s)) =
+            (self.step_pose, self.last_pose, self.ego_motion.pose_time_s)
+        else {
+            return None;
+        };
+        if !(t > last_s) || self.last_step.odometry_reset {
+            return None;
+        }
+        let velocity_mps = (pose.position() - last.position()) / (t - last_s);
+        let yaw_rate_radps = crate::math::wrap_angle(pose.yaw_rad - last.yaw_rad) / (t - last_s);
+        let limits = &self.config.tracker;
+        (velocity_mps.length() <= limits.max_ego_speed_mps
+            && yaw_rate_radps.abs() <= limits.max_ego_yaw_rate_radps)
+            .then_some(RigidVelocity { velocity_mps, yaw_rate_radps, centre_m: pose.position() })
     }
 
     /// Moves the live world-frame tracks across an odometry reset: when this frame's pose is
