@@ -26,6 +26,13 @@ use arrayvec::ArrayVec;
 /// Largest distance of a sensor mount from the vehicle's reference point, m.
 pub const MAX_MOUNT_DISTANCE_M: f64 = 100.0;
 
+/// Largest azimuth standard deviation of a sensor, rad (about 29°: beyond it a radar's
+/// azimuth carries no information a tracker could use).
+pub const MAX_AZIMUTH_STD_RAD: f64 = 0.5;
+/// Largest off-boresight growth of a sensor's azimuth standard deviation, dimensionless (the
+/// secant reaches 10 at 84°).
+pub const MAX_AZIMUTH_STD_FACTOR: f64 = 10.0;
+
 /// The coordinate frame of the tracks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -81,6 +88,10 @@ impl Default for CoordinatesConfig {
             max_range_m: 100.0,
             detection_probability_factor: 1.0,
             clutter_density_factor: 1.0,
+            // The radar's own noise, chosen on validation (`config/primm.toml`).
+            range_std_m: 0.12,
+            azimuth_std_rad: 0.0105,
+            azimuth_std_max_factor: 1.0,
         };
         let mut sensors = ArrayVec::new();
         sensors.push(mount(1, 3.66, -0.87, -85.0));
@@ -123,6 +134,17 @@ impl CoordinatesConfig {
             }
             if !(mount.clutter_density_factor >= 0.0 && mount.clutter_density_factor.is_finite()) {
                 return Some(("frame.sensors", "every clutter_density_factor must be a finite number >= 0"));
+            }
+            if !(mount.range_std_m >= 0.0 && mount.range_std_m.is_finite()) {
+                return Some(("frame.sensors", "every range_std_m must be a finite number >= 0"));
+            }
+            if !(mount.azimuth_std_rad >= 0.0 && mount.azimuth_std_rad <= MAX_AZIMUTH_STD_RAD) {
+                return Some(("frame.sensors", "every azimuth_std_rad must lie in [0, 0.5]"));
+            }
+            if !(mount.azimuth_std_max_factor >= 1.0
+                && mount.azimuth_std_max_factor <= MAX_AZIMUTH_STD_FACTOR)
+            {
+                return Some(("frame.sensors", "every azimuth_std_max_factor must lie in [1, 10]"));
             }
             if self.sensors[..index].iter().any(|other| other.id == mount.id) {
                 return Some(("frame.sensors", "sensor ids must be unique"));

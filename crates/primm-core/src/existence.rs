@@ -197,6 +197,9 @@ mod tests {
             max_range_m: 100.0,
             detection_probability_factor: 1.0,
             clutter_density_factor: 1.0,
+            range_std_m: 0.0,
+            azimuth_std_rad: 0.0,
+            azimuth_std_max_factor: 1.0,
         }
     }
 

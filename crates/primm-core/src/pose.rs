@@ -165,6 +165,17 @@ pub struct SensorMount {
     /// dimensionless (absent: 1).
     #[cfg_attr(feature = "serde", serde(default = "one"))]
     pub clutter_density_factor: f64,
+    /// Standard deviation of the measured range, m (absent: 0, no noise of the sensor's own;
+    /// `crate::sensor_noise`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub range_std_m: f64,
+    /// Standard deviation of the measured azimuth at boresight, rad (absent: 0).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub azimuth_std_rad: f64,
+    /// Largest growth of the azimuth's standard deviation off boresight, dimensionless, ≥ 1: it
+    /// grows as 1 / cos of the angle from the boresight up to this factor (absent: 1, constant).
+    #[cfg_attr(feature = "serde", serde(default = "one"))]
+    pub azimuth_std_max_factor: f64,
 }
 
 /// The default of [`SensorMount::half_fov_rad`]: all around.

@@ -19,8 +19,8 @@ use crate::imm::{Imm, ImmPrior};
 use crate::measurement::{Measurement, ObjectClass};
 use crate::motion::ModeModels;
 use crate::predictor::Displacement;
+use crate::sensor_noise::MeasurementSensor;
 use crate::track::Track;
-use glam::DVec2;
 #[cfg(feature = "std")]
 use multiversion::multiversion;
 
@@ -105,8 +105,9 @@ pub type UpdateOutcome = Result<Option<RadialVelocityOutcome>, UpdateError>;
 /// `tracks`), of the centre through the expected reflection for a class tracked as an extended
 /// object (`crate::extent`; `reflections[i]` is track `i`'s expected reflection for its
 /// measurement, computed by the caller once per frame, [`ExpectedReflection::POINT`] for a point
-/// class), with the radial-velocity row where the class asks for it, seen from
-/// `sensor_positions_m[i]` (the tracking frame) and only with `radial_velocity_rows` (the
+/// class, its spread added to the detection's own noise `sensors[i].noise_m2`), with the
+/// radial-velocity row where the class asks for it, seen from `sensors[i].position_m` (the
+/// tracking frame) and only with `radial_velocity_rows` (the
 /// tracker passes whether the step tracks in the world frame); `outcomes[i]` is the result for track `i`
 /// (`Ok(None)` for tracks without measurement, which are left untouched). A failed update
 /// leaves the track at its prior.
@@ -117,7 +118,7 @@ pub fn update(
     tracks: &mut [Track],
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
-    sensor_positions_m: &[DVec2],
+    sensors: &[MeasurementSensor],
     reflections: &[ExpectedReflection],
     radial_velocity_rows: bool,
     outcomes: &mut [UpdateOutcome],
@@ -128,7 +129,7 @@ pub fn update(
         tracks,
         priors,
         measurements,
-        sensor_positions_m,
+        sensors,
         reflections,
         radial_velocity_rows,
         outcomes,
@@ -142,27 +143,26 @@ fn update_loop(
     tracks: &mut [Track],
     priors: &[ImmPrior],
     measurements: &[Option<Measurement>],
-    sensor_positions_m: &[DVec2],
+    sensors: &[MeasurementSensor],
     reflections: &[ExpectedReflection],
     radial_velocity_rows: bool,
     outcomes: &mut [UpdateOutcome],
 ) {
-    let per_track = tracks.iter_mut().zip(priors).zip(measurements).zip(sensor_positions_m).zip(reflections);
-    for (((((track, prior), measurement), sensor_position_m), reflection), outcome) in
-        per_track.zip(outcomes.iter_mut())
+    let per_track = tracks.iter_mut().zip(priors).zip(measurements).zip(sensors).zip(reflections);
+    for (((((track, prior), measurement), sensor), reflection), outcome) in per_track.zip(outcomes.iter_mut())
     {
         *outcome = match measurement {
             Some(z) => {
                 let class = track.class.index();
                 let models = &models[class];
                 let radial_velocity = models
-                    .radial_velocity_observation(z, *sensor_position_m, reflection.offset_m)
+                    .radial_velocity_observation(z, sensor, reflection.offset_m)
                     .filter(|_| radial_velocity_rows);
                 imms[class].update_with_radial_velocity_into(
                     models,
                     prior,
                     z.position() - reflection.offset_m,
-                    &to_nalgebra(&reflection.covariance_m2),
+                    &to_nalgebra(&(reflection.covariance_m2 + sensor.noise_m2)),
                     radial_velocity.as_ref(),
                     &mut track.estimate,
                 )
@@ -242,7 +242,7 @@ pub mod baseline {
         tracks: &mut [Track],
         priors: &[ImmPrior],
         measurements: &[Option<Measurement>],
-        sensor_positions_m: &[DVec2],
+        sensors: &[MeasurementSensor],
         reflections: &[ExpectedReflection],
         radial_velocity_rows: bool,
         outcomes: &mut [UpdateOutcome],
@@ -253,7 +253,7 @@ pub mod baseline {
             tracks,
             priors,
             measurements,
-            sensor_positions_m,
+            sensors,
             reflections,
             radial_velocity_rows,
             outcomes,

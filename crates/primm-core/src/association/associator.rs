@@ -46,6 +46,7 @@ use crate::config::{AssociationCost, AssociationStages, Config};
 use crate::extent::{expected_reflection, ExpectedReflection, ExtentConfig};
 use crate::imm::ImmPrior;
 use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use crate::sensor_noise::MeasurementSensor;
 use crate::track::Track;
 use crate::track_table::MAX_TRACKS;
 use alloc::boxed::Box;
@@ -111,6 +112,9 @@ pub struct Associator {
     /// Per track of the table: the expected reflection of its assigned measurement's sensor,
     /// where gating computed it.
     assigned_reflections: Box<[Option<ExpectedReflection>]>,
+    /// The largest x variance of the current stage's measurements from their radars' own noise,
+    /// m² (widens the likelihood gate's x-window).
+    largest_sensor_noise_xx_m2: f64,
     stats: AssociationStats,
 }
 
@@ -161,6 +165,7 @@ impl Associator {
             taken: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
             row_reflections: vec![ReflectionMemo::new(); MAX_TRACKS].into_boxed_slice(),
             assigned_reflections: vec![None; MAX_TRACKS].into_boxed_slice(),
+            largest_sensor_noise_xx_m2: 0.0,
             stats: AssociationStats::default(),
         }
     }
@@ -177,7 +182,7 @@ impl Associator {
         priors: &[ImmPrior],
         frame: &F,
         accepted: &[bool],
-        sensors: &[(DVec2, bool)],
+        sensors: &[MeasurementSensor],
         config: &Config,
         track_to_measurement: &mut [Option<u16>],
     ) -> Result<(), AssignmentError> {
@@ -215,7 +220,7 @@ impl Associator {
         priors: &[ImmPrior],
         frame: &F,
         accepted: &[bool],
-        sensors: &[(DVec2, bool)],
+        sensors: &[MeasurementSensor],
         config: &Config,
         class: ObjectClass,
         stage: Stage,
@@ -229,6 +234,7 @@ impl Associator {
         );
         self.columns.clear();
         self.sorted_x.clear();
+        self.largest_sensor_noise_xx_m2 = 0.0;
         for j in 0..frame.len() {
             if !accepted[j] || self.taken[j] {
                 continue;
@@ -237,6 +243,8 @@ impl Associator {
                 if measurement.class == class {
                     self.sorted_x.push((measurement.x_m, self.columns.len() as u16));
                     self.columns.push(j as u16);
+                    self.largest_sensor_noise_xx_m2 =
+                        self.largest_sensor_noise_xx_m2.max(sensors[j].noise_m2.x_axis.x);
                 }
             }
         }
@@ -257,7 +265,7 @@ impl Associator {
             if let Some(index) = track_to_measurement[usize::from(track_index)] {
                 self.taken[usize::from(index)] = true;
                 if extended {
-                    let sensor = sensors[usize::from(index)].0;
+                    let sensor = sensors[usize::from(index)].position_m;
                     self.assigned_reflections[usize::from(track_index)] =
                         self.row_reflections[r].find(sensor).map(|entry| entry.reflection);
                 }
@@ -286,7 +294,7 @@ impl Associator {
         tracks: &[Track],
         priors: &[ImmPrior],
         frame: &F,
-        sensors: &[(DVec2, bool)],
+        sensors: &[MeasurementSensor],
         config: &Config,
         class: ObjectClass,
     ) {
@@ -313,7 +321,7 @@ impl Associator {
                 };
                 let expected = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        let sensor = sensors[index].0;
+                        let sensor = sensors[index].position_m;
                         let entry = self.row_reflections[r].get(sensor, || RowReflection {
                             reflection: expected_reflection(extent, object, sensor),
                             prepared: None,
@@ -345,7 +353,7 @@ impl Associator {
         tracks: &[Track],
         priors: &[ImmPrior],
         frame: &F,
-        sensors: &[(DVec2, bool)],
+        sensors: &[MeasurementSensor],
         config: &Config,
         class: ObjectClass,
     ) {
@@ -367,13 +375,15 @@ impl Associator {
             let Some(prepared) = prepared else { continue };
             let object = extent.map(|_| priors[usize::from(track_index)].object_prior());
             self.row_reflections[r] = ReflectionMemo::new();
+            let sensor_spread_m2 = self.largest_sensor_noise_xx_m2;
             let (x, half) = (
                 prepared.mean_m().x,
                 match extent {
                     Some(extent) => {
-                        prepared.x_half_window_with_spread_m(extent.max_spread_m2()) + extent.max_offset_m()
+                        prepared.x_half_window_with_spread_m(extent.max_spread_m2() + sensor_spread_m2)
+                            + extent.max_offset_m()
                     }
-                    None => prepared.x_half_window_m(),
+                    None => prepared.x_half_window_with_spread_m(sensor_spread_m2),
                 },
             );
             let first = self.sorted_x.partition_point(|&(mx, _)| mx < x - half);
@@ -385,17 +395,32 @@ impl Associator {
                 let Ok(measurement) = frame.measurement(index) else {
                     continue;
                 };
+                // The radar's own noise differs between measurements: with it, `S` is formed
+                // per pair.
+                let sensor = &sensors[index];
+                let own_noise = sensor.noise_m2 != glam::DMat2::ZERO;
                 let cost = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        let sensor = sensors[index].0;
-                        let entry = self.row_reflections[r].get(sensor, || {
-                            let reflection = expected_reflection(extent, object, sensor);
+                        let entry = self.row_reflections[r].get(sensor.position_m, || {
+                            let reflection = expected_reflection(extent, object, sensor.position_m);
                             RowReflection { reflection, prepared: prepared.prepare_reflection(&reflection) }
                         });
-                        entry.prepared.and_then(|reflection| {
-                            prepared.cost_of_prepared_reflection(&measurement, &reflection)
-                        })
+                        if own_noise {
+                            let spread = ExpectedReflection {
+                                covariance_m2: entry.reflection.covariance_m2 + sensor.noise_m2,
+                                ..entry.reflection
+                            };
+                            prepared.cost_of_reflection(&measurement, &spread)
+                        } else {
+                            entry.prepared.and_then(|reflection| {
+                                prepared.cost_of_prepared_reflection(&measurement, &reflection)
+                            })
+                        }
                     }
+                    _ if own_noise => prepared.cost_of_reflection(
+                        &measurement,
+                        &ExpectedReflection { offset_m: DVec2::ZERO, covariance_m2: sensor.noise_m2 },
+                    ),
                     _ => prepared.cost(&measurement),
                 };
                 if let Some(cost) = cost {

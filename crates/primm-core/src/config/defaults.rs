@@ -80,7 +80,7 @@ fn tracker() -> TrackerConfig {
 fn car() -> ClassConfig {
     ClassConfig {
         gate_m: 8.4,
-        measurement_noise_covariance_m2: diagonal(0.36, 0.36),
+        measurement_noise_covariance_m2: diagonal(0.25, 0.25),
         radial_velocity_std_mps: 0.5,
         initial_tangential_speed_std_mps: 2.0,
         radial_velocity_residual_std_mps: 0.5,
@@ -139,7 +139,7 @@ fn car() -> ClassConfig {
 fn pedestrian() -> ClassConfig {
     ClassConfig {
         gate_m: 4.2,
-        measurement_noise_covariance_m2: diagonal(0.09, 0.09),
+        measurement_noise_covariance_m2: diagonal(0.05, 0.05),
         radial_velocity_std_mps: 0.3,
         initial_tangential_speed_std_mps: 0.525,
         radial_velocity_residual_std_mps: 0.7,

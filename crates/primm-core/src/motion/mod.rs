@@ -29,6 +29,7 @@ use crate::config::{ClassConfig, RadialLineOfSight, RadialVelocityUpdateConfig};
 use crate::extent::{ExpectedReflection, ExtentConfig, ObjectPrior};
 use crate::gaussian::{Gaussian, RadialVelocityObservation};
 use crate::measurement::Measurement;
+use crate::sensor_noise::MeasurementSensor;
 use glam::DVec2;
 use index::{VX, VY, X, Y};
 use nalgebra::{Matrix2, Vector2};
@@ -140,16 +141,17 @@ impl ModeModels {
         }
     }
 
-    /// The radial-velocity row for `measurement` seen by a radar at `sensor_position_m` (the
-    /// frame of the state), with the expected reflection's offset from the object's centre
-    /// `reflection_offset_m` (zero for a point), or `None` when this class's
-    /// `radial_velocity_update` is off.
+    /// The radial-velocity row for `measurement` seen by the radar `sensor` (position in the
+    /// frame of the state, and the detection's own noise), with the expected reflection's
+    /// offset from the object's centre `reflection_offset_m` (zero for a point), or `None` when
+    /// this class's `radial_velocity_update` is off.
     pub fn radial_velocity_observation(
         &self,
         measurement: &Measurement,
-        sensor_position_m: DVec2,
+        sensor: &MeasurementSensor,
         reflection_offset_m: DVec2,
     ) -> Option<RadialVelocityObservation> {
+        let sensor_position_m = sensor.position_m;
         let update = &self.radial_velocity_update;
         if !update.enabled {
             return None;
@@ -166,9 +168,10 @@ impl ModeModels {
                     }
                     let along = offset / range;
                     // The detection's noise across the line of sight, over the range: the
-                    // direction's variance.
+                    // direction's variance (the class's noise and the radar's own).
                     let across = Vector2::new(-along.y, along.x);
-                    let noise = self.constant_velocity.measurement_noise();
+                    let noise = self.constant_velocity.measurement_noise()
+                        + crate::gaussian::to_nalgebra(&sensor.noise_m2);
                     let across_variance_m2 = (across.transpose() * noise * across)[(0, 0)];
                     (Some(along), across_variance_m2 / (range * range), DVec2::ZERO)
                 }

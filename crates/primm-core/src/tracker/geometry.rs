@@ -9,6 +9,7 @@ use crate::measurement::FrameView;
 use crate::measurement::{Measurement, ObjectClass};
 use crate::pose::{EgoPose, RigidVelocity};
 use crate::predictor::DisplacementPredictor;
+use crate::sensor_noise::{MeasurementSensor, SensorNoise};
 use glam::DVec2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
@@ -151,18 +152,29 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Where the radar of every accepted measurement is, in the tracking frame: its mount,
     /// mapped into the world in a world-frame step; without a configured mount the vehicle's
-    /// reference point (flagged, and counted where a row or an extent uses it).
+    /// reference point (flagged, and counted where a row or an extent uses it). With it, the
+    /// detection's covariance from the radar's own noise (`crate::sensor_noise`).
     pub(super) fn locate_measurement_sensors(&mut self) {
         for index in 0..self.validated.len() {
             let Some(measurement) = self.validated.accepted(index) else { continue };
-            let mount =
-                measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)).map(|m| m.position());
-            let in_vehicle = mount.unwrap_or(DVec2::ZERO);
-            let position = match self.step_pose {
+            let mount = measurement.sensor_id.and_then(|id| self.config.frame.sensor(id));
+            let in_vehicle = mount.map_or(DVec2::ZERO, |mount| mount.position());
+            let position_m = match self.step_pose {
                 Some(pose) => pose.point_to_world(in_vehicle),
                 None => in_vehicle,
             };
-            self.measurement_sensors[index] = (position, mount.is_some());
+            // The radar's own noise enters world-frame steps only. In the vehicle frame a
+            // turning ego sweeps far objects across the line of sight at ω·r, which no motion
+            // model predicts; trusting far detections less there makes their tracks lag
+            // (ARCHITECTURE.md, "The radar's own noise").
+            let noise_m2 = match (mount, self.step_pose) {
+                (Some(mount), Some(pose)) => {
+                    SensorNoise::of(mount, Some(pose)).covariance_m2(measurement.position() - position_m)
+                }
+                _ => glam::DMat2::ZERO,
+            };
+            self.measurement_sensors[index] =
+                MeasurementSensor { position_m, mounted: mount.is_some(), noise_m2 };
         }
     }
 

@@ -28,13 +28,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
             let sensor_position_m = self.sensor_position(&measurement);
             // Where the history's line of sight starts: the radial-velocity row's radar position.
-            let line_of_sight_origin = self.measurement_sensors[index].0;
+            let sensor = self.measurement_sensors[index];
+            let line_of_sight_origin = sensor.position_m;
             let models = &self.models[measurement.class.index()];
             // An extended object starts at the centre behind its reflection (no heading yet:
             // the disc model of `crate::extent`), its position spread by the reflection's.
             let (mut centre, mut reflection) = (measurement, ExpectedReflection::POINT);
             if models.extent.is_some() {
-                let (sensor_m, mounted) = self.measurement_sensors[index];
+                let (sensor_m, mounted) = (sensor.position_m, sensor.mounted);
                 let standing =
                     crate::extent::ObjectPrior { centre_m: measurement.position(), ..Default::default() };
                 reflection = models.expected_reflection(&standing, sensor_m);
@@ -50,7 +51,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 &centre,
                 sensor_position_m,
             );
-            estimate.add_position_covariance(&crate::gaussian::to_nalgebra(&reflection.covariance_m2));
+            // The radar's own noise spreads the start as it spreads every update.
+            estimate.add_position_covariance(&crate::gaussian::to_nalgebra(
+                &(reflection.covariance_m2 + sensor.noise_m2),
+            ));
             let tracker = &self.config.tracker;
             match self.table.insert(|id| {
                 Track::new(id, &measurement, line_of_sight_origin, t, estimate, initial_existence)

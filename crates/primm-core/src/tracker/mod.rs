@@ -24,6 +24,7 @@ use crate::pose::{EgoMotion, EgoPose};
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::recorded_frame::RecordedFrame;
 use crate::replay::ReplayRing;
+use crate::sensor_noise::MeasurementSensor;
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput};
 use crate::track_loops::{self, ClassImms};
@@ -131,14 +132,16 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     track_to_measurement: Box<[Option<u16>; MAX_TRACKS]>,
     /// Each track's assigned measurement of the current frame (`None`: none).
     assigned_measurements: Box<[Option<Measurement>; MAX_TRACKS]>,
-    /// Where the radar of each track's assigned measurement is, in the tracking frame.
-    assigned_sensor_positions: Box<[DVec2; MAX_TRACKS]>,
+    /// Where the radar of each track's assigned measurement is, in the tracking frame, and the
+    /// detection's covariance from the radar's own noise.
+    assigned_sensors: Box<[MeasurementSensor; MAX_TRACKS]>,
     /// The expected reflection of each track's object for its assigned measurement's radar
     /// (computed once per frame, used by the Kalman update and the existence likelihood).
     assigned_reflections: Box<[ExpectedReflection; MAX_TRACKS]>,
     /// Where the radar of each measurement of the current frame is, in the tracking frame (its
-    /// mount; the vehicle's reference point when it has none), and whether it had a mount.
-    measurement_sensors: Box<[(DVec2, bool); MAX_MEASUREMENTS_PER_FRAME]>,
+    /// mount; the vehicle's reference point when it has none), whether it had a mount, and the
+    /// detection's covariance from the radar's own noise (`crate::sensor_noise`).
+    measurement_sensors: Box<[MeasurementSensor; MAX_MEASUREMENTS_PER_FRAME]>,
     /// Each track's update outcome of the current frame.
     update_outcomes: Box<[track_loops::UpdateOutcome; MAX_TRACKS]>,
     rows: Box<[RowRecord; MAX_TRACKS]>,
@@ -195,9 +198,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
             dt_s: 0.0,
             track_to_measurement: Box::new([None; MAX_TRACKS]),
             assigned_measurements: Box::new([None; MAX_TRACKS]),
-            assigned_sensor_positions: Box::new([DVec2::ZERO; MAX_TRACKS]),
+            assigned_sensors: Box::new([MeasurementSensor::unknown(DVec2::ZERO); MAX_TRACKS]),
             assigned_reflections: Box::new([ExpectedReflection::POINT; MAX_TRACKS]),
-            measurement_sensors: Box::new([(DVec2::ZERO, false); MAX_MEASUREMENTS_PER_FRAME]),
+            measurement_sensors: Box::new(
+                [MeasurementSensor::unknown(DVec2::ZERO); MAX_MEASUREMENTS_PER_FRAME],
+            ),
             update_outcomes: Box::new([Ok(None); MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),

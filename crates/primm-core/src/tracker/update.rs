@@ -55,8 +55,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 self.track_to_measurement[i] = None;
                 continue;
             };
-            let (sensor_m, mounted) = self.measurement_sensors[usize::from(index)];
-            self.assigned_sensor_positions[i] = sensor_m;
+            let sensor = self.measurement_sensors[usize::from(index)];
+            let (sensor_m, mounted) = (sensor.position_m, sensor.mounted);
+            self.assigned_sensors[i] = sensor;
             // Gating computed it already, for the same prior and sensor.
             let reflection = self
                 .associator
@@ -80,7 +81,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.table.tracks_mut(),
             &self.priors[..count],
             &self.assigned_measurements[..count],
-            &self.assigned_sensor_positions[..count],
+            &self.assigned_sensors[..count],
             &self.assigned_reflections[..count],
             // Radial velocities are over ground: they measure the velocity of world-frame
             // tracks, not of vehicle-frame tracks of an ego whose motion is unknown.
@@ -107,7 +108,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     measurement.position() - reflection.offset_m - prior.mean,
                     prior.covariance
                         + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2)
-                        + reflection.covariance_m2,
+                        + reflection.covariance_m2
+                        + self.assigned_sensors[i].noise_m2,
                 );
                 let tracker = &self.config.tracker;
                 let track = &mut self.table.tracks_mut()[i];
@@ -117,7 +119,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     detection,
                     clutter,
                 );
-                track.record_hit(&measurement, self.assigned_sensor_positions[i], t);
+                track.record_hit(&measurement, self.assigned_sensors[i].position_m, t);
                 if track.status == TrackStatus::Tentative && confirms(track, tracker) {
                     track.status = TrackStatus::Confirmed;
                     self.last_step.newly_confirmed += 1;

@@ -79,6 +79,9 @@ impl TryFrom<RadarMountFields> for RadarMount {
             max_range_m: fields.max_range_m,
             detection_probability_factor: 1.0,
             clutter_density_factor: 1.0,
+            range_std_m: 0.0,
+            azimuth_std_rad: 0.0,
+            azimuth_std_max_factor: 1.0,
         };
         Ok(RadarMount {
             layout,
@@ -126,6 +129,9 @@ fn layout_in_degrees(
         max_range_m,
         detection_probability_factor: 1.0,
         clutter_density_factor: 1.0,
+        range_std_m: 0.0,
+        azimuth_std_rad: 0.0,
+        azimuth_std_max_factor: 1.0,
     }
 }
 
