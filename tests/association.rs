@@ -9,6 +9,7 @@ use primm_core::config::Config;
 use primm_core::imm::{Imm, ImmPrior};
 use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::motion::{ModeModels, PredictContext};
+use primm_core::sensor_noise::MeasurementSensor;
 use primm_core::track::Track;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -146,7 +147,7 @@ fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
                 &scene.priors,
                 &scene.frame,
                 &scene.accepted,
-                &vec![(glam::DVec2::ZERO, false); scene.accepted.len()],
+                &vec![MeasurementSensor::unknown(glam::DVec2::ZERO); scene.accepted.len()],
                 &config,
                 &mut track_to_measurement,
             )
@@ -202,7 +203,7 @@ fn tracks_far_apart_are_paired_without_the_solver() {
     let accepted = vec![true; 50];
     let mut associator = Associator::new();
     let mut track_to_measurement = vec![None; 50];
-    let sensors = vec![(glam::DVec2::ZERO, false); accepted.len()];
+    let sensors = vec![MeasurementSensor::unknown(glam::DVec2::ZERO); accepted.len()];
     associator
         .associate(&tracks, &priors, &frame, &accepted, &sensors, &config, &mut track_to_measurement)
         .unwrap();
@@ -230,8 +231,12 @@ fn each_assigned_car_gets_the_reflection_of_its_measurements_sensor_exactly_as_t
             // Six radar positions, so that a track's memo (four) overflows now and then.
             let radars: Vec<DVec2> =
                 (0..6).map(|k| DVec2::new(3.0 * k as f64 - 6.0, [0.9, -0.9][k % 2])).collect();
-            let sensors: Vec<(DVec2, bool)> = (0..scene.accepted.len())
-                .map(|_| (radars[rng.random_range(0..radars.len())], true))
+            let sensors: Vec<MeasurementSensor> = (0..scene.accepted.len())
+                .map(|_| MeasurementSensor {
+                    position_m: radars[rng.random_range(0..radars.len())],
+                    mounted: true,
+                    noise_m2: glam::DMat2::ZERO,
+                })
                 .collect();
             let mut track_to_measurement = vec![None; scene.tracks.len()];
             associator
@@ -259,7 +264,7 @@ fn each_assigned_car_gets_the_reflection_of_its_measurements_sensor_exactly_as_t
                 let expected = expected_reflection(
                     &config.classes.car.extent,
                     &scene.priors[i].object_prior(),
-                    sensors[usize::from(*index)].0,
+                    sensors[usize::from(*index)].position_m,
                 );
                 // The memo may not hold it (more sensors than it keeps); if it does, exactly.
                 if let Some(shared) = shared {

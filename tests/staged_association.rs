@@ -6,9 +6,13 @@ use primm_core::association::assignment::AssignmentSolver;
 use primm_core::association::associator::Associator;
 use primm_core::association::cost::{association_cost, LikelihoodPrior};
 use primm_core::config::{AssociationCost, AssociationStages, Config};
+use primm_core::coordinates::CoordinatesConfig;
+use primm_core::extent::ExpectedReflection;
 use primm_core::imm::{Imm, ImmPrior};
 use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::motion::{ModeModels, PredictContext};
+use primm_core::pose::SensorMount;
+use primm_core::sensor_noise::{MeasurementSensor, SensorNoise};
 use primm_core::track::{Track, TrackStatus};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -18,6 +22,8 @@ struct Scene {
     priors: Vec<ImmPrior>,
     frame: Frame,
     accepted: Vec<bool>,
+    /// Each measurement's radar: every other one with a polar noise of its own.
+    sensors: Vec<MeasurementSensor>,
 }
 
 fn measurement(rng: &mut ChaCha8Rng, centre: DVec2, spread: f64, class: ObjectClass) -> Measurement {
@@ -42,8 +48,13 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
     let spread = rng.random_range(0.5..4.0);
     let class_of = |i: usize| if i.is_multiple_of(3) { ObjectClass::Pedestrian } else { ObjectClass::Car };
     let (track_count, measurement_count) = (rng.random_range(0..30), rng.random_range(0..30));
-    let mut scene =
-        Scene { tracks: Vec::new(), priors: Vec::new(), frame: Frame::new(0.05), accepted: Vec::new() };
+    let mut scene = Scene {
+        tracks: Vec::new(),
+        priors: Vec::new(),
+        frame: Frame::new(0.05),
+        accepted: Vec::new(),
+        sensors: Vec::new(),
+    };
     for i in 0..track_count {
         let class = class_of(i);
         let first = measurement(rng, spots[i % spots.len()], spread, class);
@@ -72,6 +83,28 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
         ));
         scene.accepted.push(rng.random_bool(0.9));
     }
+    // A radar at (-50, 0) looking along x with a coarse azimuth: across its line of sight its
+    // detections are metres wide at these ranges, so pairs gated out without it get in.
+    let mount = SensorMount {
+        x_m: -50.0,
+        y_m: 0.0,
+        yaw_rad: 0.0,
+        range_std_m: 0.2,
+        azimuth_std_rad: 0.03,
+        azimuth_std_max_factor: 2.0,
+        ..CoordinatesConfig::default().sensors[0]
+    };
+    let noise = SensorNoise::of(&mount, None);
+    scene.sensors = (0..measurement_count)
+        .map(|j| match j % 2 {
+            0 => MeasurementSensor::unknown(DVec2::ZERO),
+            _ => MeasurementSensor {
+                position_m: mount.position(),
+                mounted: true,
+                noise_m2: noise.covariance_m2(scene.frame.measurements[j].position() - mount.position()),
+            },
+        })
+        .collect();
     scene
 }
 
@@ -92,7 +125,8 @@ fn pair_cost(scene: &Scene, config: &Config, track: usize, measurement: usize) -
         }
         AssociationCost::Likelihood => {
             let [[xx, xy], [yx, yy]] = section.measurement_noise_covariance_m2;
-            let noise = DMat2::from_cols(DVec2::new(xx, yx), DVec2::new(xy, yy));
+            let noise = DMat2::from_cols(DVec2::new(xx, yx), DVec2::new(xy, yy))
+                + scene.sensors[measurement].noise_m2;
             // Computed here from first principles, not through LikelihoodPrior's own arithmetic.
             let s = prior.covariance + noise;
             let nu = m.position() - prior.mean;
@@ -168,7 +202,7 @@ fn run_scenes(config: &Config, seed: u64) -> usize {
                 &scene.priors,
                 &scene.frame,
                 &scene.accepted,
-                &sensors(&scene.accepted),
+                &scene.sensors,
                 config,
                 &mut answer,
             )
@@ -309,7 +343,18 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
             for (j, m) in scene.frame.measurements.iter().enumerate().filter(|(_, m)| m.class == track.class)
             {
                 let reference = pair_cost(&scene, &likelihood, i, j);
-                match (prepared.cost(m), reference) {
+                // The radar's own noise spreads the pair's innovation as a reflection's would.
+                let cost = match scene.sensors[j].noise_m2 == DMat2::ZERO {
+                    true => prepared.cost(m),
+                    false => prepared.cost_of_reflection(
+                        m,
+                        &ExpectedReflection {
+                            offset_m: DVec2::ZERO,
+                            covariance_m2: scene.sensors[j].noise_m2,
+                        },
+                    ),
+                };
+                match (cost, reference) {
                     (Some(a), Some(b)) => assert!((a - b).abs() < 1e-9 * b.abs().max(1.0), "{a} vs {b}"),
                     (None, None) => {}
                     other => panic!("gate disagrees: {other:?}"),
@@ -320,6 +365,6 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
 }
 
 /// Sensors at the reference point, without mounts (the costs here treat every class as a point).
-fn sensors(accepted: &[bool]) -> Vec<(glam::DVec2, bool)> {
-    vec![(glam::DVec2::ZERO, false); accepted.len()]
+fn sensors(accepted: &[bool]) -> Vec<MeasurementSensor> {
+    vec![MeasurementSensor::unknown(glam::DVec2::ZERO); accepted.len()]
 }

@@ -21,6 +21,7 @@ use primm_core::measurement::{Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::motion::ModeModels;
 use primm_core::predictor::Displacement;
+use primm_core::sensor_noise::MeasurementSensor;
 use primm_core::track::Track;
 use primm_core::track_loops::{self, ClassModels, LoopVersion};
 use primm_core::tracker::Tracker;
@@ -129,14 +130,24 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
                 (i % 4 != 0).then(|| measurement(prior.fused.mean.x + 0.3, prior.fused.mean.y - 0.2, 1.0))
             })
             .collect();
-        let sensors: Vec<DVec2> =
+        let sensor_positions: Vec<DVec2> =
             (0..tracks.len()).map(|i| DVec2::new(3.7, -0.9 + 0.6 * (i % 4) as f64)).collect();
+        // Every other measurement with a radar noise of its own.
+        let sensors: Vec<MeasurementSensor> = sensor_positions
+            .iter()
+            .enumerate()
+            .map(|(i, &position_m)| MeasurementSensor {
+                position_m,
+                mounted: true,
+                noise_m2: glam::DMat2::from_diagonal(DVec2::new(0.01, 0.2 * (i % 2) as f64)),
+            })
+            .collect();
         // The reflections the tracker computes once per frame and hands to the loop.
         let reflections: Vec<ExpectedReflection> = tracks
             .iter()
             .enumerate()
             .map(|(i, track)| {
-                models[track.class.index()].expected_reflection(&plain[i].object_prior(), sensors[i])
+                models[track.class.index()].expected_reflection(&plain[i].object_prior(), sensor_positions[i])
             })
             .collect();
         let mut dispatched_tracks = tracks.clone();
@@ -157,16 +168,17 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             let expected = match measurements[i] {
                 Some(z) => {
                     let models = &models[track.class.index()];
-                    let reflection = models.expected_reflection(&plain[i].object_prior(), sensors[i]);
+                    let reflection =
+                        models.expected_reflection(&plain[i].object_prior(), sensor_positions[i]);
                     let radial_velocity =
-                        models.radial_velocity_observation(&z, sensors[i], reflection.offset_m);
+                        models.radial_velocity_observation(&z, &sensors[i], reflection.offset_m);
                     assert!(radial_velocity.is_some());
                     assert_eq!(reflection.offset_m == DVec2::ZERO, track.class != ObjectClass::Car);
                     imms[track.class.index()].update_with_radial_velocity_into(
                         models,
                         &plain[i],
                         z.position() - reflection.offset_m,
-                        &primm_core::gaussian::to_nalgebra(&reflection.covariance_m2),
+                        &primm_core::gaussian::to_nalgebra(&(reflection.covariance_m2 + sensors[i].noise_m2)),
                         radial_velocity.as_ref(),
                         &mut track.estimate,
                     )
