@@ -16,9 +16,10 @@ use super::RadarConfig;
 #[serde(try_from = "RadarMountFields", into = "RadarMountFields")]
 pub struct RadarMount {
     /// Id, position, boresight, half field of view and range of the sensor, in the layout
-    /// type of the tracker's `frame.sensors`. Its `detection_probability_factor` and
-    /// `clutter_density_factor` describe the tracker's model, not the sensor; the generator
-    /// leaves them at 1 and does not read them.
+    /// type of the tracker's `frame.sensors`. Its `detection_probability_factor`,
+    /// `clutter_density_factor` and noise keys (`range_std_m`, `azimuth_std_rad`,
+    /// `azimuth_std_max_factor`) describe the tracker's model, not the sensor; the generator
+    /// leaves them neutral (1, 1, 0, 0, 1) and does not read them: its noise is `radar.*`.
     pub layout: SensorMount,
     /// Residual azimuth misalignment of this sensor, degrees.
     pub azimuth_bias_deg: f64,
@@ -149,7 +150,14 @@ impl RadarMount {
             .iter()
             .zip(errors)
             .map(|(&layout, (azimuth_bias_deg, azimuth_noise_scale))| RadarMount {
-                layout,
+                // The tracker's model of the sensor's noise is not the generator's: neutral
+                // here, as a scenario file's mounts have it.
+                layout: SensorMount {
+                    range_std_m: 0.0,
+                    azimuth_std_rad: 0.0,
+                    azimuth_std_max_factor: 1.0,
+                    ..layout
+                },
                 azimuth_bias_deg,
                 azimuth_noise_scale,
             })
