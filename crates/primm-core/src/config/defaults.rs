@@ -80,7 +80,7 @@ fn tracker() -> TrackerConfig {
 fn car() -> ClassConfig {
     ClassConfig {
         gate_m: 8.4,
-        measurement_noise_covariance_m2: diagonal(0.25, 0.25),
+        measurement_noise_covariance_m2: diagonal(0.36, 0.36),
         radial_velocity_std_mps: 0.5,
         initial_tangential_speed_std_mps: 2.0,
         radial_velocity_residual_std_mps: 0.5,
