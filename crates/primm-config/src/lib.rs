@@ -138,8 +138,8 @@ mod tests {
     #[test]
     fn an_asymmetric_covariance_is_named() {
         let text = DEFAULT_CONFIG_TOML.replacen(
-            "measurement_noise_covariance_m2 = [[0.09, 0.0], [0.0, 0.09]]",
-            "measurement_noise_covariance_m2 = [[0.09, 0.01], [0.0, 0.09]]",
+            "measurement_noise_covariance_m2 = [[0.05, 0.0], [0.0, 0.05]]",
+            "measurement_noise_covariance_m2 = [[0.05, 0.01], [0.0, 0.05]]",
             1,
         );
         assert_eq!(invalid_key(&text), "classes.pedestrian.measurement_noise_covariance_m2");

@@ -43,9 +43,9 @@ use super::assignment::{AssignmentError, AssignmentSolver};
 use super::cost::{association_cost, LikelihoodPrior};
 use super::reflection_memo::{ReflectionMemo, RowReflection, REFLECTION_MEMO_SENSORS};
 use crate::config::{AssociationCost, AssociationStages, Config};
-use crate::extent::{expected_reflection, ExpectedReflection, ExtentConfig};
+use crate::extent::{expected_reflection, ExpectedReflection, ExtentConfig, ObjectPrior};
 use crate::imm::ImmPrior;
-use crate::measurement::{FrameView, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use crate::measurement::{FrameView, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use crate::sensor_noise::MeasurementSensor;
 use crate::track::Track;
 use crate::track_table::MAX_TRACKS;
@@ -395,34 +395,14 @@ impl Associator {
                 let Ok(measurement) = frame.measurement(index) else {
                     continue;
                 };
-                // The radar's own noise differs between measurements: with it, `S` is formed
-                // per pair.
-                let sensor = &sensors[index];
-                let own_noise = sensor.noise_m2 != glam::DMat2::ZERO;
-                let cost = match (extent, &object) {
-                    (Some(extent), Some(object)) => {
-                        let entry = self.row_reflections[r].get(sensor.position_m, || {
-                            let reflection = expected_reflection(extent, object, sensor.position_m);
-                            RowReflection { reflection, prepared: prepared.prepare_reflection(&reflection) }
-                        });
-                        if own_noise {
-                            let spread = ExpectedReflection {
-                                covariance_m2: entry.reflection.covariance_m2 + sensor.noise_m2,
-                                ..entry.reflection
-                            };
-                            prepared.cost_of_reflection(&measurement, &spread)
-                        } else {
-                            entry.prepared.and_then(|reflection| {
-                                prepared.cost_of_prepared_reflection(&measurement, &reflection)
-                            })
-                        }
-                    }
-                    _ if own_noise => prepared.cost_of_reflection(
-                        &measurement,
-                        &ExpectedReflection { offset_m: DVec2::ZERO, covariance_m2: sensor.noise_m2 },
-                    ),
-                    _ => prepared.cost(&measurement),
-                };
+                let extended = extent.zip(object.as_ref());
+                let cost = likelihood_pair_cost(
+                    &prepared,
+                    &mut self.row_reflections[r],
+                    extended,
+                    &measurement,
+                    &sensors[index],
+                );
                 if let Some(cost) = cost {
                     self.pairs[count] = Pair { row: r as u16, column, cost };
                     count += 1;
@@ -538,6 +518,43 @@ fn union(parent: &mut [u16], a: usize, b: usize) {
         // The smaller index becomes the root, keeping roots stable and the result deterministic.
         let (low, high) = (root_a.min(root_b), root_a.max(root_b));
         parent[high] = low as u16;
+    }
+}
+
+/// The likelihood cost of one pair. For an extended class the track's expected reflection for
+/// the measurement's radar comes from (or goes into) its `memo`; with the radar's own noise,
+/// which differs between measurements, `S` is formed for this pair.
+fn likelihood_pair_cost(
+    prepared: &LikelihoodPrior,
+    memo: &mut ReflectionMemo<RowReflection, REFLECTION_MEMO_SENSORS>,
+    extended: Option<(&ExtentConfig, &ObjectPrior)>,
+    measurement: &Measurement,
+    sensor: &MeasurementSensor,
+) -> Option<f64> {
+    let own_noise = sensor.noise_m2 != glam::DMat2::ZERO;
+    match extended {
+        Some((extent, object)) => {
+            let entry = memo.get(sensor.position_m, || {
+                let reflection = expected_reflection(extent, object, sensor.position_m);
+                RowReflection { reflection, prepared: prepared.prepare_reflection(&reflection) }
+            });
+            if own_noise {
+                let spread = ExpectedReflection {
+                    covariance_m2: entry.reflection.covariance_m2 + sensor.noise_m2,
+                    ..entry.reflection
+                };
+                prepared.cost_of_reflection(measurement, &spread)
+            } else {
+                entry
+                    .prepared
+                    .and_then(|reflection| prepared.cost_of_prepared_reflection(measurement, &reflection))
+            }
+        }
+        None if own_noise => prepared.cost_of_reflection(
+            measurement,
+            &ExpectedReflection { offset_m: DVec2::ZERO, covariance_m2: sensor.noise_m2 },
+        ),
+        None => prepared.cost(measurement),
     }
 }
 
