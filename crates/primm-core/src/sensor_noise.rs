@@ -180,6 +180,32 @@ mod tests {
         assert!((across.dot(noise.covariance_m2(offset) * across) - 0.01).abs() < 1e-12);
     }
 
+    proptest::proptest! {
+        #[test]
+        fn the_covariance_is_finite_symmetric_and_positive_semidefinite(
+            range_std in 0.0f64..2.0,
+            azimuth_std in 0.0f64..0.5,
+            factor in 1.0f64..10.0,
+            yaw in -7.0f64..7.0,
+            x in -1000.0f64..1000.0,
+            y in -1000.0f64..1000.0,
+        ) {
+            let noise = SensorNoise::of(
+                &SensorMount { yaw_rad: yaw, ..mount(range_std, azimuth_std, factor) },
+                None,
+            );
+            let c = noise.covariance_m2(DVec2::new(x, y));
+            proptest::prop_assert!(c.to_cols_array().iter().all(|v| v.is_finite()));
+            proptest::prop_assert!((c.x_axis.y - c.y_axis.x).abs() <= 1e-12 * (1.0 + c.x_axis.y.abs()));
+            proptest::prop_assert!(c.x_axis.x >= 0.0 && c.y_axis.y >= 0.0);
+            proptest::prop_assert!(c.determinant() >= -1e-9 * (1.0 + c.x_axis.x * c.y_axis.y));
+            // Never more than the bounded growth allows across the line of sight.
+            let range = DVec2::new(x, y).length();
+            let bound = range_std * range_std + (range * azimuth_std * factor).powi(2);
+            proptest::prop_assert!(c.x_axis.x + c.y_axis.y <= bound * (1.0 + 1e-9) + 1e-12);
+        }
+    }
+
     #[test]
     fn a_sensor_without_noise_keys_adds_nothing() {
         let noise = SensorNoise::of(&mount(0.0, 0.0, 1.0), None);
