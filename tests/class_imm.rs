@@ -4,7 +4,7 @@
 //! the shipped overrides leave the physics modes' switching (the `imm` method) as `imm` has it, and
 //! the `compensated_*` keys govern the steps with an ego pose, and only those.
 
-use crate::common::{scene_frames, SceneObject};
+use crate::common::{invalid_key, scene_frames, SceneObject};
 use primm_core::config::{Config, ConfigError, ImmConfig};
 use primm_core::imm::Imm;
 use primm_core::measurement::ObjectClass;
@@ -152,13 +152,6 @@ fn the_shipped_overrides_change_pr_only_and_leave_the_imm_method_as_it_was() {
         }
     }
     assert_eq!(changed, 2, "cars and pedestrians carry overrides, two-wheelers none");
-}
-
-fn invalid_key(result: Result<impl std::fmt::Debug, ConfigError>) -> String {
-    match result {
-        Err(ConfigError::Invalid { key, .. }) => key,
-        other => panic!("expected an invalid key, got {other:?}"),
-    }
 }
 
 #[test]

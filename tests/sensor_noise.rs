@@ -3,9 +3,9 @@
 //! those, a far detection moves a track less across the line of sight than a near one, and bad
 //! values are refused naming their section.
 
-use crate::common::{scene_frames, SceneObject};
+use crate::common::{invalid_key, scene_frames, SceneObject};
 use glam::DVec2;
-use primm_core::config::{Config, ConfigError};
+use primm_core::config::Config;
 use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::pose::EgoPose;
 use primm_core::track::TrackOutput;
@@ -119,13 +119,6 @@ fn a_far_detection_moves_a_track_less_across_the_line_of_sight_than_a_near_one()
     let plain = without_sensor_noise();
     let (near, far) = (pull_across(&plain, 8.0), pull_across(&plain, 90.0));
     assert!((far - near).abs() < 0.05 * near, "near {near} m, far {far} m");
-}
-
-fn invalid_key(result: Result<impl std::fmt::Debug, ConfigError>) -> String {
-    match result {
-        Err(ConfigError::Invalid { key, .. }) => key,
-        other => panic!("expected an invalid key, got {other:?}"),
-    }
 }
 
 #[test]

@@ -232,3 +232,11 @@ pub mod counting_allocator;
 pub mod service;
 #[cfg(feature = "tunnel")]
 pub mod tunnel;
+
+/// The key a configuration error names, for a result that must be `ConfigError::Invalid`.
+pub fn invalid_key(result: Result<impl std::fmt::Debug, primm_core::config::ConfigError>) -> String {
+    match result {
+        Err(primm_core::config::ConfigError::Invalid { key, .. }) => key,
+        other => panic!("expected an invalid key, got {other:?}"),
+    }
+}

@@ -35,13 +35,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
             // the disc model of `crate::extent`), its position spread by the reflection's.
             let (mut centre, mut reflection) = (measurement, ExpectedReflection::POINT);
             if models.extent.is_some() {
-                let (sensor_m, mounted) = (sensor.position_m, sensor.mounted);
                 let standing =
                     crate::extent::ObjectPrior { centre_m: measurement.position(), ..Default::default() };
-                reflection = models.expected_reflection(&standing, sensor_m);
+                reflection = models.expected_reflection(&standing, sensor.position_m);
                 (centre.x_m, centre.y_m) =
                     (measurement.x_m - reflection.offset_m.x, measurement.y_m - reflection.offset_m.y);
-                if !mounted {
+                if !sensor.mounted {
                     self.last_step.updates_from_unknown_sensor += 1;
                 }
             }

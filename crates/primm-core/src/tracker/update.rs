@@ -56,16 +56,15 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 continue;
             };
             let sensor = self.measurement_sensors[usize::from(index)];
-            let (sensor_m, mounted) = (sensor.position_m, sensor.mounted);
             self.assigned_sensors[i] = sensor;
             // Gating computed it already, for the same prior and sensor.
             let reflection = self
                 .associator
                 .assigned_reflection(i)
-                .unwrap_or_else(|| self.expected_reflection(i, sensor_m));
+                .unwrap_or_else(|| self.expected_reflection(i, sensor.position_m));
             self.assigned_reflections[i] = reflection;
             let models = &self.models[measurement.class.index()];
-            if !mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
+            if !sensor.mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
                 self.last_step.updates_from_unknown_sensor += 1;
             }
         }
