@@ -506,6 +506,9 @@ impl From<&TrackerStats> for PrimmStats {
             radial_velocity_updates_gated,
             updates_from_unknown_sensor,
             detections_absorbed,
+            // Not in `PrimmStats`: a field more would change the struct the caller allocates, an
+            // ABI break (PRIMM_ABI_VERSION 1 keeps its layout).
+            speeds_bounded: _,
         } = *stats;
         PrimmStats {
             frames_tracked,

@@ -49,6 +49,13 @@ pub struct ClassConfig {
     pub radial_velocity_std_mps: f64,
     /// Standard deviation of the velocity across the line of sight at initiation, m/s.
     pub initial_tangential_speed_std_mps: f64,
+    /// Highest speed over ground an object of this class reaches, m/s (absent: no bound). In
+    /// steps with an ego pose, a mode's velocity estimate above it after an update or at a
+    /// track's start is scaled back onto it (counted as
+    /// [`TrackerStats::speeds_bounded`](crate::TrackerStats)): no measurement can make a car
+    /// faster than cars drive.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub max_speed_mps: Option<f64>,
     /// Standard deviation of the difference between a measurement's radial velocity and the
     /// track's last one, as the `likelihood` association cost scores it, m/s (absent: 1 m/s).
     /// Wider than the sensor's noise: the two may come from different sensors, whose lines of

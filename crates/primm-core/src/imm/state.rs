@@ -74,6 +74,31 @@ impl ImmState {
         self.learned_velocity_mps += sign * field.at(learned);
     }
 
+    /// Scales every velocity faster than `max_speed_mps` (CV, CA, CT and PR's last displacement)
+    /// back onto that speed, keeping its direction; the covariances are left as they are. Whether
+    /// any was.
+    pub fn bound_speed(&mut self, max_speed_mps: f64) -> bool {
+        fn bound(velocity: DVec2, max_speed_mps: f64) -> Option<DVec2> {
+            let speed = velocity.length();
+            (speed > max_speed_mps).then(|| velocity * (max_speed_mps / speed))
+        }
+        fn bound_mode<const N: usize>(gaussian: &mut Gaussian<N>, vx: usize, max_speed_mps: f64) -> bool {
+            let velocity = DVec2::new(gaussian.mean[vx], gaussian.mean[vx + 1]);
+            let Some(bounded) = bound(velocity, max_speed_mps) else { return false };
+            gaussian.mean[vx] = bounded.x;
+            gaussian.mean[vx + 1] = bounded.y;
+            true
+        }
+        let mut any = bound_mode(&mut self.constant_velocity, cv::VX, max_speed_mps);
+        any |= bound_mode(&mut self.constant_acceleration, ca::VX, max_speed_mps);
+        any |= bound_mode(&mut self.coordinated_turn, ct::VX, max_speed_mps);
+        if let Some(bounded) = bound(self.learned_velocity_mps, max_speed_mps) {
+            self.learned_velocity_mps = bounded;
+            any = true;
+        }
+        any
+    }
+
     /// This state in another frame (see [`Gaussian::transformed`]): positions mapped,
     /// velocities and accelerations rotated, turn rate and mode probabilities unchanged.
     pub fn transformed(&self, transform: &RigidTransform) -> Self {

@@ -54,6 +54,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             estimate.add_position_covariance(&crate::gaussian::to_nalgebra(
                 &(reflection.covariance_m2 + sensor.noise_m2),
             ));
+            let max_speed_mps = self.config.classes.get(measurement.class).max_speed_mps;
+            if super::update::bound_speed(max_speed_mps, self.step_pose.is_some(), &mut estimate) {
+                self.last_step.speeds_bounded += 1;
+            }
             let tracker = &self.config.tracker;
             match self.table.insert(|id| {
                 Track::new(id, &measurement, line_of_sight_origin, t, estimate, initial_existence)

@@ -93,6 +93,9 @@ pub struct TrackerStats {
     /// Track updates whose radial-velocity row lay beyond `radial_velocity_update.gate_std` in
     /// every mode and was left out.
     pub radial_velocity_updates_gated: u64,
+    /// Track updates and initiations after which a velocity estimate was faster than the
+    /// class's `max_speed_mps` and was scaled back onto it (steps with an ego pose only).
+    pub speeds_bounded: u64,
     /// Updates and initiations of a class with a radial-velocity row or an extent whose
     /// measurement's sensor has no configured mount: seen from the vehicle's reference point.
     pub updates_from_unknown_sensor: u64,
@@ -165,6 +168,9 @@ pub struct StepSummary {
     pub radial_velocity_rows_applied: usize,
     /// Track updates whose radial-velocity row was gated out.
     pub radial_velocity_rows_gated: usize,
+    /// Track updates and initiations after which a velocity was scaled back onto the class's
+    /// highest speed.
+    pub speeds_bounded: usize,
     /// Updates and initiations seen from the vehicle's reference point (no configured mount)
     /// by a class with a radial-velocity row or an extent.
     pub updates_from_unknown_sensor: usize,
@@ -197,6 +203,7 @@ impl TrackerStats {
         self.odometry_resets += u64::from(step.odometry_reset);
         self.radial_velocity_updates += count(step.radial_velocity_rows_applied);
         self.radial_velocity_updates_gated += count(step.radial_velocity_rows_gated);
+        self.speeds_bounded += count(step.speeds_bounded);
         self.updates_from_unknown_sensor += count(step.updates_from_unknown_sensor);
         self.detections_absorbed += count(step.detections_absorbed);
     }

@@ -5,7 +5,9 @@ use super::{confirms, covariance, MeasurementFate, RowRecord, StepError, Tracker
 use crate::existence::{self, Evidence};
 use crate::extent::ExpectedReflection;
 use crate::gaussian::RadialVelocityOutcome;
+use crate::imm::ImmState;
 use crate::measurement::FrameView;
+use crate::measurement::ObjectClass;
 use crate::predictor::DisplacementPredictor;
 use crate::track::TrackStatus;
 use crate::track_loops;
@@ -70,6 +72,16 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
+    /// Scales track `i`'s velocities back onto its class's highest speed over ground, in a step
+    /// with an ego pose (without one, the velocities are relative to an ego whose motion is
+    /// unknown, and any speed is possible).
+    fn bound_speed(&mut self, i: usize, class: ObjectClass) {
+        let max_speed_mps = self.config.classes.get(class).max_speed_mps;
+        if bound_speed(max_speed_mps, self.step_pose.is_some(), &mut self.table.tracks_mut()[i].estimate) {
+            self.last_step.speeds_bounded += 1;
+        }
+    }
+
     /// Kalman and mode-probability update of every assigned track.
     pub(super) fn update(&mut self, t: f64) {
         let count = self.table.len();
@@ -100,6 +112,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     Some(RadialVelocityOutcome::NoLineOfSight) | None => {}
                 }
                 let class = self.table.tracks()[i].class;
+                self.bound_speed(i, class);
                 let (detection, clutter) = self.detection_and_clutter(class, measurement.sensor_id);
                 let reflection = self.assigned_reflections[i];
                 let prior = &self.priors[i].fused;
@@ -182,5 +195,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 measurement_index,
             };
         }
+    }
+}
+
+/// Scales `estimate`'s velocities back onto `max_speed_mps` (the class's
+/// `classes.<class>.max_speed_mps`) in a step with an ego pose (`posed`); whether any was.
+pub(super) fn bound_speed(max_speed_mps: Option<f64>, posed: bool, estimate: &mut ImmState) -> bool {
+    match max_speed_mps {
+        Some(max_speed_mps) if posed => estimate.bound_speed(max_speed_mps),
+        _ => false,
     }
 }
