@@ -205,9 +205,7 @@ pub(super) fn validate_class(class: ObjectClass, section: &ClassConfig) -> Resul
     covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
     positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
     positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
-    if let Some(max_speed_mps) = section.max_speed_mps {
-        positive(&key("max_speed_mps"), max_speed_mps)?;
-    }
+    section.max_speed_mps.map_or(Ok(()), |speed| positive(&key("max_speed_mps"), speed))?;
     positive(&key("radial_velocity_residual_std_mps"), section.radial_velocity_residual_std_mps)?;
     positive(&key("duplicate_distance_m"), section.duplicate_distance_m)?;
     positive(&key("duplicate_speed_difference_mps"), section.duplicate_speed_difference_mps)?;
