@@ -79,7 +79,7 @@ pub enum CsvErrorKind {
     #[error("invalid integer `{0}`")]
     BadInteger(String),
     /// The class name is not one of the known classes.
-    #[error("unknown object class `{0}` (expected `car` or `pedestrian`)")]
+    #[error("unknown object class `{0}` (expected `car`, `pedestrian` or `two_wheeler`, or one of their names in docs/scenario.md)")]
     UnknownClass(String),
     /// A value required on this row is empty.
     #[error("missing value")]
@@ -459,7 +459,7 @@ impl RowParser<'_> {
             }
             return Ok(None);
         }
-        let class = ObjectClass::from_name(class_text)
+        let class = class_from_label(class_text)
             .ok_or_else(|| self.error("class", CsvErrorKind::UnknownClass(class_text.to_owned())))?;
         let gt_text = self.field(c_gt);
         let ground_truth_id = if gt_text.is_empty() || gt_text == "-1" {
@@ -642,6 +642,27 @@ pub fn read_dataset_dir(dir: &Path) -> Result<Vec<Sequence>, CsvError> {
     dataset_files(dir)?.iter().map(|path| read_sequence_file(path)).collect()
 }
 
+/// The class of a `class` cell: `car`, `pedestrian` or `two_wheeler`, or a name other datasets
+/// and stacks give the same kind of object (docs/scenario.md), in any letter case, with `-` or a
+/// space for `_`. A truck or a bus is tracked as a car, a cyclist as a two-wheeler.
+pub fn class_from_label(text: &str) -> Option<ObjectClass> {
+    let label: String = text
+        .trim()
+        .chars()
+        .map(|c| if c == '-' || c == ' ' { '_' } else { c.to_ascii_lowercase() })
+        .collect();
+    match label.as_str() {
+        "car" | "vehicle" | "passenger_car" | "van" | "truck" | "bus" | "large_vehicle" | "trailer" => {
+            Some(ObjectClass::Car)
+        }
+        "pedestrian" | "person" | "pedestrian_group" => Some(ObjectClass::Pedestrian),
+        "two_wheeler" | "bicycle" | "bike" | "cyclist" | "motorcycle" | "motorbike" | "scooter" => {
+            Some(ObjectClass::TwoWheeler)
+        }
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -806,9 +827,32 @@ mod tests {
 
     #[test]
     fn unknown_class_is_reported() {
-        let err = read_err(&format!("{HEADER}0,0,1,truck,1,2,3,4,,,,,,\n"));
-        assert!(matches!(err.kind, CsvErrorKind::UnknownClass(ref c) if c == "truck"));
+        let err = read_err(&format!("{HEADER}0,0,1,tram,1,2,3,4,,,,,,\n"));
+        assert!(matches!(err.kind, CsvErrorKind::UnknownClass(ref c) if c == "tram"));
         assert_eq!((err.line, err.column.as_deref()), (Some(2), Some("class")));
+        assert!(err.to_string().contains("two_wheeler"), "{err}");
+    }
+
+    #[test]
+    fn other_names_of_the_classes_are_read_as_those_classes() {
+        for (label, class) in [
+            ("Truck", ObjectClass::Car),
+            (" BUS ", ObjectClass::Car),
+            ("passenger-car", ObjectClass::Car),
+            ("Pedestrian Group", ObjectClass::Pedestrian),
+            ("person", ObjectClass::Pedestrian),
+            ("Bicycle", ObjectClass::TwoWheeler),
+            ("motorcycle", ObjectClass::TwoWheeler),
+            ("two_wheeler", ObjectClass::TwoWheeler),
+        ] {
+            let sequence =
+                read_sequence(format!("{HEADER}0,0,1,{label},1,2,3,4,,,,,,\n").as_bytes(), "names")
+                    .unwrap_or_else(|error| panic!("{label}: {error}"));
+            assert_eq!(sequence.frames[0].measurements[0].measurement.class, class, "{label}");
+        }
+        for label in ["", "c a r", "cars", "pedestrians"] {
+            assert_eq!(class_from_label(label), None, "{label}");
+        }
     }
 
     #[test]
