@@ -312,8 +312,8 @@ typedef struct PrimmStats {
   uint64_t update_failures;
   // Calls to `primm_tracker_reset`.
   uint64_t resets;
-  // Frames with a measurement whose sensor has no configured mount (or no sensor id): every
-  // track counted as in view of that sensor.
+  // Frames with a measurement whose sensor has no configured mount (or no sensor id): such a
+  // radar is taken to look where its detections of the frame lie.
   uint64_t frames_with_unknown_sensor;
   // Tracks merged into an older track of the same object.
   uint64_t duplicate_tracks_merged;

@@ -128,19 +128,36 @@ fn a_coasting_track_is_confirmed_again_by_its_next_detection() {
 }
 
 #[test]
-fn a_measurement_of_an_unknown_sensor_counts_every_miss_and_is_counted() {
+fn a_measurement_of_an_unknown_sensor_counts_a_miss_within_its_sector_and_is_counted() {
+    // With a margin of pi an unknown radar looks everywhere: the far measurement's radar counts
+    // the first track as seen and missed. With the shipped margin it looks only around its
+    // detection, which lies on the other side, and the first track keeps its existence.
+    for (everywhere, missed) in [(true, true), (false, false)] {
+        let mut config = config(Lifecycle::Counts);
+        if everywhere {
+            config.frame.unknown_sensor_margin_rad = std::f64::consts::PI;
+        }
+        let mut tracker = Tracker::new(config.clone()).unwrap();
+        tracker.step(&frame(0.0, &[car(LEFT, Some(3), 1)])).unwrap();
+        let before = tracker.tracks()[0].existence_probability;
+        // A far measurement without a sensor id.
+        tracker.step(&frame(0.05, &[car(RIGHT, None, 2)])).unwrap();
+        let survived = before * survival_probability(0.05, &config.tracker);
+        let detection = config.classes.car.existence.detection_probability;
+        let expected = if missed {
+            updated_existence(survived, Evidence::MissedInView, detection, 1e-4)
+        } else {
+            survived
+        };
+        let first = tracker.tracks().iter().find(|t| t.id == 1).unwrap();
+        assert!((first.existence_probability - expected).abs() < 1e-12, "everywhere: {everywhere}");
+        assert_eq!(tracker.last_step().missed_in_view, usize::from(missed));
+        assert_eq!(tracker.stats().frames_with_unknown_sensor, 1);
+    }
     let config = config(Lifecycle::Counts);
     let mut tracker = Tracker::new(config.clone()).unwrap();
     tracker.step(&frame(0.0, &[car(LEFT, Some(3), 1)])).unwrap();
-    let before = tracker.tracks()[0].existence_probability;
-    // A far measurement without a sensor id: the first track counts as seen and missed.
     tracker.step(&frame(0.05, &[car(RIGHT, None, 2)])).unwrap();
-    let survived = before * survival_probability(0.05, &config.tracker);
-    let detection = config.classes.car.existence.detection_probability;
-    let expected = updated_existence(survived, Evidence::MissedInView, detection, 1e-4);
-    let first = tracker.tracks().iter().find(|t| t.id == 1).unwrap();
-    assert!((first.existence_probability - expected).abs() < 1e-12);
-    assert_eq!(tracker.stats().frames_with_unknown_sensor, 1);
     // A frame without measurements names no sensor: nothing is counted against anyone.
     let quiet = tracker.tracks().iter().find(|t| t.id == 1).unwrap().existence_probability;
     tracker.step(&frame(0.1, &[])).unwrap();

@@ -66,4 +66,5 @@ mod tracker;
 mod tracker_allocation;
 #[cfg(feature = "tunnel")]
 mod tunnel_loopback;
+mod unknown_sensor_view;
 mod world_frame;

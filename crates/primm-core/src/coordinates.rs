@@ -72,6 +72,31 @@ pub struct CoordinatesConfig {
     /// Mounting pose of every sensor, by sensor id. A measurement of a sensor not listed here
     /// (or without a sensor id) is seen from the vehicle's reference point, and counted.
     pub sensors: ArrayVec<SensorMount, MAX_SENSORS>,
+    /// A radar without a configured mount is taken to look where its detections of the frame
+    /// lie, seen from the vehicle's reference point: the sector around them, widened by this
+    /// angle on each side, rad (absent: 0.35, 20°; π: every direction), out to the farthest
+    /// detection plus `unknown_sensor_margin_m`. Tracks outside it lose no existence by not
+    /// being detected in that frame.
+    #[cfg_attr(feature = "serde", serde(default = "default_unknown_sensor_margin_rad"))]
+    pub unknown_sensor_margin_rad: f64,
+    /// See `unknown_sensor_margin_rad`, m (absent: 10).
+    #[cfg_attr(feature = "serde", serde(default = "default_unknown_sensor_margin_m"))]
+    pub unknown_sensor_margin_m: f64,
+}
+
+/// `frame.unknown_sensor_margin_rad` when absent.
+pub const DEFAULT_UNKNOWN_SENSOR_MARGIN_RAD: f64 = 0.35;
+/// `frame.unknown_sensor_margin_m` when absent.
+pub const DEFAULT_UNKNOWN_SENSOR_MARGIN_M: f64 = 10.0;
+
+#[cfg(feature = "serde")]
+fn default_unknown_sensor_margin_rad() -> f64 {
+    DEFAULT_UNKNOWN_SENSOR_MARGIN_RAD
+}
+
+#[cfg(feature = "serde")]
+fn default_unknown_sensor_margin_m() -> f64 {
+    DEFAULT_UNKNOWN_SENSOR_MARGIN_M
 }
 
 impl Default for CoordinatesConfig {
@@ -98,7 +123,12 @@ impl Default for CoordinatesConfig {
         sensors.push(mount(2, 3.86, -0.70, -25.0));
         sensors.push(mount(3, 3.86, 0.70, 25.0));
         sensors.push(mount(4, 3.66, 0.87, 85.0));
-        CoordinatesConfig { tracking_frame: CoordinateFrame::World, sensors }
+        CoordinatesConfig {
+            tracking_frame: CoordinateFrame::World,
+            sensors,
+            unknown_sensor_margin_rad: DEFAULT_UNKNOWN_SENSOR_MARGIN_RAD,
+            unknown_sensor_margin_m: DEFAULT_UNKNOWN_SENSOR_MARGIN_M,
+        }
     }
 }
 
@@ -110,6 +140,12 @@ impl CoordinatesConfig {
 
     /// The first problem of the section, as (key, reason).
     pub(crate) fn problem(&self) -> Option<(&'static str, &'static str)> {
+        if !(0.0..=core::f64::consts::PI).contains(&self.unknown_sensor_margin_rad) {
+            return Some(("frame.unknown_sensor_margin_rad", "must lie in [0, pi]"));
+        }
+        if !(self.unknown_sensor_margin_m.is_finite() && self.unknown_sensor_margin_m >= 0.0) {
+            return Some(("frame.unknown_sensor_margin_m", "must be a finite number >= 0"));
+        }
         for (index, mount) in self.sensors.iter().enumerate() {
             if !(mount.x_m.is_finite() && mount.y_m.is_finite() && mount.yaw_rad.is_finite()) {
                 return Some(("frame.sensors", "every x_m, y_m and yaw_rad must be finite"));

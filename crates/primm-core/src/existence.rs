@@ -171,6 +171,35 @@ impl FieldOfView {
         }
     }
 
+    /// The field of view of a radar without a configured mount, as far as its detections of
+    /// one frame show it: seen from `origin_m` (the vehicle's reference point, tracking frame),
+    /// the smallest sector around the detections' mean direction that holds them all, widened
+    /// by `margin_rad` on each side, out to the farthest detection plus `margin_m`. `None`
+    /// without detections.
+    pub fn spanning(
+        origin_m: DVec2,
+        detections_m: impl Iterator<Item = DVec2> + Clone,
+        margin_rad: f64,
+        margin_m: f64,
+    ) -> Option<Self> {
+        let directions = detections_m.clone().filter_map(|p| (p - origin_m).try_normalize());
+        let sum: DVec2 = directions.clone().sum();
+        let max_range_m = detections_m
+            .map(|p| p.distance(origin_m))
+            .fold(None, |far: Option<f64>, r| Some(far.map_or(r, |far| far.max(r))))?;
+        // Detections all around (or one on the origin): every direction.
+        let (boresight, cos_half_angle) = match sum.try_normalize() {
+            Some(mean) => {
+                let cos_widest = directions.map(|d| d.dot(mean)).fold(1.0, f64::min);
+                let half_angle =
+                    (math::acos(cos_widest.clamp(-1.0, 1.0)) + margin_rad).min(core::f64::consts::PI);
+                (mean, math::sin_cos(half_angle).1)
+            }
+            None => (DVec2::X, -1.0),
+        };
+        Some(FieldOfView { origin_m, boresight, cos_half_angle, max_range_m: max_range_m + margin_m })
+    }
+
     /// Whether `position_m` (tracking frame) lies within range and opening angle.
     pub fn contains(&self, position_m: DVec2) -> bool {
         let relative = position_m - self.origin_m;
@@ -261,6 +290,34 @@ mod tests {
         let turned = FieldOfView::of(&mount(0.0), Some(pose));
         assert!(turned.contains(pose.point_to_world(DVec2::new(40.0, 0.0))));
         assert!(!turned.contains(DVec2::new(140.0, -20.0)));
+    }
+
+    #[test]
+    fn an_unknown_radars_view_is_the_sector_its_detections_span_widened_by_the_margins() {
+        let origin = DVec2::new(10.0, -5.0);
+        // Detections 20° either side of +x, out to 50 m.
+        let detections = [20f64, -20.0, 5.0].map(|deg| {
+            let (sin, cos) = deg.to_radians().sin_cos();
+            origin + DVec2::new(cos, sin) * if deg == 5.0 { 50.0 } else { 30.0 }
+        });
+        let view = FieldOfView::spanning(origin, detections.iter().copied(), 0.1, 5.0).unwrap();
+        let at = |deg: f64, range: f64| {
+            let (sin, cos) = deg.to_radians().sin_cos();
+            view.contains(origin + DVec2::new(cos, sin) * range)
+        };
+        for detection in detections {
+            assert!(view.contains(detection));
+        }
+        // The mean direction is 1.74° (the third detection pulls it); the widest detection lies
+        // 21.74° from it, so with the margin of 5.73° the sector runs from −25.7° to 29.2°.
+        assert!(at(29.0, 20.0) && at(-25.5, 20.0));
+        assert!(!at(29.5, 20.0) && !at(-26.0, 20.0) && !at(180.0, 20.0));
+        assert!(at(0.0, 54.9) && !at(0.0, 55.1));
+        // Detections all around: every direction, out to the farthest.
+        let around = [DVec2::X, -DVec2::X, DVec2::Y, -DVec2::Y].map(|d| origin + d * 10.0);
+        let view = FieldOfView::spanning(origin, around.iter().copied(), 0.0, 0.0).unwrap();
+        assert!(view.contains(origin + DVec2::new(-7.0, 7.0)) && !view.contains(origin + DVec2::X * 10.5));
+        assert!(FieldOfView::spanning(origin, core::iter::empty(), 0.1, 5.0).is_none());
     }
 
     #[test]

@@ -28,6 +28,15 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     return libm::sincos(x);
 }
 
+/// Arc cosine, radians in [0, π] (NaN outside [−1, 1]).
+#[inline(always)]
+pub fn acos(x: f64) -> f64 {
+    #[cfg(feature = "std")]
+    return x.acos();
+    #[cfg(not(feature = "std"))]
+    return libm::acos(x);
+}
+
 /// Square root.
 #[inline(always)]
 pub fn sqrt(x: f64) -> f64 {

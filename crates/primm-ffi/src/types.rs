@@ -441,8 +441,8 @@ pub struct PrimmStats {
     pub update_failures: u64,
     /// Calls to `primm_tracker_reset`.
     pub resets: u64,
-    /// Frames with a measurement whose sensor has no configured mount (or no sensor id): every
-    /// track counted as in view of that sensor.
+    /// Frames with a measurement whose sensor has no configured mount (or no sensor id): such a
+    /// radar is taken to look where its detections of the frame lie.
     pub frames_with_unknown_sensor: u64,
     /// Tracks merged into an older track of the same object.
     pub duplicate_tracks_merged: u64,

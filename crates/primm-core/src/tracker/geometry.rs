@@ -127,9 +127,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// The sensors that scanned in this frame, as its measurements name them, with their fields
     /// of view in the tracking frame. A measurement without a sensor id or of a sensor without a
-    /// configured mount marks the frame (every track then counts as in view).
+    /// configured mount marks the frame; such radars are taken to look where their detections lie
+    /// (`unknown_sensor_view`).
     pub(super) fn find_scanning_sensors(&mut self) {
         self.scanning_sensors.clear();
+        self.unknown_sensor_view = None;
         for index in 0..self.validated.len() {
             let Some(measurement) = self.validated.accepted(index) else { continue };
             let mount = measurement.sensor_id.and_then(|id| self.config.frame.sensor(id));
@@ -148,6 +150,27 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 clutter_density_factor: mount.clutter_density_factor,
             });
         }
+        if self.last_step.unknown_sensor {
+            self.unknown_sensor_view = self.unknown_sensor_view();
+        }
+    }
+
+    /// Where the frame's radars without a configured mount looked: the sector their detections
+    /// span, seen from the vehicle's reference point ([`FieldOfView::spanning`]).
+    fn unknown_sensor_view(&self) -> Option<FieldOfView> {
+        let frame = &self.config.frame;
+        let unknown = (0..self.validated.len()).filter_map(|index| {
+            let measurement = self.validated.accepted(index)?;
+            let mounted = measurement.sensor_id.and_then(|id| frame.sensor(id)).is_some();
+            (!mounted).then(|| measurement.position())
+        });
+        let origin_m = self.step_pose.map_or(DVec2::ZERO, |pose| pose.position());
+        FieldOfView::spanning(
+            origin_m,
+            unknown,
+            frame.unknown_sensor_margin_rad,
+            frame.unknown_sensor_margin_m,
+        )
     }
 
     /// Where the radar of every accepted measurement is, in the tracking frame: its mount,

@@ -150,6 +150,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// The fields of view of the sensors that scanned in the current frame, with their
     /// detection-probability and clutter-density factors.
     scanning_sensors: Box<ArrayVec<ScanningSensor, MAX_SENSORS>>,
+    /// Where the frame's radars without a configured mount looked, as their detections show it
+    /// (`None`: the frame had none).
+    unknown_sensor_view: Option<FieldOfView>,
     /// Each live track's fused state for the duplicate check, aligned with the table.
     duplicate_views: Box<[DuplicateView; MAX_TRACKS]>,
     /// Tracks merged into an older one in the current frame, aligned with the table.
@@ -208,6 +211,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
             accepted: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
             scanning_sensors: Box::new(ArrayVec::new()),
+            unknown_sensor_view: None,
             duplicate_views: Box::new([DuplicateView::default(); MAX_TRACKS]),
             merged: Box::new([false; MAX_TRACKS]),
             recorded: Box::new(RecordedFrame::new()),

@@ -69,8 +69,9 @@ pub struct TrackerStats {
     pub update_failures: u64,
     /// Calls to [`Tracker::reset`].
     pub resets: u64,
-    /// Frames with a measurement whose sensor has no configured mount (or no sensor id): every
-    /// track counted as in view of that sensor, so misses counted against existence.
+    /// Frames with a measurement whose sensor has no configured mount (or no sensor id): such a
+    /// radar is taken to look where its detections of the frame lie (`frame.unknown_sensor_*`),
+    /// and a track there that it missed loses existence.
     pub frames_with_unknown_sensor: u64,
     /// Tracks merged into an older track of the same object (`crate::duplicates`).
     pub duplicate_tracks_merged: u64,

@@ -168,7 +168,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     );
                     missed = true;
                 }
-                if self.last_step.unknown_sensor {
+                if self.unknown_sensor_view.is_some_and(|view| view.contains(prior_m)) {
                     let (detection, clutter) = self.detection_and_clutter(track.class, None);
                     existence_probability = existence::updated_existence(
                         existence_probability,
