@@ -963,7 +963,7 @@ mod tests {
         std::fs::write(dir.join("notes.txt"), "not a sequence").unwrap();
         let sequences = read_dataset_dir(&dir).unwrap();
         assert_eq!(sequences, vec![a, b]);
-        std::fs::write(dir.join("c_bad.csv"), format!("{HEADER}0,0,1,bus,1,2,3,4,,,,,,\n")).unwrap();
+        std::fs::write(dir.join("c_bad.csv"), format!("{HEADER}0,0,1,tram,1,2,3,4,,,,,,\n")).unwrap();
         let err = read_dataset_dir(&dir).unwrap_err();
         assert_eq!(err.path.as_deref(), Some(dir.join("c_bad.csv").as_path()));
         assert!(err.to_string().contains("c_bad.csv:line 2, column `class`"), "{err}");
