@@ -165,6 +165,28 @@ def fitted_errors(history, position_std, radial_std):
     return result
 
 
+def by_detections(rows, fits, wanted: str) -> list[dict]:
+    """RMSE along and across the line of sight of the tracker and of both fits, per bucket of
+    detections so far, over the `wanted` rows of tracks that began on the object's first
+    detection and where both fits are determined."""
+    names = ("tracker", "positions", "positions_and_radial_velocities")
+    buckets = []
+    for label, low, high in BUCKETS:
+        sums = {name: [0, 0.0, 0.0] for name in names}
+        for cls, key, k, from_first, errors in rows:
+            fitted = fits.get((key, k)) if cls == wanted and from_first and low <= k <= high else None
+            if not fitted or None in fitted.values():
+                continue
+            for name, (along, across) in zip(names, (errors, fitted["positions"], fitted["positions_and_radial_velocities"])):
+                sums[name][0] += 1
+                sums[name][1] += along
+                sums[name][2] += across
+        rmse = lambda total, n: math.sqrt(total / n) if n else float("nan")  # noqa: E731
+        buckets.append({"detections": label, "rows": sums["tracker"][0], **{
+            name: {"rmse_along_mps": rmse(a, n), "rmse_across_mps": rmse(c, n)} for name, (n, a, c) in sums.items()}})
+    return buckets
+
+
 def analyse(objects, rows, wanted: str, max_k: int, fit_from: int) -> dict:
     classes = {key: cls for cls, key, *_ in rows}
     position_std, radial_std = noise_of(objects, wanted, classes)
@@ -174,23 +196,7 @@ def analyse(objects, rows, wanted: str, max_k: int, fit_from: int) -> dict:
             continue
         for k in range(2, min(max_k, len(detections)) + 1):
             fits[(key, k)] = fitted_errors(detections[:k], position_std, radial_std)
-    buckets = []
-    for label, low, high in BUCKETS:
-        sums = {"tracker": [0, 0.0, 0.0], "positions": [0, 0.0, 0.0], "positions_and_radial_velocities": [0, 0.0, 0.0]}
-        for cls, key, k, from_first, (along, across) in rows:
-            if cls != wanted or not from_first or not low <= k <= high:
-                continue
-            fitted = fits.get((key, k))
-            if fitted is None or fitted["positions_and_radial_velocities"] is None or fitted["positions"] is None:
-                continue
-            for name, (a, c) in (("tracker", (along, across)), ("positions", fitted["positions"]),
-                                 ("positions_and_radial_velocities", fitted["positions_and_radial_velocities"])):
-                sums[name][0] += 1
-                sums[name][1] += a
-                sums[name][2] += c
-        buckets.append({"detections": label, "rows": sums["tracker"][0], **{
-            name: {"rmse_along_mps": math.sqrt(a / n) if n else float("nan"), "rmse_across_mps": math.sqrt(c / n) if n else float("nan")}
-            for name, (n, a, c) in sums.items()}})
+    buckets = by_detections(rows, fits, wanted)
     total = oracle = replaced = 0.0
     for cls, key, k, from_first, (along, across) in rows:
         fitted = fits.get((key, k)) if cls == wanted and from_first else None
