@@ -118,8 +118,10 @@ fn bench_association(c: &mut Criterion) {
     for n in SIZES {
         let (tracks, priors, frame, accepted) = association_scene(n);
         let mut associator = Associator::new();
-        let sensors =
-            vec![primm_core::sensor_noise::MeasurementSensor::unknown(glam::DVec2::ZERO); accepted.len()];
+        let sensors = vec![
+            primm_core::sensor_noise::MeasurementSensor::unknown(glam::DVec2::ZERO, 0.5);
+            accepted.len()
+        ];
         let mut track_to_measurement = vec![None; n];
         group.bench_function(BenchmarkId::new("clustered", n), |bencher| {
             bencher.iter(|| {

@@ -92,16 +92,19 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
         range_std_m: 0.2,
         azimuth_std_rad: 0.03,
         azimuth_std_max_factor: 2.0,
+        reflection: primm_core::sensor::ReflectionModel::Outline,
         ..CoordinatesConfig::default().sensors[0]
     };
     let noise = SensorNoise::of(&mount, None);
     scene.sensors = (0..measurement_count)
         .map(|j| match j % 2 {
-            0 => MeasurementSensor::unknown(DVec2::ZERO),
+            0 => MeasurementSensor::unknown(DVec2::ZERO, 0.5),
             _ => MeasurementSensor {
                 position_m: mount.position(),
                 mounted: true,
                 noise_m2: noise.covariance_m2(scene.frame.measurements[j].position() - mount.position()),
+                slot: 0,
+                reflection_scale: 0.5,
             },
         })
         .collect();
@@ -366,5 +369,5 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
 
 /// Sensors at the reference point, without mounts (the costs here treat every class as a point).
 fn sensors(accepted: &[bool]) -> Vec<MeasurementSensor> {
-    vec![MeasurementSensor::unknown(glam::DVec2::ZERO); accepted.len()]
+    vec![MeasurementSensor::unknown(glam::DVec2::ZERO, 0.5); accepted.len()]
 }

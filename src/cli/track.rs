@@ -162,6 +162,10 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         stats.tracks_deleted,
         args.output.display()
     );
+    let sensors = tracker.sensors().report(tracker.config()).to_string();
+    if !sensors.is_empty() {
+        eprintln!("sensors (estimated from the data):\n{sensors}");
+    }
     Ok(())
 }
 

@@ -144,22 +144,32 @@ const HEADING_STD_BOX_RAD: f64 = 0.6;
 const HEADING_STD_DISC_RAD: f64 = 1.0;
 
 /// The expected reflection of an object of `extent` with prior `object`, seen by a sensor at
-/// `sensor_m` (all in one frame); see the module documentation for the box and disc models.
+/// `sensor_m` (all in one frame), for a sensor whose detections lie `scale` of the way from the
+/// centre (0) to the outline (1): the outline's offset and spread, scaled (the sensor's
+/// measurement model, `crate::sensor`; see the module documentation for the box and disc
+/// models). At scale 0, a point.
 pub fn expected_reflection(
     extent: &ExtentConfig,
     object: &ObjectPrior,
     sensor_m: DVec2,
+    scale: f64,
 ) -> ExpectedReflection {
-    let reflection = on_the_outline(extent, object, sensor_m);
-    let scale = extent.offset_scale;
+    if !(scale > 0.0) {
+        return ExpectedReflection::POINT;
+    }
+    let reflection = outline_reflection(extent, object, sensor_m);
     ExpectedReflection {
         offset_m: reflection.offset_m * scale,
         covariance_m2: reflection.covariance_m2 * (scale * scale),
     }
 }
 
-/// [`expected_reflection`] on the outline itself (`offset_scale` 1).
-fn on_the_outline(extent: &ExtentConfig, object: &ObjectPrior, sensor_m: DVec2) -> ExpectedReflection {
+/// [`expected_reflection`] on the outline itself (scale 1).
+pub fn outline_reflection(
+    extent: &ExtentConfig,
+    object: &ObjectPrior,
+    sensor_m: DVec2,
+) -> ExpectedReflection {
     let to_sensor = sensor_m - object.centre_m;
     let range = to_sensor.length();
     if !(range > 1e-6) {

@@ -72,6 +72,7 @@ pub mod predictor;
 pub mod readable_number;
 mod recorded_frame;
 mod replay;
+pub mod sensor;
 pub mod sensor_noise;
 pub mod stage_timing;
 pub mod track;

@@ -665,6 +665,18 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             c.publish_failures,
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
+            + &sensor_lines(&self.tracker)
+    }
+}
+
+/// The sensors' estimates for the summary, one line each after a newline (nothing before any
+/// sensor took a sample).
+fn sensor_lines<P: DisplacementPredictor>(tracker: &Tracker<P>) -> String {
+    let report = tracker.sensors().report(tracker.config()).to_string();
+    if report.is_empty() {
+        report
+    } else {
+        format!("\nsensors (estimated from the data):\n{report}")
     }
 }
 

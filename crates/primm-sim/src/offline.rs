@@ -32,7 +32,8 @@ pub enum OfflineError {
     },
 }
 
-/// Tracks `sequence` from scratch with `tracker` (which is [`reset`](Tracker::reset) first) and
+/// Tracks `sequence` from scratch with `tracker` (which is [`reset`](Tracker::reset) first, its
+/// sensors' estimates back at their priors: [`Tracker::forget_sensors`]) and
 /// calls `on_frame` with every recorded frame and the tracker's outputs for it.
 pub fn track_sequence<P: DisplacementPredictor>(
     tracker: &mut Tracker<P>,
@@ -40,6 +41,7 @@ pub fn track_sequence<P: DisplacementPredictor>(
     mut on_frame: impl FnMut(&RecordedFrame, &[TrackOutput]),
 ) -> Result<(), OfflineError> {
     tracker.reset();
+    tracker.forget_sensors();
     let mut frame = Frame::default();
     for recorded in &sequence.frames {
         frame.timestamp_s = recorded.timestamp_s;

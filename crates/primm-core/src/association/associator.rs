@@ -265,9 +265,10 @@ impl Associator {
             if let Some(index) = track_to_measurement[usize::from(track_index)] {
                 self.taken[usize::from(index)] = true;
                 if extended {
-                    let sensor = sensors[usize::from(index)].position_m;
-                    self.assigned_reflections[usize::from(track_index)] =
-                        self.row_reflections[r].find(sensor).map(|entry| entry.reflection);
+                    let sensor = &sensors[usize::from(index)];
+                    self.assigned_reflections[usize::from(track_index)] = self.row_reflections[r]
+                        .find(sensor.position_m, sensor.reflection_scale)
+                        .map(|entry| entry.reflection);
                 }
             }
         }
@@ -321,9 +322,9 @@ impl Associator {
                 };
                 let expected = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        let sensor = sensors[index].position_m;
-                        let entry = self.row_reflections[r].get(sensor, || RowReflection {
-                            reflection: expected_reflection(extent, object, sensor),
+                        let (sensor, scale) = (sensors[index].position_m, sensors[index].reflection_scale);
+                        let entry = self.row_reflections[r].get(sensor, scale, || RowReflection {
+                            reflection: expected_reflection(extent, object, sensor, scale),
                             prepared: None,
                         });
                         centre + entry.reflection.offset_m
@@ -534,8 +535,9 @@ fn likelihood_pair_cost(
     let own_noise = sensor.noise_m2 != glam::DMat2::ZERO;
     match extended {
         Some((extent, object)) => {
-            let entry = memo.get(sensor.position_m, || {
-                let reflection = expected_reflection(extent, object, sensor.position_m);
+            let entry = memo.get(sensor.position_m, sensor.reflection_scale, || {
+                let reflection =
+                    expected_reflection(extent, object, sensor.position_m, sensor.reflection_scale);
                 RowReflection { reflection, prepared: prepared.prepare_reflection(&reflection) }
             });
             if own_noise {

@@ -133,10 +133,16 @@ impl ModeModels {
     }
 
     /// Where the reflection of a track of this class is expected (a point class: no offset, no
-    /// spread), for its fused prior `object` and a sensor at `sensor_position_m`.
-    pub fn expected_reflection(&self, object: &ObjectPrior, sensor_position_m: DVec2) -> ExpectedReflection {
+    /// spread), for its fused prior `object` and a sensor at `sensor_position_m` whose
+    /// measurement model scales the outline offset by `scale`.
+    pub fn expected_reflection(
+        &self,
+        object: &ObjectPrior,
+        sensor_position_m: DVec2,
+        scale: f64,
+    ) -> ExpectedReflection {
         match &self.extent {
-            Some(extent) => crate::extent::expected_reflection(extent, object, sensor_position_m),
+            Some(extent) => crate::extent::expected_reflection(extent, object, sensor_position_m, scale),
             None => ExpectedReflection::POINT,
         }
     }

@@ -120,6 +120,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         before.last_pose = self.last_pose;
         before.ego_motion = self.ego_motion;
         before.stats = self.stats;
+        before.sensors = Some(*self.sensors);
     }
 
     /// Puts the tracker back into the state saved in ring slot `slot`.
@@ -131,6 +132,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.last_pose = before.last_pose;
         self.ego_motion = before.ego_motion;
         self.stats.restore_tracked_counts(&before.stats);
+        if let Some(sensors) = &before.sensors {
+            *self.sensors = *sensors;
+        }
     }
 
     /// Tracks the recorded frame; counts what it did into [`last_step`](Self::last_step) and

@@ -26,9 +26,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 self.last_step.detections_absorbed += 1;
                 continue;
             }
-            let sensor_position_m = self.sensor_position(&measurement);
             // Where the history's line of sight starts: the radial-velocity row's radar position.
             let sensor = self.measurement_sensors[index];
+            if !sensor.mounted && self.step_pose.is_some() {
+                self.last_step.initiations_from_unknown_sensor += 1;
+            }
             let line_of_sight_origin = sensor.position_m;
             let models = &self.models[measurement.class.index()];
             // An extended object starts at the centre behind its reflection (no heading yet:
@@ -37,7 +39,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if models.extent.is_some() {
                 let standing =
                     crate::extent::ObjectPrior { centre_m: measurement.position(), ..Default::default() };
-                reflection = models.expected_reflection(&standing, sensor.position_m);
+                reflection =
+                    models.expected_reflection(&standing, sensor.position_m, sensor.reflection_scale);
                 (centre.x_m, centre.y_m) =
                     (measurement.x_m - reflection.offset_m.x, measurement.y_m - reflection.offset_m.y);
                 if !sensor.mounted {
@@ -48,7 +51,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let mut estimate = imms[measurement.class.index()].initiate_seen_from(
                 &self.models[measurement.class.index()],
                 &centre,
-                sensor_position_m,
+                sensor.position_m,
             );
             // The radar's own noise spreads the start as it spreads every update.
             estimate.add_position_covariance(&crate::gaussian::to_nalgebra(
@@ -63,6 +66,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 Track::new(id, &measurement, line_of_sight_origin, t, estimate, initial_existence)
             }) {
                 Ok(track) => {
+                    track.birth_sensor_slot = sensor.slot;
                     self.last_step.initiated += 1;
                     // A confirmation threshold of one hit (or an initial existence at the
                     // threshold) confirms at once.
@@ -108,6 +112,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// `tentative_max_misses` misses and confirmed ones after `confirmed_max_misses`.
     pub(super) fn delete(&mut self, t: f64) {
         let lifecycle = &self.config.tracker;
+        let mut false_tracks =
+            [(crate::measurement::ObjectClass::Car, 0u8, 0u32); crate::track_table::MAX_TRACKS];
+        let mut false_count = 0;
         let deleted = retain_with_rows(&mut self.table, &mut self.rows[..], |_, track| {
             let (max_misses, max_coast_s) = if track.status.is_confirmed() {
                 (lifecycle.confirmed_max_misses, lifecycle.max_coast_s)
@@ -120,8 +127,16 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     track.existence_probability >= lifecycle.deletion_existence_probability
                 }
             };
-            alive && t - track.last_update_s <= max_coast_s
+            let kept = alive && t - track.last_update_s <= max_coast_s;
+            if !kept && super::sensors::was_false(track) {
+                false_tracks[false_count] = (track.class, track.birth_sensor_slot, track.hits);
+                false_count += 1;
+            }
+            kept
         });
+        for &(class, slot, hits) in &false_tracks[..false_count] {
+            self.learn_false_track(class, slot, hits);
+        }
         self.last_step.deleted = deleted;
     }
 

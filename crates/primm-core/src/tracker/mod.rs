@@ -24,6 +24,7 @@ use crate::pose::{EgoMotion, EgoPose};
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::recorded_frame::RecordedFrame;
 use crate::replay::ReplayRing;
+use crate::sensor::SensorSet;
 use crate::sensor_noise::MeasurementSensor;
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput};
@@ -41,6 +42,7 @@ mod late_frames;
 mod lifecycle;
 mod output;
 mod predict;
+mod sensors;
 mod stats;
 mod update;
 mod validate;
@@ -80,17 +82,13 @@ struct RowRecord {
 const EMPTY_ROW: RowRecord =
     RowRecord { prior_position_m: None, available: ModeSet::EMPTY, measurement_index: None };
 
-/// A sensor that scanned in the current frame, in the tracking frame.
+/// A sensor that scanned in the current frame: its slot in the [`SensorSet`] and its field of
+/// view in the tracking frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct ScanningSensor {
-    id: u16,
+    slot: usize,
     field_of_view: FieldOfView,
-    detection_probability_factor: f64,
-    clutter_density_factor: f64,
 }
-
-/// The detection probabilities are kept below 1, so that a miss never makes existence 0.
-const MAX_DETECTION_PROBABILITY: f64 = 0.999;
 
 /// The PR-IMM multi-object tracker with a learned-displacement predictor `P`.
 #[derive(Debug)]
@@ -117,6 +115,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     last_pose: Option<EgoPose>,
     /// When `last_pose` was taken and the ego's velocity over ground that the poses give.
     ego_motion: EgoMotion,
+    /// Every sensor: its mount, measurement model and what its data said so far.
+    sensors: Box<SensorSet>,
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
     /// The table row of each request's track (`predictor.classes` may leave tracks out).
@@ -142,6 +142,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// mount; the vehicle's reference point when it has none), whether it had a mount, and the
     /// detection's covariance from the radar's own noise (`crate::sensor_noise`).
     measurement_sensors: Box<[MeasurementSensor; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// Whether each track was confirmed (or coasting) before the current frame's update.
+    was_confirmed: Box<[bool; MAX_TRACKS]>,
     /// Each track's update outcome of the current frame.
     update_outcomes: Box<[track_loops::UpdateOutcome; MAX_TRACKS]>,
     rows: Box<[RowRecord; MAX_TRACKS]>,
@@ -182,6 +184,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             imms: track_loops::class_imms(&config),
             compensated_imms: track_loops::class_compensated_imms(&config),
             models: ObjectClass::ALL.map(|class| ModeModels::from_config(config.classes.get(class))),
+            sensors: Box::new(sensor_set(&config)),
             config,
             predictor,
             table: TrackTable::new(),
@@ -201,11 +204,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
             dt_s: 0.0,
             track_to_measurement: Box::new([None; MAX_TRACKS]),
             assigned_measurements: Box::new([None; MAX_TRACKS]),
-            assigned_sensors: Box::new([MeasurementSensor::unknown(DVec2::ZERO); MAX_TRACKS]),
+            assigned_sensors: Box::new([MeasurementSensor::unknown(DVec2::ZERO, 0.0); MAX_TRACKS]),
             assigned_reflections: Box::new([ExpectedReflection::POINT; MAX_TRACKS]),
             measurement_sensors: Box::new(
-                [MeasurementSensor::unknown(DVec2::ZERO); MAX_MEASUREMENTS_PER_FRAME],
+                [MeasurementSensor::unknown(DVec2::ZERO, 0.0); MAX_MEASUREMENTS_PER_FRAME],
             ),
+            was_confirmed: Box::new([false; MAX_TRACKS]),
             update_outcomes: Box::new([Ok(None); MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
@@ -283,6 +287,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         observer.stage_finished(Stage::Associate);
         self.update(t);
         self.coast();
+        self.learn_sensors();
         self.initiate(t);
         self.delete(t);
         self.merge_duplicates();
@@ -304,6 +309,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.step_pose = None;
         self.last_step = StepSummary::default();
         self.stats.resets += 1;
+    }
+
+    /// Puts every sensor's estimates back at their priors (the configured values), e.g. before
+    /// tracking a recording of another vehicle. [`reset`](Self::reset) keeps them: a gap in the
+    /// stream does not change the radars.
+    pub fn forget_sensors(&mut self) {
+        *self.sensors = sensor_set(&self.config);
+        self.ring.clear();
     }
 
     /// What the associator did in the last association: allowed pairs, clusters paired
@@ -340,6 +353,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.table.tracks()
     }
 
+    /// Every sensor with what its data said so far (`crate::sensor`).
+    pub fn sensors(&self) -> &SensorSet {
+        &self.sensors
+    }
+
     /// The configuration.
     pub fn config(&self) -> &Config {
         &self.config
@@ -373,6 +391,15 @@ fn retain_with_rows(
         read += 1;
         kept
     })
+}
+
+/// The sensors of `config` at their priors.
+fn sensor_set(config: &Config) -> SensorSet {
+    let classes = ObjectClass::ALL.map(|class| {
+        let section = config.classes.get(class);
+        (&section.extent, &section.existence)
+    });
+    SensorSet::new(&config.frame, &classes)
 }
 
 /// Whether a tentative `track` has earned confirmation under the configured lifecycle.

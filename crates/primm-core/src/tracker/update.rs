@@ -9,9 +9,10 @@ use crate::imm::ImmState;
 use crate::measurement::FrameView;
 use crate::measurement::ObjectClass;
 use crate::predictor::DisplacementPredictor;
+use crate::sensor::UNMOUNTED;
+use crate::sensor_noise::MeasurementSensor;
 use crate::track::TrackStatus;
 use crate::track_loops;
-use glam::DVec2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
     /// Per-class gated optimal assignment (`eq:association_cost`).
@@ -29,15 +30,15 @@ impl<P: DisplacementPredictor> Tracker<P> {
         Ok(())
     }
 
-    /// The expected reflection of track `i`'s object for a sensor at `sensor_m` (a point class:
-    /// none).
-    pub(super) fn expected_reflection(&self, i: usize, sensor_m: DVec2) -> ExpectedReflection {
+    /// The expected reflection of track `i`'s object for a measurement of `sensor` (a point
+    /// class: none).
+    pub(super) fn expected_reflection(&self, i: usize, sensor: &MeasurementSensor) -> ExpectedReflection {
         let class = self.table.tracks()[i].class;
         let models = &self.models[class.index()];
         match models.extent {
             Some(_) => {
                 let prior = &self.priors[i];
-                models.expected_reflection(&prior.object_prior(), sensor_m)
+                models.expected_reflection(&prior.object_prior(), sensor.position_m, sensor.reflection_scale)
             }
             None => ExpectedReflection::POINT,
         }
@@ -63,7 +64,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let reflection = self
                 .associator
                 .assigned_reflection(i)
-                .unwrap_or_else(|| self.expected_reflection(i, sensor.position_m));
+                .unwrap_or_else(|| self.expected_reflection(i, &sensor));
             self.assigned_reflections[i] = reflection;
             let models = &self.models[measurement.class.index()];
             if !sensor.mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
@@ -85,6 +86,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// Kalman and mode-probability update of every assigned track.
     pub(super) fn update(&mut self, t: f64) {
         let count = self.table.len();
+        for (was_confirmed, track) in self.was_confirmed.iter_mut().zip(self.table.tracks()) {
+            *was_confirmed = track.status.is_confirmed();
+        }
         self.read_assignment();
         track_loops::update(
             super::step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms),
@@ -113,15 +117,21 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }
                 let class = self.table.tracks()[i].class;
                 self.bound_speed(i, class);
-                let (detection, clutter) = self.detection_and_clutter(class, measurement.sensor_id);
+                let sensor = self.assigned_sensors[i];
+                let (detection, clutter) = self.detection_and_clutter(class, usize::from(sensor.slot));
                 let reflection = self.assigned_reflections[i];
                 let prior = &self.priors[i].fused;
-                let likelihood = existence::gaussian_density_per_m2(
-                    measurement.position() - reflection.offset_m - prior.mean,
-                    prior.covariance
-                        + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2)
-                        + reflection.covariance_m2
-                        + self.assigned_sensors[i].noise_m2,
+                let innovation_m = measurement.position() - reflection.offset_m - prior.mean;
+                let innovation_covariance_m2 = prior.covariance
+                    + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2)
+                    + reflection.covariance_m2
+                    + sensor.noise_m2;
+                let likelihood = existence::gaussian_density_per_m2(innovation_m, innovation_covariance_m2);
+                self.learn_reflection(
+                    i,
+                    &sensor,
+                    innovation_m,
+                    0.5 * (innovation_covariance_m2.x_axis.x + innovation_covariance_m2.y_axis.y),
                 );
                 let tracker = &self.config.tracker;
                 let track = &mut self.table.tracks_mut()[i];
@@ -159,7 +169,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 let mut missed = false;
                 let prior_m = self.priors[i].fused.mean;
                 for sensor in self.scanning_sensors.iter().filter(|s| s.field_of_view.contains(prior_m)) {
-                    let (detection, clutter) = self.detection_and_clutter(track.class, Some(sensor.id));
+                    let (detection, clutter) = self.detection_and_clutter(track.class, sensor.slot);
                     existence_probability = existence::updated_existence(
                         existence_probability,
                         Evidence::MissedInView,
@@ -169,7 +179,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     missed = true;
                 }
                 if self.unknown_sensor_view.is_some_and(|view| view.contains(prior_m)) {
-                    let (detection, clutter) = self.detection_and_clutter(track.class, None);
+                    let (detection, clutter) = self.detection_and_clutter(track.class, UNMOUNTED);
                     existence_probability = existence::updated_existence(
                         existence_probability,
                         Evidence::MissedInView,

@@ -83,6 +83,7 @@ impl TryFrom<RadarMountFields> for RadarMount {
             range_std_m: 0.0,
             azimuth_std_rad: 0.0,
             azimuth_std_max_factor: 1.0,
+            reflection: primm_core::sensor::ReflectionModel::Outline,
         };
         Ok(RadarMount {
             layout,
@@ -133,6 +134,7 @@ fn layout_in_degrees(
         range_std_m: 0.0,
         azimuth_std_rad: 0.0,
         azimuth_std_max_factor: 1.0,
+        reflection: primm_core::sensor::ReflectionModel::Outline,
     }
 }
 
@@ -156,6 +158,7 @@ impl RadarMount {
                     range_std_m: 0.0,
                     azimuth_std_rad: 0.0,
                     azimuth_std_max_factor: 1.0,
+                    reflection: primm_core::sensor::ReflectionModel::Outline,
                     ..layout
                 },
                 azimuth_bias_deg,
