@@ -51,6 +51,7 @@ mod process_noise;
 mod radial_velocity_update;
 mod scenario;
 mod sensor_layout;
+mod sensor_models;
 mod sensor_noise;
 mod service_allocation;
 mod service_faults;

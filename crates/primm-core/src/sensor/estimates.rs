@@ -183,19 +183,20 @@ impl ReflectionEstimate {
 }
 
 /// How often a sensor detects an object of a class in its field of view: detections of
-/// confirmed tracks over opportunities (confirmed tracks in view of the scanning sensor), with
-/// the configured probability as `detection_prior_samples` opportunities of prior:
-/// `p = (n₀ p₀ + hits) / (n₀ + opportunities)`, both counts scaled down together beyond the
-/// window.
+/// confirmed tracks over opportunities (confirmed tracks in view of the scanning sensor). The
+/// configured probability enters as `detection_prior_samples` pseudo-opportunities with that
+/// rate, `p = (n₀ p₀ + hits) / (n₀ + opportunities)`; beyond the window both counts, the prior's
+/// included, are scaled down together, so the prior is forgotten like any old sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DetectionEstimate {
     /// The configured probability (the prior).
     pub prior: f64,
-    /// Opportunities, within the window.
+    /// Opportunities, the prior's pseudo-opportunities included, within the window (0 before
+    /// the first).
     pub opportunities: f64,
     /// Detections among them.
     pub detections: f64,
-    /// Opportunities taken in all (not scaled down).
+    /// Opportunities taken in all.
     pub samples: u64,
     /// Times the estimate lay outside its bounds and was held at them.
     pub bounded: u64,
@@ -208,25 +209,29 @@ impl DetectionEstimate {
     }
 
     /// The estimate, within [`DETECTION_BOUNDS`].
-    pub fn value(&self, config: &EstimationConfig) -> f64 {
-        let n0 = config.detection_prior_samples;
-        let raw = (n0 * self.prior + self.detections) / (n0 + self.opportunities);
-        raw.clamp(DETECTION_BOUNDS.0, DETECTION_BOUNDS.1)
+    pub fn value(&self, _config: &EstimationConfig) -> f64 {
+        if !(self.opportunities > 0.0) {
+            return self.prior;
+        }
+        (self.detections / self.opportunities).clamp(DETECTION_BOUNDS.0, DETECTION_BOUNDS.1)
     }
 
     /// Takes one opportunity: a confirmed track in view, `detected` or not.
     pub fn observe(&mut self, config: &EstimationConfig, detected: bool) {
+        if self.samples == 0 {
+            self.opportunities = config.detection_prior_samples;
+            self.detections = config.detection_prior_samples * self.prior;
+        }
         self.opportunities += 1.0;
         self.detections += f64::from(u8::from(detected));
         self.samples += 1;
-        let window = config.existence_window_samples;
+        let window = config.existence_window_samples.max(config.detection_prior_samples);
         if self.opportunities > window {
             let scale = window / self.opportunities;
             self.opportunities = window;
             self.detections *= scale;
         }
-        let n0 = config.detection_prior_samples;
-        let raw = (n0 * self.prior + self.detections) / (n0 + self.opportunities);
+        let raw = self.detections / self.opportunities;
         if !(DETECTION_BOUNDS.0..=DETECTION_BOUNDS.1).contains(&raw) {
             self.bounded += 1;
         }
@@ -235,18 +240,17 @@ impl DetectionEstimate {
 
 /// How much clutter a sensor reports of a class, per scan and square metre of its field of
 /// view: the detections that started tracks which ended without being confirmed, over the
-/// scans' field-of-view areas, with the configured density as `clutter_prior_scans` scans of
-/// prior: `λ = (E₀ λ₀ + false detections) / (E₀ + Σ areas)`, `E₀` the prior scans times the
-/// latest scan's area.
+/// scans' field-of-view areas. The configured density enters as `clutter_prior_scans`
+/// pseudo-scans of the first scan's area at that density, `λ = (E₀ λ₀ + false detections) /
+/// (E₀ + Σ areas)`; beyond the window, exposure and count, the prior's included, are scaled down
+/// together.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClutterEstimate {
     /// The configured density (the prior), 1/m².
     pub prior_per_m2: f64,
-    /// The area of the sensor's latest scan, m².
-    pub scan_area_m2: f64,
-    /// Sum of the scans' areas within the window, m².
+    /// Sum of the scans' areas within the window, the prior's pseudo-scans included, m².
     pub exposure_m2: f64,
-    /// False detections within the window.
+    /// False detections within the window, the prior's included.
     pub false_detections: f64,
     /// Scans taken in all.
     pub scans: u64,
@@ -257,25 +261,15 @@ pub struct ClutterEstimate {
 impl ClutterEstimate {
     /// The estimate at its prior.
     pub fn new(prior_per_m2: f64) -> Self {
-        ClutterEstimate {
-            prior_per_m2,
-            scan_area_m2: 0.0,
-            exposure_m2: 0.0,
-            false_detections: 0.0,
-            scans: 0,
-            bounded: 0,
-        }
+        ClutterEstimate { prior_per_m2, exposure_m2: 0.0, false_detections: 0.0, scans: 0, bounded: 0 }
     }
 
     /// The estimate, 1/m², within [`CLUTTER_BOUNDS_PER_M2`].
-    pub fn value_per_m2(&self, config: &EstimationConfig) -> f64 {
-        let prior_exposure = config.clutter_prior_scans * self.scan_area_m2;
-        if !(prior_exposure + self.exposure_m2 > 0.0) {
+    pub fn value_per_m2(&self, _config: &EstimationConfig) -> f64 {
+        if !(self.exposure_m2 > 0.0) {
             return self.prior_per_m2;
         }
-        let raw = (prior_exposure * self.prior_per_m2 + self.false_detections)
-            / (prior_exposure + self.exposure_m2);
-        raw.clamp(CLUTTER_BOUNDS_PER_M2.0, CLUTTER_BOUNDS_PER_M2.1)
+        (self.false_detections / self.exposure_m2).clamp(CLUTTER_BOUNDS_PER_M2.0, CLUTTER_BOUNDS_PER_M2.1)
     }
 
     /// Takes one scan of the sensor over `area_m2`.
@@ -283,10 +277,13 @@ impl ClutterEstimate {
         if !(area_m2 > 0.0 && area_m2.is_finite()) {
             return;
         }
-        self.scan_area_m2 = area_m2;
+        if self.scans == 0 {
+            self.exposure_m2 = config.clutter_prior_scans * area_m2;
+            self.false_detections = self.exposure_m2 * self.prior_per_m2;
+        }
         self.exposure_m2 += area_m2;
         self.scans += 1;
-        let window = config.existence_window_samples * area_m2;
+        let window = config.existence_window_samples.max(config.clutter_prior_scans) * area_m2;
         if self.exposure_m2 > window {
             let scale = window / self.exposure_m2;
             self.exposure_m2 = window;
@@ -295,15 +292,14 @@ impl ClutterEstimate {
     }
 
     /// Takes `count` detections found to be false (a tentative track ended unconfirmed).
-    pub fn observe_false(&mut self, config: &EstimationConfig, count: u32) {
+    pub fn observe_false(&mut self, _config: &EstimationConfig, count: u32) {
+        if !(self.exposure_m2 > 0.0) {
+            // No scan of the sensor yet to hold them against.
+            return;
+        }
         self.false_detections += f64::from(count);
-        let prior_exposure = config.clutter_prior_scans * self.scan_area_m2;
-        let total = prior_exposure + self.exposure_m2;
-        if total > 0.0 {
-            let raw = (prior_exposure * self.prior_per_m2 + self.false_detections) / total;
-            if raw > CLUTTER_BOUNDS_PER_M2.1 {
-                self.bounded += 1;
-            }
+        if self.false_detections / self.exposure_m2 > CLUTTER_BOUNDS_PER_M2.1 {
+            self.bounded += 1;
         }
     }
 }
