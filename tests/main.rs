@@ -19,6 +19,7 @@ mod assignment;
 mod assignment_allocation;
 mod association;
 mod class_imm;
+mod cli_late_frames;
 mod cli_offline;
 mod cli_soak;
 mod clutter_flood;
