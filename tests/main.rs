@@ -21,6 +21,7 @@ mod association;
 mod class_imm;
 mod cli_late_frames;
 mod cli_offline;
+mod cli_release;
 mod cli_soak;
 mod clutter_flood;
 mod crate_layout;
