@@ -399,8 +399,12 @@ size_t primm_last_error_message(char *buf, size_t len);
 // `two_wheeler`; a static string), or NULL for an unknown code.
 const char *primm_object_class_name(PrimmObjectClass class_code);
 
-// The class code of a class name (`car`, `pedestrian`, `two_wheeler`; NUL-terminated), or -1
-// for NULL or an unknown name.
+// The class code of a class label (NUL-terminated), or -1 for NULL or a label that names no
+// class. Accepts what `primm track` accepts in a measurement file: the class names (`car`,
+// `pedestrian`, `two_wheeler`) and other data sets' names of the same objects (`truck`, `bus`,
+// `person`, `bicycle`, `motorcycle`, ...), in any letter case, with `-` or a space for `_`,
+// surrounding white space ignored (`ObjectClass::from_label` of primm-core, one mapping for
+// both).
 //
 // # Safety
 // `name` is NULL or a NUL-terminated string.

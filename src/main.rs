@@ -1,6 +1,6 @@
 //! `primm`: command-line host of the PR-IMM tracker. Each subcommand lives in `src/cli/`.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 mod cli;
 
 use std::process::ExitCode;
@@ -40,6 +40,10 @@ enum Command {
     /// Relay the service's streams to other hosts through the iceoryx2 link tunnel over zenoh.
     #[cfg(feature = "tunnel")]
     Tunnel(cli::tunnel::Args),
+    /// Print the shell completion script (bash, elvish, fish, powershell, zsh).
+    Completions(cli::completions::Args),
+    /// Print the manual page, or write one page per subcommand into a directory.
+    Man(cli::man::Args),
 }
 
 /// Why a subcommand failed: its own error.
@@ -82,6 +86,12 @@ enum CommandError {
     #[cfg(feature = "tunnel")]
     #[error(transparent)]
     Tunnel(#[from] cli::tunnel::TunnelError),
+    /// `primm completions` failed.
+    #[error(transparent)]
+    Completions(#[from] cli::completions::CompletionsError),
+    /// `primm man` failed.
+    #[error(transparent)]
+    Man(#[from] cli::man::ManError),
 }
 
 fn main() -> ExitCode {
@@ -101,6 +111,8 @@ fn main() -> ExitCode {
         Command::LatencyPlot(args) => cli::latency_plot::run(&args).map_err(Into::into),
         #[cfg(feature = "tunnel")]
         Command::Tunnel(args) => cli::tunnel::run(&args).map_err(Into::into),
+        Command::Completions(args) => cli::completions::run(&args, Cli::command()).map_err(Into::into),
+        Command::Man(args) => cli::man::run(&args, Cli::command()).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

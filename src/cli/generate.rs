@@ -82,7 +82,14 @@ impl From<PresetChoice> for Preset {
 
 /// Arguments of `primm generate`.
 #[derive(Debug, Clone, ClapArgs)]
-#[command(about = "Generate simulated radar sequences (one CSV file per sequence in DIR/<split>/)")]
+#[command(
+    about = "Generate simulated radar sequences (one CSV file per sequence in DIR/<split>/)",
+    after_help = "\
+Examples:
+  primm generate --output data                                   # train, validation and evaluation splits
+  primm generate --output clutter --split evaluation --preset clutter
+  primm generate --output short --split evaluation --sequences 2 --duration-s 5"
+)]
 pub struct Args {
     /// Output directory; sequences go to DIR/train, DIR/validation and DIR/evaluation.
     #[arg(long, value_name = "DIR")]

@@ -3,11 +3,13 @@
 //! `primm subscribe` run the loops of the `primm-publisher` and `primm-subscriber` packages.
 
 pub mod bench_service;
+pub mod completions;
 pub mod demo;
 pub mod eval;
 pub mod generate;
 pub mod latency_out;
 pub mod latency_plot;
+pub mod man;
 pub mod score;
 pub mod serve;
 pub mod soak;

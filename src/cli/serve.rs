@@ -24,7 +24,12 @@ use std::time::Duration;
 /// Arguments of `primm serve`.
 #[derive(Debug, Clone, clap::Args)]
 #[command(
-    about = "Track frames from primm/measurements and publish primm/tracks and primm/latency over shared memory"
+    about = "Track frames from primm/measurements and publish primm/tracks and primm/latency over shared memory",
+    after_help = "\
+Examples:
+  primm serve --method imm                    # then: primm publish --scenario, primm subscribe
+  primm serve --method pr-imm --config my.toml
+  primm serve --method pr-imm --cpu-affinity 2 --inference-cpu-affinity 3 --realtime-priority 80 --lock-memory"
 )]
 pub struct Args {
     /// The tracker's configuration, model (run on dedicated inference threads with the

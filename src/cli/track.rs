@@ -14,7 +14,14 @@ use std::path::{Path, PathBuf};
 
 /// Arguments of `primm track`.
 #[derive(Debug, Clone, ClapArgs)]
-#[command(about = "Track a measurement CSV file offline and write the track CSV file")]
+#[command(
+    about = "Track a measurement CSV file offline and write the track CSV file",
+    after_help = "\
+Examples:
+  primm track --input data/evaluation/evaluation_0000.csv --output tracks.csv --method imm
+  primm track --input scene.csv --output tracks.csv --config my.toml --associations assoc.csv
+  primm track --input scene.csv --output tracks.csv --method pr-imm --timing steps.txt"
+)]
 pub struct Args {
     /// Measurement CSV file.
     #[arg(long, value_name = "FILE")]
@@ -112,8 +119,9 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
     let mut step_ns: Vec<u64> = Vec::with_capacity(frames.len());
     tracker.reset();
     // Frames in file order, which is arrival order: a late frame (within
-    // `tracker.max_frame_delay_s`) is tracked in its place and writes no rows of its own; one
-    // older than that is rejected, counted and skipped.
+    // `tracker.max_frame_delay_s`) is tracked in its place and writes the rows of the tracks as
+    // they were right after it (the rows of the newer frames, written when they came, stay);
+    // one older than that is rejected, counted and skipped.
     for (recorded, frame) in sequence.frames.iter().zip(&frames) {
         let start = std::time::Instant::now();
         match tracker.step(frame) {
@@ -125,10 +133,8 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
             Err(source) => return Err(TrackError::Step { frame: recorded.index, source }),
         };
         step_ns.push(start.elapsed().as_nanos() as u64);
-        if tracker.last_step().late {
-            continue;
-        }
-        let outputs = tracker.last_outputs();
+        let outputs =
+            if tracker.last_step().late { tracker.late_frame_outputs() } else { tracker.last_outputs() };
         writer.write_frame(recorded.index, recorded.timestamp_s, outputs)?;
         if let Some(associations) = associations.as_mut() {
             associations.write_frame(recorded.index, recorded.measurements.len(), outputs)?;

@@ -52,6 +52,7 @@
 extern crate alloc;
 
 pub mod association;
+pub mod class_label;
 pub mod config;
 pub mod coordinates;
 pub mod displacement_check;

@@ -77,7 +77,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let result = self.track_recorded(observer);
         let mut summary = self.last_step;
         let mut next = position;
+        self.late_outputs.clear();
         if result.is_ok() {
+            self.keep_late_outputs();
             core::mem::swap(&mut self.recorded, &mut self.ring.slot_mut(late).frame);
             self.ring.insert(late, position);
             self.stats.late_frames_tracked += 1;
@@ -104,6 +106,15 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.last_step = summary;
         self.count_live_tracks();
         result
+    }
+
+    /// The report of the late frame just tracked, into `late_outputs` (whose room was reserved
+    /// when the tracker was built).
+    fn keep_late_outputs(&mut self) {
+        let outputs = &mut self.late_outputs;
+        let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
+        let t = self.last_timestamp_s.unwrap_or(0.0);
+        super::report(&self.table, &self.rows[..], &self.imms, to_vehicle, t, |output| outputs.push(*output));
     }
 
     /// The newest tracked frame's time, s (0 before the first).

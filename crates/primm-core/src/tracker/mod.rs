@@ -166,6 +166,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// The recent frames and the state before each, for late frames.
     ring: ReplayRing,
     outputs: Box<ArrayVec<TrackOutput, MAX_TRACKS>>,
+    /// The outputs of the latest late frame right after it was tracked in its place, before
+    /// the newer frames were tracked again (room reserved only when late frames are on).
+    late_outputs: alloc::vec::Vec<TrackOutput>,
 }
 
 impl Tracker<NoPredictor> {
@@ -220,6 +223,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             merged: Box::new([false; MAX_TRACKS]),
             recorded: Box::new(RecordedFrame::new()),
             validated: Box::new(ValidatedFrame::new()),
+            late_outputs: alloc::vec::Vec::with_capacity(if ring.is_enabled() { MAX_TRACKS } else { 0 }),
             ring,
             outputs: Box::new(ArrayVec::new()),
         })
@@ -329,6 +333,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// [`step_into`](Self::step_into), which hands them to its sink instead).
     pub fn last_outputs(&self) -> &[TrackOutput] {
         &self.outputs
+    }
+
+    /// When the last step tracked a late frame in its place ([`StepSummary::late`]): the
+    /// outputs of every live track right after that frame, at its time and with
+    /// `measurement_index` into its measurements, as in-order arrival gives them after it
+    /// (before the newer frames were tracked again). Empty after any other step, and when the
+    /// late frame itself was refused.
+    pub fn late_frame_outputs(&self) -> &[TrackOutput] {
+        if self.last_step.late {
+            &self.late_outputs
+        } else {
+            &[]
+        }
     }
 
     /// The newest tracked frame's time, s: the time of the latest outputs (after a late frame
