@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Measures the figures of the reports' headline tables on the shipped defaults (config/primm.toml,
+# models/pr.onnx) and rewrites their results files (docs/results/release_*.csv) and the tables:
+#
+#   tools/release_figures.sh [--part evaluation|benchmarks|reliability]... [OUT_DIR]
+#
+# (default: every part, into out/release). One command for a release: run it on the release's
+# tree after the last change to the tracker, then commit docs/. Each results file records the
+# workspace's version and the commit measured (tools/check_release_figures.py, run by ./test.sh,
+# fails when the headline tables are of another version; with --strict also when the tracker's
+# sources changed since). The sources must be committed: the figures describe a commit.
+#
+# What it runs, in a release build:
+#   evaluation   primm generate --split evaluation --preset P, then primm eval --json, for the
+#                presets default, clutter_turning, extended and robustness (methods cv, imm,
+#                pr-imm; the default preset with every method, as tools/evaluate.sh)
+#   benchmarks   cargo bench --bench step_growth -- --counts 8,64,256, and primm bench-service
+#                --objects 64 --rate-hz 100 --duration-s 20 --find-max-rate for imm and pr-imm
+#   reliability  primm soak --objects 64 for imm (SOAK_FRAMES, default 200 000) and pr-imm
+#                (SOAK_FRAMES_PR_IMM, default 20 000); the service rows come from the benchmarks
+# Latencies depend on the host and on what else runs on it: run it on a quiet machine.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+parts=()
+out=out/release
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --part) parts+=("$2"); shift 2 ;;
+        -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
+        *) out=$1; shift ;;
+    esac
+done
+[ ${#parts[@]} -gt 0 ] || parts=(evaluation benchmarks reliability)
+wants() { [[ " ${parts[*]} " == *" $1 "* ]]; }
+
+# What the figures depend on (the benchmarks' own result files excepted: step_growth rewrites them).
+sources=(crates src config models Cargo.lock Cargo.toml publisher subscriber benches ':!benches/results')
+if [ -n "$(git status --porcelain -- "${sources[@]}")" ] && [ "${RELEASE_FIGURES_ALLOW_DIRTY:-0}" != 1 ]; then
+    echo "release_figures: uncommitted changes under ${sources[*]}; commit first (the figures name a commit)," >&2
+    echo "or set RELEASE_FIGURES_ALLOW_DIRTY=1 for a trial run (the files then say +uncommitted)" >&2
+    git status --short -- "${sources[@]}" >&2
+    exit 1
+fi
+commit=$(git rev-parse HEAD)
+release=$(python3 -c 'import tomllib; print(tomllib.load(open("Cargo.toml", "rb"))["workspace"]["package"]["version"])')
+mkdir -p "$out"
+echo "$(nproc) logical CPUs, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), load average $(cut -d' ' -f1 /proc/loadavg) at the start" > "$out/host.txt"
+
+started=$SECONDS
+step() { echo "release_figures: $* ($((SECONDS - started)) s)"; }
+cargo build --release --quiet --workspace --bins
+primm=target/release/primm
+
+if wants evaluation; then
+    mkdir -p "$out/evaluation"
+    for preset in default clutter_turning extended robustness; do
+        step "evaluation, preset $preset"
+        "$primm" generate --output "$out/data/$preset" --split evaluation --preset "$preset" >/dev/null
+        methods=cv,imm,pr-imm
+        [ "$preset" = default ] && methods=cv,ca,ct,pr,imm,pr-imm
+        "$primm" eval --data "$out/data/$preset/evaluation" --methods "$methods" \
+            --json "$out/evaluation/$preset.json" > "$out/evaluation/$preset.txt"
+    done
+fi
+
+if wants benchmarks; then
+    step "benchmarks: step_growth"
+    cargo bench --quiet --bench step_growth -- --counts 8,64,256 --frames 1000 > "$out/step_growth.txt"
+    cp benches/results/step_growth.json "$out/step_growth.json"
+    for method in imm pr-imm; do
+        step "benchmarks: bench-service $method"
+        rm -rf "$out/bench_service/$method"
+        "$primm" bench-service --method "$method" --objects 64 --rate-hz 100 --duration-s 20 \
+            --find-max-rate --trial-s 3 --steps 3 --latency-out "$out/bench_service/$method" > "$out/bench_service_$method.log" 2>&1
+    done
+fi
+
+if wants reliability; then
+    step "reliability: soak imm"
+    "$primm" soak --method imm --frames "${SOAK_FRAMES:-200000}" --objects 64 --seed 1 > "$out/soak_imm.txt"
+    step "reliability: soak pr-imm"
+    "$primm" soak --method pr-imm --frames "${SOAK_FRAMES_PR_IMM:-20000}" --objects 64 --seed 3 > "$out/soak_pr-imm.txt"
+fi
+
+[ -z "$(git status --porcelain -- "${sources[@]}")" ] || commit="$commit+uncommitted"
+step "tables"
+python3 tools/release_tables.py --measured "$out" --release "$release" --commit "$commit"
+python3 tools/doc_tables.py --write
+step "done: release $release, commit ${commit:0:10}"
