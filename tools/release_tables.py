@@ -35,9 +35,6 @@ COMMAND = "tools/release_figures.sh"
 
 PRESETS = ("default", "turning", "clutter", "clutter_turning", "extended", "robustness")
 METHOD_NAMES = {"cv": "CV", "ca": "CA", "ct": "CT", "pr": "PR", "imm": "IMM", "pr_imm": "PR-IMM", "pr-imm": "PR-IMM"}
-CLASSES = ("car", "pedestrian", "two-wheeler")
-MOTIONS = (("straight", "straight"), ("accel_decel", "accelerating / decelerating"),
-           ("left_right_turn", "turning"), ("nonlinear", "nonlinear"))
 
 # The targets the benchmarks are held to (docs/BENCHMARKS.md), as (limit, better): a measured value
 # meets its target when it is at most (better = "lower") or at least (better = "higher") the limit.
@@ -114,45 +111,12 @@ def evaluation_rows(measured: Measured, methods: tuple[str, ...]) -> list[list[s
     return rows
 
 
-def by_class_rows(document: dict) -> list[list[str]]:
-    methods = evaluated_methods(document)
-    rows = [["class"] + [f"{METHOD_NAMES[key]} RMSE_xy m / velocity RMSE m/s" for key in methods]]
-    for name in CLASSES:
-        cells = []
-        for key in methods:
-            method = document["methods"][key]
-            position = method["scenarios"].get(f"class_{name}", {}).get("rmse_xy")
-            velocity = ((method.get("velocity") or {}).get("by_class", {}).get(name) or {}).get("rmse_mps")
-            cells.append(f"{number(position, 3)} / {number(velocity, 3)}")
-        if any(cell != "– / –" for cell in cells):
-            rows.append([name] + cells)
-    return rows
-
-
-def motion_rows(document: dict) -> list[list[str]]:
-    methods = evaluated_methods(document)
-    rows = [["motion (object frames)"] + [METHOD_NAMES[key] for key in methods]]
-    for key, label in MOTIONS:
-        first = document["methods"][methods[0]]["scenarios"].get(key)
-        if first is None:
-            continue
-        cells = [number(document["methods"][m]["scenarios"][key]["rmse_xy"], 3) for m in methods]
-        rows.append([f"{label} ({thousands(first['gt_object_frames'])})"] + cells)
-    return rows
-
-
 def write_evaluation(measured: Measured, meta: dict) -> list[Path]:
     written = []
     headline = evaluation_rows(measured, ("cv", "imm", "pr_imm"))
     if len(headline) > 1:
         what = "primm eval on the evaluation split (22 sequences) of each preset, config/primm.toml and models/pr.onnx"
         written.append(write_csv("release_evaluation.csv", header(what=what, **meta), headline))
-    default = measured.evaluation("default")
-    if default is not None:
-        what = "primm eval, evaluation split of the default preset: RMSE by class"
-        written.append(write_csv("release_evaluation_by_class.csv", header(what=what, **meta), by_class_rows(default)))
-        what = "primm eval, evaluation split of the default preset: prior RMSE_xy by motion (the paper's Table III)"
-        written.append(write_csv("release_evaluation_by_motion.csv", header(what=what, **meta), motion_rows(default)))
     text = measured.path("evaluation/default.txt")
     if text is not None:
         what = "primm eval --data out/release/data/default/evaluation (the default preset's evaluation split)"
@@ -248,6 +212,10 @@ def benchmark_headline(step_growth: list[dict] | None, summaries: dict[str, dict
             rows.append([f"{METHOD_NAMES[method]} service, highest rate without a lost frame",
                          f"{summary['max_rate_hz']:.0f} Hz", target,
                          verdict(summary["max_rate_hz"], TARGET_PR_IMM_RATE_HZ, "higher") if target else ""])
+    if "imm" in summaries and "pr-imm" in summaries:
+        imm_p50 = summaries["imm"]["latency"]["receive_to_publish"]["p50"]
+        pr_imm_p50 = summaries["pr-imm"]["latency"]["receive_to_publish"]["p50"]
+        rows.append(["PR-IMM / IMM service, receive → publish (medians)", f"{pr_imm_p50 / imm_p50:.2f}×", "", ""])
     return rows
 
 
