@@ -21,8 +21,8 @@ SOAK = """soak report
   frames: 200000 (0 rejected), seed 1
   objects in view: 64 (8123 replaced after leaving the scene)
   resident set: 12.4 MiB at start, 12.6 MiB at end
-  step latency, first 10 %: p50 61.0 / p90 80.1 / p99 120.3 / max 900.2 µs (20000 frames)
-  step latency, last 10 %: p50 60.2 / p90 79.0 / p99 118.0 / max 850.0 µs (20000 frames)
+  step latency, first 10 %: p50 61.0 µs, p90 80.1 µs, p99 120.3 µs, max 900.2 µs (20000 frames)
+  step latency, last 10 %: p50 60.2 µs, p90 79.0 µs, p99 118.0 µs, max 850.0 µs (20000 frames)
   tracks: 420000 started, 419900 deleted, 80 live at the end, at most 91 live (bound 512)
   learned predictions: 0 missing, 0 rejected non-finite, 0 rejected implausible, 0 rejected for their covariance
   wall time: 14.2 s
