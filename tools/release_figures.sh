@@ -14,11 +14,14 @@
 #   evaluation   primm generate --split evaluation --preset P, then primm eval --json, for the
 #                six presets, default, turning, clutter, clutter_turning, extended and
 #                robustness (methods cv, imm, pr-imm; the default preset with every method)
-#   benchmarks   cargo bench --bench step_growth -- --counts 8,64,256, and primm bench-service
-#                --objects 64 --rate-hz 100 --duration-s 20 --find-max-rate for imm and pr-imm
+#   benchmarks   primm track --timing on every evaluation sequence of the default and robustness
+#                presets (imm and pr-imm), and primm bench-service --objects 64 --rate-hz 100
+#                --duration-s 20 --find-max-rate for imm and pr-imm
 #   reliability  primm soak --objects 64 --frames SOAK_FRAMES (default 200 000) for imm and
 #                pr-imm; the service rows come from the benchmarks
 # Latencies depend on the host and on what else runs on it: run it on a quiet machine.
+# Environment: SOAK_FRAMES (default 200000); PRIMM_BINARY (a primm binary built from this tree);
+# RELEASE_FIGURES_ALLOW_DIRTY=1 (a trial run on uncommitted sources, recorded as such).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,7 +30,7 @@ out=out/release
 while [ $# -gt 0 ]; do
     case "$1" in
         --part) parts+=("$2"); shift 2 ;;
-        -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
         *) out=$1; shift ;;
     esac
 done
@@ -49,8 +52,9 @@ echo "$(nproc) logical CPUs, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2
 
 started=$SECONDS
 step() { echo "release_figures: $* ($((SECONDS - started)) s)"; }
-cargo build --release --quiet --workspace --bins
-primm=target/release/primm
+# PRIMM_BINARY: a primm built from this same tree elsewhere (skips the build here).
+primm=${PRIMM_BINARY:-target/release/primm}
+[ -n "${PRIMM_BINARY:-}" ] || cargo build --release --quiet --workspace --bins
 
 if wants evaluation; then
     mkdir -p "$out/evaluation"
@@ -65,9 +69,21 @@ if wants evaluation; then
 fi
 
 if wants benchmarks; then
-    step "benchmarks: step_growth"
-    cargo bench --quiet --bench step_growth -- --counts 8,64,256 --frames 1000 > "$out/step_growth.txt"
-    cp benches/results/step_growth.json "$out/step_growth.json"
+    # The tracker's step on recorded sequences: every evaluation sequence of two presets through
+    # `primm track --timing` (offline: the PR model runs on the tracking thread), both methods.
+    mkdir -p "$out/timing"
+    for preset in default robustness; do
+        [ -d "$out/data/$preset/evaluation" ] ||
+            "$primm" generate --output "$out/data/$preset" --split evaluation --preset "$preset" >/dev/null
+        for method in imm pr-imm; do
+            step "benchmarks: primm track --timing, preset $preset, $method"
+            rm -f "$out/timing/$preset.$method.txt"
+            for sequence in "$out/data/$preset/evaluation"/*.csv; do
+                "$primm" track --input "$sequence" --output "$out/timing/tracks.csv" --method "$method" \
+                    --timing "$out/timing/$preset.$method.txt" >/dev/null 2>&1
+            done
+        done
+    done
     for method in imm pr-imm; do
         step "benchmarks: bench-service $method"
         rm -rf "$out/bench_service/$method"

@@ -12,7 +12,8 @@ What DIR holds (each part is optional; a results file is written for every part 
 
 * ``evaluation/PRESET.json``: ``primm eval --json`` on the evaluation split of a preset;
   ``evaluation/default.txt`` the text tables of the default preset;
-* ``step_growth.json``: ``cargo bench --bench step_growth`` (its benches/results/step_growth.json);
+* ``timing/PRESET.METHOD.txt``: ``primm track --timing`` over a preset's evaluation sequences
+  (one step time in ns per line);
 * ``bench_service/METHOD/summary.md``: ``primm bench-service``'s summary per method;
 * ``soak_METHOD.txt``: ``primm soak``'s report per method;
 * ``host.txt``: one line describing the machine.
@@ -25,6 +26,7 @@ import csv
 import datetime
 import io
 import json
+import math
 import re
 import sys
 from pathlib import Path
@@ -38,7 +40,6 @@ METHOD_NAMES = {"cv": "CV", "ca": "CA", "ct": "CT", "pr": "PR", "imm": "IMM", "p
 
 # The targets the benchmarks are held to (docs/BENCHMARKS.md), as (limit, better): a measured value
 # meets its target when it is at most (better = "lower") or at least (better = "higher") the limit.
-TARGET_IMM_STEP_US = 50.0
 TARGET_PR_IMM_STEP_RATIO = 4.0
 TARGET_PR_IMM_P99_US = 2000.0
 TARGET_PR_IMM_RATE_HZ = 1500.0
@@ -126,21 +127,31 @@ def write_evaluation(measured: Measured, meta: dict) -> list[Path]:
     return written
 
 
-def step_rows(step_growth: list[dict]) -> list[list[str]]:
-    by_key = {(row["method"], row["objects"]): row for row in step_growth}
-    rows = [["objects", "IMM step p50 / p99 µs", "IMM µs per object", "PR-IMM step p50 / p99 µs",
-             "PR-IMM µs per object", "PR-IMM / IMM (p50)"]]
-    for objects in sorted({row["objects"] for row in step_growth}):
-        imm, pr_imm = by_key.get(("imm", objects)), by_key.get(("pr-imm", objects))
-        cells = [str(objects)]
-        for row in (imm, pr_imm):
-            if row is None:
-                cells += ["–", "–"]
-            else:
-                cells += [f"{row['step_p50_us']:.1f} / {row['step_p99_us']:.1f}", f"{row['per_object_p50_us']:.2f}"]
-        ratio = pr_imm["step_p50_us"] / imm["step_p50_us"] if imm and pr_imm else None
-        cells.append(f"{ratio:.2f}×" if ratio is not None else "–")
-        rows.append(cells)
+def percentile(sorted_ns: list[int], q: float) -> float:
+    """The nearest-rank percentile in µs, as `primm track --timing` computes it."""
+    rank = min(max(math.ceil(q * len(sorted_ns)), 1), len(sorted_ns))
+    return sorted_ns[rank - 1] / 1000.0
+
+
+def read_timing(path: Path) -> list[int]:
+    steps = sorted(int(line) for line in path.read_text(encoding="utf-8").split() if line.strip())
+    if not steps:
+        raise SystemExit(f"release_tables: {path} holds no step times")
+    return steps
+
+
+def step_rows(timings: dict[str, dict[str, list[int]]]) -> list[list[str]]:
+    rows = [["preset (evaluation split)", "frames", "IMM step p50 / p99 µs", "PR-IMM step p50 / p99 µs",
+             "PR-IMM / IMM, medians", "PR-IMM / IMM, total time"]]
+    for preset, methods in timings.items():
+        imm, pr_imm = methods.get("imm"), methods.get("pr-imm")
+        if not imm or not pr_imm:
+            continue
+        rows.append([preset, thousands(len(imm)),
+                     f"{percentile(imm, 0.5):.1f} / {percentile(imm, 0.99):.1f}",
+                     f"{percentile(pr_imm, 0.5):.1f} / {percentile(pr_imm, 0.99):.1f}",
+                     f"{percentile(pr_imm, 0.5) / percentile(imm, 0.5):.2f}×",
+                     f"{sum(pr_imm) / sum(imm):.2f}×"])
     return rows
 
 
@@ -185,19 +196,16 @@ def verdict(value: float, limit: float, better: str) -> str:
     return "met" if met else "**missed**"
 
 
-def benchmark_headline(step_growth: list[dict] | None, summaries: dict[str, dict]) -> list[list[str]]:
-    rows = [["figure (64 objects, the shipped configuration)", "measured", "target", "verdict"]]
-    by_key = {(row["method"], row["objects"]): row for row in step_growth or []}
-    imm, pr_imm = by_key.get(("imm", 64)), by_key.get(("pr-imm", 64))
-    if imm:
-        rows.append(["IMM step, median", f"{imm['step_p50_us']:.1f} µs", f"≤ {TARGET_IMM_STEP_US:.0f} µs",
-                     verdict(imm["step_p50_us"], TARGET_IMM_STEP_US, "lower")])
-    if pr_imm:
-        rows.append(["PR-IMM step, median", f"{pr_imm['step_p50_us']:.1f} µs", "", ""])
-    if imm and pr_imm:
-        ratio = pr_imm["step_p50_us"] / imm["step_p50_us"]
-        rows.append(["PR-IMM step / IMM step (medians, same run)", f"{ratio:.2f}×", f"≤ {TARGET_PR_IMM_STEP_RATIO:.0f}×",
-                     verdict(ratio, TARGET_PR_IMM_STEP_RATIO, "lower")])
+def benchmark_headline(timings: dict[str, dict[str, list[int]]], summaries: dict[str, dict]) -> list[list[str]]:
+    rows = [["figure (the shipped configuration)", "measured", "target", "verdict"]]
+    for preset, methods in timings.items():
+        imm, pr_imm = methods.get("imm"), methods.get("pr-imm")
+        if not imm or not pr_imm:
+            continue
+        rows.append([f"IMM step, median, {preset} sequences", f"{percentile(imm, 0.5):.1f} µs", "", ""])
+        ratio = sum(pr_imm) / sum(imm)
+        rows.append([f"PR-IMM step / IMM step, {preset} sequences (total time, same run)", f"{ratio:.2f}×",
+                     f"≤ {TARGET_PR_IMM_STEP_RATIO:.0f}×", verdict(ratio, TARGET_PR_IMM_STEP_RATIO, "lower")])
     for method in ("imm", "pr-imm"):
         summary = summaries.get(method)
         if summary is None:
@@ -221,11 +229,15 @@ def benchmark_headline(step_growth: list[dict] | None, summaries: dict[str, dict
 
 def write_benchmarks(measured: Measured, meta: dict) -> tuple[list[Path], dict[str, dict]]:
     written = []
-    step_path = measured.path("step_growth.json")
-    step_growth = json.loads(step_path.read_text(encoding="utf-8")) if step_path else None
-    if step_growth:
-        what = "cargo bench --bench step_growth -- --counts 8,64,256: Tracker::step on lanes, every object measured in each frame"
-        written.append(write_csv("release_benchmarks_step.csv", header(what=what, **meta), step_rows(step_growth)))
+    timings: dict[str, dict[str, list[int]]] = {}
+    for preset in PRESETS:
+        for method in ("imm", "pr-imm"):
+            path = measured.path(f"timing/{preset}.{method}.txt")
+            if path:
+                timings.setdefault(preset, {})[method] = read_timing(path)
+    if timings:
+        what = "primm track --timing on every sequence of the evaluation split, both methods one after the other"
+        written.append(write_csv("release_benchmarks_step.csv", header(what=what, **meta), step_rows(timings)))
     summaries = {}
     for method in ("imm", "pr-imm"):
         path = measured.path(f"bench_service/{method}/summary.md")
@@ -234,9 +246,9 @@ def write_benchmarks(measured: Measured, meta: dict) -> tuple[list[Path], dict[s
     if summaries:
         what = "primm bench-service --objects 64 --rate-hz 100 --find-max-rate (its summary.md per method)"
         written.append(write_csv("release_benchmarks_service.csv", header(what=what, **meta), service_rows(summaries)))
-    headline = benchmark_headline(step_growth, summaries)
+    headline = benchmark_headline(timings, summaries)
     if len(headline) > 1:
-        what = "the step_growth benchmark and primm bench-service, 64 objects"
+        what = "primm track --timing on the evaluation sequences, and primm bench-service at 64 objects"
         written.append(write_csv("release_benchmarks.csv", header(what=what, **meta), headline))
     return written, summaries
 

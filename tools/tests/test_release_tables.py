@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import shutil
 import sys
 from pathlib import Path
@@ -35,7 +34,9 @@ def measured(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     directory = tmp_path / "measured"
     (directory / "bench_service" / "imm").mkdir(parents=True)
     shutil.copy(ROOT / "benches/results/bench_service/imm/summary.md", directory / "bench_service/imm/summary.md")
-    shutil.copy(ROOT / "benches/results/step_growth.json", directory / "step_growth.json")
+    (directory / "timing").mkdir()
+    (directory / "timing" / "default.imm.txt").write_text("\n".join(str(ns) for ns in range(1000, 11000, 10)) + "\n")
+    (directory / "timing" / "default.pr-imm.txt").write_text("\n".join(str(3 * ns) for ns in range(1000, 11000, 10)) + "\n")
     (directory / "soak_imm.txt").write_text(SOAK, encoding="utf-8")
     results = tmp_path / "results"
     results.mkdir()
@@ -51,25 +52,21 @@ def test_a_bench_service_summary_gives_its_latencies_losses_and_highest_rate() -
     assert summary["max_rate_hz"] == 11200 and summary["loss_rate_hz"] == 12000
 
 
-def test_the_step_table_divides_pr_imm_by_imm_at_each_count() -> None:
-    step_growth = json.loads((ROOT / "benches/results/step_growth.json").read_text(encoding="utf-8"))
-    rows = release_tables.step_rows(step_growth)
-    imm = next(row for row in step_growth if row["method"] == "imm" and row["objects"] == 64)
-    pr_imm = next(row for row in step_growth if row["method"] == "pr-imm" and row["objects"] == 64)
-    row64 = next(row for row in rows if row[0] == "64")
-    assert row64[-1] == f"{pr_imm['step_p50_us'] / imm['step_p50_us']:.2f}×"
+def test_the_step_table_gives_nearest_rank_percentiles_and_both_ratios() -> None:
+    imm = list(range(1000, 101000, 1000))  # 1 ... 100 µs
+    pr_imm = [3 * ns for ns in imm]
+    rows = release_tables.step_rows({"default": {"imm": imm, "pr-imm": pr_imm}})
+    assert rows[1] == ["default", "100", "50.0 / 99.0", "150.0 / 297.0", "3.00×", "3.00×"]
 
 
 def test_a_missed_target_is_marked_missed() -> None:
-    step_growth = [
-        {"method": "imm", "objects": 64, "step_p50_us": 40.0},
-        {"method": "pr-imm", "objects": 64, "step_p50_us": 200.0},
-    ]
-    rows = release_tables.benchmark_headline(step_growth, {})
+    timings = {"robustness": {"imm": [40_000] * 10, "pr-imm": [200_000] * 10}}
+    rows = release_tables.benchmark_headline(timings, {})
     ratio = next(row for row in rows if row[0].startswith("PR-IMM step / IMM step"))
     assert ratio[1:] == ["5.00×", "≤ 4×", "**missed**"]
-    imm = next(row for row in rows if row[0] == "IMM step, median")
-    assert imm[-1] == "met"
+    timings = {"robustness": {"imm": [40_000] * 10, "pr-imm": [120_000] * 10}}
+    ratio = next(row for row in release_tables.benchmark_headline(timings, {}) if row[0].startswith("PR-IMM step"))
+    assert ratio[-1] == "met"
 
 
 def test_every_written_file_names_release_and_commit_and_renders(measured: Path) -> None:
