@@ -167,7 +167,8 @@ def provenance(metadata: dict[str, str]) -> list[str]:
         parts.append(f"commit {metadata['commit'][:10]}")
     if "measured" in metadata:
         parts.append(metadata["measured"])
-    return ["", f"*Measured on {', '.join(parts)}.*"]
+    host = f"; {metadata['host']}" if "host" in metadata else ""
+    return ["", f"*Measured on {', '.join(parts)}{host}.*"]
 
 
 def read_csv(path: Path) -> list[list[str]]:

@@ -48,7 +48,7 @@ fi
 commit=$(git rev-parse HEAD)
 release=$(python3 -c 'import sys; sys.path.insert(0, "tools"); import check_release_figures as c, pathlib; print(c.workspace_version(pathlib.Path(".")))')
 mkdir -p "$out"
-echo "$(nproc) logical CPUs, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), load average $(cut -d' ' -f1 /proc/loadavg) at the start" > "$out/host.txt"
+echo "$(nproc) logical CPUs ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)), load average $(cut -d' ' -f1 /proc/loadavg) at the start" > "$out/host.txt"
 
 started=$SECONDS
 step() { echo "release_figures: $* ($((SECONDS - started)) s)"; }
