@@ -22,7 +22,7 @@ mkdir -p "$out"
 # Service variants: name and `primm bench-service` arguments.
 service_variants=("imm|--method imm" "pr-imm|--method pr-imm" "pr-imm-in-frame|--method pr-imm --no-speculation")
 # Offline variants: name and `primm track` arguments.
-track_variants=("imm|--method imm" "pr-imm|--method pr-imm" "pr-imm-2-threads|--method pr-imm --inference-threads 2" "pr-imm-4-threads|--method pr-imm --inference-threads 4")
+track_variants=("imm|--method imm" "pr-imm|--method pr-imm" "pr-imm-2-threads|--method pr-imm --inference-threads 2" "pr-imm-4-threads|--method pr-imm --inference-threads 4" "pr-imm-6-threads|--method pr-imm --inference-threads 6")
 
 echo "run,variant,receive_to_publish_p50_us,receive_to_publish_p99_us,learned_wait_p50_us,learned_wait_p99_us,predict_p50_us,frames_sent,frames_lost_client,frames_lost_tracker" >"$out/service.csv"
 echo "run,variant,frames,step_seconds,step_p50_us,step_p99_us,tracks_identical_to_synchronous" >"$out/track.csv"
