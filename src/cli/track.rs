@@ -42,7 +42,8 @@ pub struct Args {
     pub timing: Option<PathBuf>,
     /// Run the PR model on COUNT inference threads (1 to 8) instead of on the tracking thread,
     /// each step handing them the next frame's requests ahead for its guessed time
-    /// (speculation); the threads spin briefly before parking. Every frame waits for its
+    /// (speculation); the threads spin briefly before parking, so give each one a core of its
+    /// own (on an oversubscribed host this is many times slower). Every frame waits for its
     /// answers (up to a minute, not the service's deadline), so the tracks are the same bit for
     /// bit as without.
     #[arg(long, value_name = "COUNT", value_parser = clap::value_parser!(u8).range(1..=8))]
