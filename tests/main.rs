@@ -62,6 +62,7 @@ mod service_python;
 mod service_realtime;
 mod service_replay;
 mod shm_hygiene;
+mod speculation;
 mod speed_bound;
 mod staged_association;
 mod track_loops;

@@ -59,6 +59,10 @@ pub struct Args {
     /// step, and the learned mode sits the prediction out). See docs/integrating.md.
     #[arg(long, value_enum, default_value = "frame", value_name = "WHEN")]
     pub publish_time: PublishTimeArg,
+    /// Predict the learned mode only when a frame arrives, not ahead of it for the next frame's
+    /// guessed time once the previous answer is sent (same results; for comparison).
+    #[arg(long)]
+    pub no_speculation: bool,
     /// Latency files (`--latency-out DIR`).
     #[command(flatten)]
     pub latency_files: LatencyOutArgs,
@@ -190,6 +194,7 @@ fn serve<P: DisplacementPredictor>(
             PublishTimeArg::Frame => PublishTime::Frame,
             PublishTimeArg::Now => PublishTime::Now,
         },
+        speculate: !args.no_speculation,
     };
     let names = options.names.clone();
     let mut service = TrackingService::new(tracker, options)?;

@@ -89,6 +89,8 @@ pub struct TrackingOptions {
     pub poll_timeout: Duration,
     /// The time the published tracks describe.
     pub publish_time: PublishTime,
+    /// After each answer, hand the predictor the next frame's requests ([`Tracker::speculate`]).
+    pub speculate: bool,
 }
 
 impl Default for TrackingOptions {
@@ -99,6 +101,7 @@ impl Default for TrackingOptions {
             latency_report_interval_frames: 100,
             poll_timeout: Duration::from_millis(50),
             publish_time: PublishTime::Frame,
+            speculate: true,
         }
     }
 }
@@ -314,6 +317,9 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 header.input_publish_time_ns,
                 header.input_scheduled_time_ns,
             );
+        }
+        if self.options.speculate {
+            self.tracker.speculate();
         }
         self.write_latency_interval();
 

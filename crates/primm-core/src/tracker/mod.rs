@@ -43,11 +43,13 @@ mod lifecycle;
 mod output;
 mod predict;
 mod sensors;
+mod speculation;
 mod stats;
 mod update;
 mod validate;
 
 use output::report;
+pub use speculation::{IntervalGuess, SpeculationStats};
 pub use stats::{StepSummary, TrackerStats};
 
 /// Why a step failed. The tracker's tracks are exactly as before the frame (after an
@@ -121,6 +123,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
     /// The table row of each request's track (`predictor.classes` may leave tracks out).
     requested_rows: Box<ArrayVec<u16, MAX_TRACKS>>,
+    /// Learned predictions computed between frames (`speculation`).
+    speculation: speculation::Speculation,
     /// The predictor's answers, aligned with `requests`.
     answers: Box<[Option<Displacement>; MAX_TRACKS]>,
     /// Each track's checked displacement, aligned with the table (`None`: the PR mode sits out).
@@ -201,6 +205,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             ego_motion: EgoMotion::default(),
             requests: Box::new(ArrayVec::new()),
             requested_rows: Box::new(ArrayVec::new()),
+            speculation: speculation::Speculation::new(),
             answers: Box::new([None; MAX_TRACKS]),
             displacements: Box::new([None; MAX_TRACKS]),
             priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
