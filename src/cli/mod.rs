@@ -9,6 +9,7 @@ pub mod generate;
 pub mod latency_out;
 pub mod latency_plot;
 pub mod score;
+pub mod sensor_truth;
 pub mod serve;
 pub mod soak;
 pub mod track;
