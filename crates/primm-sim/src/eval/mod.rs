@@ -62,5 +62,7 @@ pub use record::{counts_as_confirmed, AssociationRecord, EvalError, Method};
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;
 pub use scenario::{classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules};
-pub use sensor_truth::{format_sensor_truth, SensorClassTruth, SensorTruthAccumulator, UnknownSensor};
+pub use sensor_truth::{
+    format_sensor_truth, sensor_truth_of_split, SensorClassTruth, SensorTruthAccumulator, UnknownSensor,
+};
 pub use velocity::{SpeedHeadingAccumulator, VelocityRmseAccumulator, HEADING_MIN_TRUE_SPEED_MPS};
