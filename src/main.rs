@@ -25,6 +25,8 @@ enum Command {
     Subscribe(primm_subscriber::Args),
     /// Generate simulated radar sequences as measurement CSV files.
     Generate(cli::generate::Args),
+    /// The true reflection offset, detection probability and clutter density of simulated sensors.
+    SensorTruth(cli::sensor_truth::Args),
     /// Track a measurement CSV file offline into a track CSV file.
     Track(cli::track::Args),
     /// Evaluate methods on a data set and print the paper's tables.
@@ -64,6 +66,9 @@ enum CommandError {
     /// `primm generate` failed.
     #[error(transparent)]
     Generate(#[from] cli::generate::GenerateError),
+    /// `primm sensor-truth` failed.
+    #[error(transparent)]
+    SensorTruth(#[from] cli::sensor_truth::SensorTruthError),
     /// `primm track` failed.
     #[error(transparent)]
     Track(#[from] cli::track::TrackError),
@@ -103,6 +108,7 @@ fn main() -> ExitCode {
         Command::Publish(args) => primm_publisher::run(args).map_err(Into::into),
         Command::Subscribe(args) => primm_subscriber::run(args).map_err(Into::into),
         Command::Generate(args) => cli::generate::run(&args).map_err(Into::into),
+        Command::SensorTruth(args) => cli::sensor_truth::run(&args).map_err(Into::into),
         Command::Track(args) => cli::track::run(&args).map_err(Into::into),
         Command::Eval(args) => cli::eval::run(&args).map_err(Into::into),
         Command::Score(args) => cli::score::run(&args).map_err(Into::into),

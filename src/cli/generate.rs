@@ -62,6 +62,13 @@ pub enum PresetChoice {
     /// The clutter-turning scene with extended vehicles.
     #[value(name = "extended_clutter_turning", alias = "extended-clutter-turning")]
     ExtendedClutterTurning,
+    /// The default scene seen by object-list radars: each detected object at its true centre
+    /// plus noise.
+    Centroid,
+    /// One static roadside radar in dense traffic (25 to 45 objects in view), frames every 50
+    /// to 80 ms without ego pose or sensor id, a little clutter.
+    #[value(name = "dense_static", alias = "dense-static")]
+    DenseStatic,
 }
 
 impl From<PresetChoice> for Preset {
@@ -76,6 +83,8 @@ impl From<PresetChoice> for Preset {
             PresetChoice::ExtendedTurning => Preset::ExtendedTurning,
             PresetChoice::ExtendedClutter => Preset::ExtendedClutter,
             PresetChoice::ExtendedClutterTurning => Preset::ExtendedClutterTurning,
+            PresetChoice::Centroid => Preset::Centroid,
+            PresetChoice::DenseStatic => Preset::DenseStatic,
         }
     }
 }

@@ -11,6 +11,7 @@ pub mod latency_out;
 pub mod latency_plot;
 pub mod man;
 pub mod score;
+pub mod sensor_truth;
 pub mod serve;
 pub mod soak;
 pub mod track;
