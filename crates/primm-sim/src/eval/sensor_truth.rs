@@ -30,7 +30,7 @@ use serde::Serialize;
 
 use crate::scenario::{GeneratedSequence, ScenarioConfig, ScenarioGenerator, Split, TruthFrame};
 use primm_core::config::Config;
-use primm_core::extent::{expected_reflection, ExtentConfig, ObjectPrior};
+use primm_core::extent::{ExtentConfig, ObjectPrior};
 use primm_core::measurement::ObjectClass;
 use primm_core::pose::SensorMount;
 
@@ -239,9 +239,8 @@ pub fn sensor_truth_of_split(
 /// `velocity_mps`, seen from `sensor_m`: its expected reflection with `offset_scale` 1 and no
 /// uncertainty.
 pub fn outline_offset(extent: &ExtentConfig, centre_m: DVec2, velocity_mps: DVec2, sensor_m: DVec2) -> DVec2 {
-    let outline = ExtentConfig { offset_scale: 1.0, ..*extent };
     let object = ObjectPrior { centre_m, velocity_mps, ..ObjectPrior::default() };
-    expected_reflection(&outline, &object, sensor_m).offset_m
+    primm_core::extent::outline_reflection(extent, &object, sensor_m).offset_m
 }
 
 /// Whether `point` (car frame) lies within `mount`'s range and field of view.

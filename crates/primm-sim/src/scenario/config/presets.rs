@@ -238,6 +238,7 @@ fn static_sensor_layout() -> SensorMount {
         range_std_m: 0.0,
         azimuth_std_rad: 0.0,
         azimuth_std_max_factor: 1.0,
+        reflection: primm_core::sensor::ReflectionModel::Outline,
     }
 }
 
