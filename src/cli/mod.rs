@@ -3,6 +3,7 @@
 //! `primm subscribe` run the loops of the `primm-publisher` and `primm-subscriber` packages.
 
 pub mod bench_service;
+pub mod config;
 pub mod demo;
 pub mod eval;
 pub mod generate;

@@ -125,7 +125,7 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
             Err(source) => return Err(TrackError::Step { frame: recorded.index, source }),
         };
         step_ns.push(start.elapsed().as_nanos() as u64);
-        if tracker.last_step().late {
+        if tracker.last_step().late() {
             continue;
         }
         let outputs = tracker.last_outputs();

@@ -30,10 +30,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if self.step_pose.is_some() { CoordinateFrame::World } else { CoordinateFrame::Vehicle };
         self.last_step.tracking_frame = step_frame;
         if world && pose.is_none() {
-            self.stats.frames_without_ego_pose += 1;
+            self.last_step.counts.frames_without_ego_pose += 1;
         }
         if step_frame == CoordinateFrame::World {
-            self.stats.frames_in_world_frame += 1;
+            self.last_step.counts.frames_in_world_frame += 1;
         }
         let motion_since_last = self.ego_motion_since_last_pose(t);
         if step_frame != self.tracks_frame && !self.table.is_empty() {
@@ -65,7 +65,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                         add_ego(track);
                     }
                 }
-                self.last_step.tracking_frame_changed = true;
+                self.last_step.counts.tracking_frame_changes = 1;
             }
         }
         self.tracks_frame = step_frame;
@@ -88,7 +88,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         else {
             return None;
         };
-        if !(t > last_s) || self.last_step.odometry_reset {
+        if !(t > last_s) || self.last_step.odometry_reset() {
             return None;
         }
         let velocity_mps = (pose.position() - last.position()) / (t - last_s);
@@ -117,7 +117,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if !jumped {
             return;
         }
-        self.last_step.odometry_reset = true;
+        self.last_step.counts.odometry_resets = 1;
         let (to_vehicle, to_world) = (last.world_to_vehicle(), pose.vehicle_to_world());
         for track in self.table.tracks_mut() {
             track.transform(&to_vehicle);
@@ -136,7 +136,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let Some(measurement) = self.validated.accepted(index) else { continue };
             let mount = measurement.sensor_id.and_then(|id| self.config.frame.sensor(id));
             let Some(mount) = mount else {
-                self.last_step.unknown_sensor = true;
+                self.last_step.counts.frames_with_unknown_sensor = 1;
                 continue;
             };
             if self.scanning_sensors.iter().any(|sensor| sensor.id == mount.id) {
@@ -150,7 +150,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 clutter_density_factor: mount.clutter_density_factor,
             });
         }
-        if self.last_step.unknown_sensor {
+        if self.last_step.unknown_sensor() {
             self.unknown_sensor_view = self.unknown_sensor_view();
         }
     }
@@ -209,7 +209,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         match measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)) {
             Some(mount) => pose.point_to_world(mount.position()),
             None => {
-                self.last_step.initiations_from_unknown_sensor += 1;
+                self.last_step.counts.initiations_from_unknown_sensor += 1;
                 pose.position()
             }
         }
