@@ -384,13 +384,12 @@ impl PrimmStepSummary {
     }
 }
 
+// cbindgen reads this struct as written, so each counter is spelled out here; the conversion
+// below is generated from the list, so a counter added there and missing here (or the
+// reverse) does not compile. Such a change changes this struct's size: raise
+// `PRIMM_ABI_VERSION` and regenerate the header.
 /// The tracker's counters since it was built: `TrackerStats` of primm-core, field for field,
 /// in the order of primm-core's list of counters (`tracker_counters!`), which documents each.
-///
-/// cbindgen reads this struct as written, so each counter is spelled out here; the conversion
-/// below is generated from the list, so a counter added there and missing here (or the
-/// reverse) does not compile. Such a change changes this struct's size: raise
-/// `PRIMM_ABI_VERSION` and regenerate the header.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct PrimmStats {
