@@ -11,7 +11,7 @@ use std::process::Command;
 
 /// A generated four-radar sequence (one radar per frame, with ego poses).
 fn four_radar_frames() -> Vec<Frame> {
-    let generated = ScenarioGenerator::from_preset(Preset::Default).generate(Split::Validation, 1);
+    let generated = ScenarioGenerator::from_preset(Preset::Default).generate(Split::Validation, 0);
     let frames: Vec<Frame> =
         generated.sequence.frames.iter().map(|frame| frame.to_frame().unwrap()).collect();
     let sensors: std::collections::BTreeSet<u16> =
@@ -32,9 +32,9 @@ fn a_file_of_one_key_tracks_a_four_radar_sequence_bit_for_bit_like_the_shipped_f
     let shipped = track(Config::default(), &frames);
     for (one_key, shipped_line, changed_line) in [
         (
-            "[tracker]\ntentative_max_coast_s = 0.2\n",
-            "tentative_max_coast_s = 0.3",
-            "tentative_max_coast_s = 0.2",
+            "[tracker]\nexistence_persistence_time_s = 5.0\n",
+            "existence_persistence_time_s = 40.0",
+            "existence_persistence_time_s = 5.0",
         ),
         (
             "[classes.car]\nmeasurement_noise_covariance_m2 = [[0.3, 0.0], [0.0, 0.3]]\n",
