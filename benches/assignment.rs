@@ -149,7 +149,7 @@ fn bench_association(c: &mut Criterion) {
                     let rows: Vec<usize> = (0..n).filter(|&i| tracks[i].class == class).collect();
                     let columns: Vec<usize> =
                         (0..n).filter(|&j| frame.measurements[j].class == class).collect();
-                    let gate = config.classes.get(class).gate_m;
+                    let gate = config.classes.get(class).paper_gate_m;
                     for (r, &i) in rows.iter().enumerate() {
                         for (k, &j) in columns.iter().enumerate() {
                             let cost = association_cost(

@@ -37,6 +37,8 @@ enum Command {
     Soak(cli::soak::Args),
     /// Benchmark the tracking service: latency files, plots, a summary, the highest lossless rate.
     BenchService(cli::bench_service::Args),
+    /// Print the configuration in effect (`show`) or the description of every key (`parameters`).
+    Config(cli::config::Args),
     /// Plot HdrHistogram interval logs (.hlog) by percentile into one SVG to compare runs.
     LatencyPlot(cli::latency_plot::Args),
     /// Relay the service's streams to other hosts through the iceoryx2 link tunnel over zenoh.
@@ -84,6 +86,9 @@ enum CommandError {
     /// `primm bench-service` failed.
     #[error(transparent)]
     BenchService(#[from] cli::bench_service::BenchServiceError),
+    /// `primm config` failed.
+    #[error(transparent)]
+    Config(#[from] cli::config::ConfigCommandError),
     /// `primm latency-plot` failed.
     #[error(transparent)]
     LatencyPlot(#[from] cli::latency_plot::LatencyPlotError),
@@ -114,6 +119,7 @@ fn main() -> ExitCode {
         Command::Score(args) => cli::score::run(&args).map_err(Into::into),
         Command::Soak(args) => cli::soak::run(&args).map_err(Into::into),
         Command::BenchService(args) => cli::bench_service::run(&args).map_err(Into::into),
+        Command::Config(args) => cli::config::run(&args).map_err(Into::into),
         Command::LatencyPlot(args) => cli::latency_plot::run(&args).map_err(Into::into),
         #[cfg(feature = "tunnel")]
         Command::Tunnel(args) => cli::tunnel::run(&args).map_err(Into::into),

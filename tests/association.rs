@@ -92,7 +92,7 @@ fn score(
             &measurement,
             &config.association,
         );
-        assert!(cost <= config.classes.get(class).gate_m, "an assigned pair lies outside the gate");
+        assert!(cost <= config.classes.get(class).paper_gate_m, "an assigned pair lies outside the gate");
         pairs += 1;
         total += cost;
     }
@@ -108,7 +108,7 @@ fn dense_optimum(scene: &Scene, config: &Config, class: ObjectClass) -> (usize, 
     if rows.is_empty() || columns.is_empty() {
         return (0, 0.0);
     }
-    let gate = config.classes.get(class).gate_m;
+    let gate = config.classes.get(class).paper_gate_m;
     let mut costs = vec![f64::INFINITY; rows.len() * columns.len()];
     for (r, &i) in rows.iter().enumerate() {
         for (c, &j) in columns.iter().enumerate() {

@@ -73,7 +73,7 @@ fn a_four_radar_sequence_delivered_out_of_order_within_the_window_gives_the_same
     for &index in &order {
         shuffled.step(&frames[index]).unwrap_or_else(|error| panic!("frame {index}: {error}"));
         has_arrived[index] = true;
-        let late = shuffled.last_step().late;
+        let late = shuffled.last_step().late();
         let outputs = shuffled.last_outputs();
         assert_eq!(late, index < newest, "frame {index} after {newest}");
         assert_eq!(late, !shuffled.late_frame_outputs().is_empty(), "frame {index}");
@@ -154,9 +154,9 @@ fn a_frame_just_inside_the_window_is_tracked_in_its_place() {
     let late = two_cars(newest - 0.14);
     tracker.step(&late).unwrap();
     let step = *tracker.last_step();
-    assert!(step.late);
+    assert!(step.late());
     // It went between the frames at 0.85 and 0.9 s: the three newer ones were tracked again.
-    assert_eq!(step.replayed_frames, 3);
+    assert_eq!(step.counts.frames_replayed, 3);
     assert_eq!(tracker.stats().late_frames_tracked, 1);
     // The same as tracking it in order.
     let mut in_order = Tracker::new(imm_config()).unwrap();

@@ -37,6 +37,7 @@ mod imm_spread_of_means;
 mod inference_faults;
 mod late_frames;
 mod latency_files;
+mod layered_config;
 mod learned_covariance;
 mod logging;
 mod motion_models;

@@ -119,7 +119,7 @@ fn switched_off_the_row_is_never_applied_nor_counted() {
     let mut tracker = Tracker::new(config(false)).unwrap();
     for (frame, _) in &frames {
         tracker.step(frame).unwrap();
-        assert_eq!(tracker.last_step().radial_velocity_rows_applied, 0);
+        assert_eq!(tracker.last_step().counts.radial_velocity_updates, 0);
     }
     let stats = tracker.stats();
     assert_eq!(

@@ -124,7 +124,7 @@ fn pair_cost(scene: &Scene, config: &Config, track: usize, measurement: usize) -
                 m,
                 &config.association,
             );
-            (cost <= section.gate_m).then_some(cost)
+            (cost <= section.paper_gate_m).then_some(cost)
         }
         AssociationCost::Likelihood => {
             let [[xx, xy], [yx, yy]] = section.measurement_noise_covariance_m2;
@@ -134,7 +134,8 @@ fn pair_cost(scene: &Scene, config: &Config, track: usize, measurement: usize) -
             let s = prior.covariance + noise;
             let nu = m.position() - prior.mean;
             let dv = m.radial_velocity_mps - scene.tracks[track].last_radial_velocity_mps;
-            let distance = nu.dot(s.inverse() * nu) + (dv / section.radial_velocity_residual_std_mps).powi(2);
+            let distance =
+                nu.dot(s.inverse() * nu) + (dv / section.likelihood_radial_velocity_std_mps).powi(2);
             (distance <= config.association.likelihood_gate_chi2).then(|| distance + s.determinant().ln())
         }
     }
@@ -339,7 +340,7 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
                 &scene.priors[i].fused,
                 DMat2::from_cols(DVec2::new(xx, yx), DVec2::new(xy, yy)),
                 track.last_radial_velocity_mps,
-                section.radial_velocity_residual_std_mps,
+                section.likelihood_radial_velocity_std_mps,
                 likelihood.association.likelihood_gate_chi2,
             )
             .unwrap();

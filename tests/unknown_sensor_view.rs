@@ -43,7 +43,7 @@ fn run(config: Config) -> (Vec<(bool, f64)>, usize) {
             .iter()
             .map(|o| (o.status.is_confirmed(), o.existence_probability))
             .collect();
-        missed += tracker.last_step().missed_in_view;
+        missed += tracker.last_step().counts.tracks_missed_in_view;
     }
     (last, missed)
 }

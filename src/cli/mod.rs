@@ -4,6 +4,7 @@
 
 pub mod bench_service;
 pub mod completions;
+pub mod config;
 pub mod demo;
 pub mod eval;
 pub mod generate;

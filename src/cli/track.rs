@@ -185,7 +185,7 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         }
         step_ns.push(start.elapsed().as_nanos() as u64);
         let outputs =
-            if tracker.last_step().late { tracker.late_frame_outputs() } else { tracker.last_outputs() };
+            if tracker.last_step().late() { tracker.late_frame_outputs() } else { tracker.last_outputs() };
         writer.write_frame(recorded.index, recorded.timestamp_s, outputs)?;
         if let Some(associations) = associations.as_mut() {
             associations.write_frame(recorded.index, recorded.measurements.len(), outputs)?;

@@ -37,7 +37,7 @@ use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::stage_timing::Stage;
 use primm_core::track::TrackOutput;
-use primm_core::tracker::{StepError, StepSummary, Tracker};
+use primm_core::tracker::{StepError, StepSummary, Tracker, TrackerStats};
 use primm_wire::{
     FrameStatus, LatencyReport, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
     TrackFrameWriter, FRAME_FLAG_STREAM_END, STAGE_CAPACITY, TRACK_FLAG_LATE_FRAME, TRACK_FLAG_PREDICTED,
@@ -287,7 +287,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         if frame.flags & FRAME_FLAG_STREAM_END != 0 {
             flags |= TRACK_FLAG_STREAM_END;
         }
-        if step.late {
+        if step.late() {
             flags |= TRACK_FLAG_LATE_FRAME;
         }
         let mut tracks_timestamp_s = self.tracker.newest_timestamp_s().unwrap_or(frame.sensor_timestamp_s);
@@ -397,15 +397,13 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             Ok(step) => {
                 self.counters.frames_tracked += 1;
                 self.stream.tracker_dirty = true;
-                let rejected = step.predictions_rejected_non_finite
-                    + step.predictions_rejected_implausible
-                    + step.predictions_rejected_invalid_covariance;
+                let rejected = step.learned_predictions_rejected();
                 if rejected > 0 && self.logs.learned_rejected.occur() {
                     tracing::warn!(
                         sequence = frame.sequence,
-                        non_finite = step.predictions_rejected_non_finite,
-                        implausible = step.predictions_rejected_implausible,
-                        invalid_covariance = step.predictions_rejected_invalid_covariance,
+                        non_finite = step.counts.learned_predictions_rejected_non_finite,
+                        implausible = step.counts.learned_predictions_rejected_implausible,
+                        invalid_covariance = step.counts.learned_predictions_rejected_invalid_covariance,
                         occurrences = self.logs.learned_rejected.occurrences(),
                         "learned displacements rejected; the PR mode sat out for those tracks"
                     );
@@ -642,15 +640,14 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         &self.node
     }
 
-    /// A plain-text summary for the end of a run: counters and the latency table.
+    /// A plain-text summary for the end of a run: the service's counters, the tracker's
+    /// counters by their names (those not zero; the list is primm-core's `tracker_counters!`)
+    /// and the latency table.
     pub fn summary(&self) -> String {
         let c = &self.counters;
-        let s = self.tracker.stats();
         format!(
             "frames: {} received, {} tracked, {} rejected, {} lost; resets: {} (stream start {}, new publisher {}, interval too long {}); \
-             measurements: {} accepted, {} rejected; tracks: {} started, {} confirmed, {} deleted; \
-             learned predictions: {} missing ({} rejected non-finite, {} rejected implausible, {} rejected for their covariance); \
-             publish failures: {}\n{}",
+             publish failures: {}\n{}\n{}",
             c.frames_received,
             c.frames_tracked,
             c.frames_rejected,
@@ -659,16 +656,8 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             c.resets_stream_start,
             c.resets_new_publisher,
             c.resets_interval_too_long,
-            s.measurements_accepted,
-            s.measurements_rejected_unknown_class + s.measurements_rejected_non_finite + s.measurements_rejected_out_of_range,
-            s.tracks_initiated,
-            s.tracks_confirmed,
-            s.tracks_deleted,
-            s.learned_predictions_missing,
-            s.learned_predictions_rejected_non_finite,
-            s.learned_predictions_rejected_implausible,
-            s.learned_predictions_rejected_invalid_covariance,
             c.publish_failures,
+            tracker_counters_line(self.tracker.stats()),
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
             + &sensor_lines(&self.tracker)
@@ -686,6 +675,18 @@ fn sensor_lines<P: DisplacementPredictor>(tracker: &Tracker<P>) -> String {
     }
 }
 
+/// The tracker's counters that are not zero, by name: `tracker: name value, ...` (every counter
+/// not named is zero).
+fn tracker_counters_line(stats: &TrackerStats) -> String {
+    let counted: Vec<String> = stats
+        .named_values()
+        .iter()
+        .filter(|(_, value)| *value > 0)
+        .map(|(name, value)| format!("{name} {value}"))
+        .collect();
+    format!("tracker: {} (the other counters are zero)", counted.join(", "))
+}
+
 /// The header of the answer to `frame` (its publish time is stamped when it is sent).
 fn track_frame_header(
     frame: &MeasurementFrame,
@@ -694,7 +695,7 @@ fn track_frame_header(
     flags: u8,
     step: &StepSummary,
 ) -> TrackFrameHeader {
-    let saturating_u16 = |count: usize| u16::try_from(count).unwrap_or(u16::MAX);
+    let saturating_u16 = |count: u64| u16::try_from(count).unwrap_or(u16::MAX);
     TrackFrameHeader {
         input_sequence: frame.sequence,
         source_frame: frame.source_frame,
@@ -706,7 +707,7 @@ fn track_frame_header(
         publish_time_ns: 0,
         status,
         flags,
-        measurements_accepted: saturating_u16(step.measurements_accepted),
-        measurements_rejected: saturating_u16(step.measurements_rejected),
+        measurements_accepted: saturating_u16(step.counts.measurements_accepted),
+        measurements_rejected: saturating_u16(step.measurements_rejected()),
     }
 }

@@ -31,7 +31,7 @@
 //!
 //! # Costs
 //!
-//! `association.cost = "paper"` is `eq:association_cost` gated at `classes.<class>.gate_m`;
+//! `association.cost = "paper"` is `eq:association_cost` gated at `classes.<class>.paper_gate_m`;
 //! `"likelihood"` is the negative log-likelihood of [`LikelihoodPrior`] gated by χ². Both
 //! bound `|Δx|` per track, which is all the x-sorted gating needs.
 //!
@@ -299,7 +299,7 @@ impl Associator {
         config: &Config,
         class: ObjectClass,
     ) {
-        let gate = config.classes.get(class).gate_m;
+        let gate = config.classes.get(class).paper_gate_m;
         let extent = extent_of(config, class);
         // An expected reflection moves the compared point by at most the extent's half diagonal.
         let window = gate + extent.map_or(0.0, |extent| extent.max_offset_m());
@@ -370,7 +370,7 @@ impl Associator {
                 &priors[usize::from(track_index)].fused,
                 noise,
                 track.last_radial_velocity_mps,
-                section.radial_velocity_residual_std_mps,
+                section.likelihood_radial_velocity_std_mps,
                 config.association.likelihood_gate_chi2,
             );
             let Some(prepared) = prepared else { continue };

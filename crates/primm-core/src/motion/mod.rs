@@ -99,7 +99,7 @@ impl ModeModels {
     /// Models from a class's configuration section.
     pub fn from_config(class: &ClassConfig) -> Self {
         let initial_velocity = InitialVelocity {
-            radial_std_mps: class.radial_velocity_std_mps,
+            radial_std_mps: class.initial_radial_speed_std_mps,
             tangential_std_mps: class.initial_tangential_speed_std_mps,
         };
         let r = crate::config::to_matrix(&class.measurement_noise_covariance_m2);

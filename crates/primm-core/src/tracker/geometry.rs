@@ -31,10 +31,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if self.step_pose.is_some() { CoordinateFrame::World } else { CoordinateFrame::Vehicle };
         self.last_step.tracking_frame = step_frame;
         if world && pose.is_none() {
-            self.stats.frames_without_ego_pose += 1;
+            self.last_step.counts.frames_without_ego_pose += 1;
         }
         if step_frame == CoordinateFrame::World {
-            self.stats.frames_in_world_frame += 1;
+            self.last_step.counts.frames_in_world_frame += 1;
         }
         let motion_since_last = self.ego_motion_since_last_pose(t);
         if step_frame != self.tracks_frame && !self.table.is_empty() {
@@ -66,7 +66,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                         add_ego(track);
                     }
                 }
-                self.last_step.tracking_frame_changed = true;
+                self.last_step.counts.tracking_frame_changes = 1;
             }
         }
         self.tracks_frame = step_frame;
@@ -89,7 +89,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         else {
             return None;
         };
-        if !(t > last_s) || self.last_step.odometry_reset {
+        if !(t > last_s) || self.last_step.odometry_reset() {
             return None;
         }
         let velocity_mps = (pose.position() - last.position()) / (t - last_s);
@@ -118,7 +118,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if !jumped {
             return;
         }
-        self.last_step.odometry_reset = true;
+        self.last_step.counts.odometry_resets = 1;
         let (to_vehicle, to_world) = (last.world_to_vehicle(), pose.vehicle_to_world());
         for track in self.table.tracks_mut() {
             track.transform(&to_vehicle);
@@ -137,7 +137,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let Some(measurement) = self.validated.accepted(index) else { continue };
             let slot = self.sensors.slot(measurement.sensor_id);
             let Some(field_of_view) = self.sensors.get(slot).field_of_view(self.step_pose) else {
-                self.last_step.unknown_sensor = true;
+                self.last_step.counts.frames_with_unknown_sensor = 1;
                 continue;
             };
             if self.scanning_sensors.iter().any(|sensor| sensor.slot == slot) {
@@ -146,7 +146,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             // There are at most MAX_SENSORS configured mounts, so this never overflows.
             let _ = self.scanning_sensors.try_push(ScanningSensor { slot, field_of_view });
         }
-        if self.last_step.unknown_sensor {
+        if self.last_step.unknown_sensor() {
             self.unknown_sensor_view = self.unknown_sensor_view();
         }
     }

@@ -23,13 +23,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
             let Some(measurement) = self.validated.accepted(index) else { continue };
             if self.absorbed_by_a_track(&measurement, tracks_before) {
-                self.last_step.detections_absorbed += 1;
+                self.last_step.counts.detections_absorbed += 1;
                 continue;
             }
             // Where the history's line of sight starts: the radial-velocity row's radar position.
             let sensor = self.measurement_sensors[index];
             if !sensor.mounted && self.step_pose.is_some() {
-                self.last_step.initiations_from_unknown_sensor += 1;
+                self.last_step.counts.initiations_from_unknown_sensor += 1;
             }
             let line_of_sight_origin = sensor.position_m;
             let models = &self.models[measurement.class.index()];
@@ -44,7 +44,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 (centre.x_m, centre.y_m) =
                     (measurement.x_m - reflection.offset_m.x, measurement.y_m - reflection.offset_m.y);
                 if !sensor.mounted {
-                    self.last_step.updates_from_unknown_sensor += 1;
+                    self.last_step.counts.updates_from_unknown_sensor += 1;
                 }
             }
             let imms = super::step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms);
@@ -59,7 +59,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             ));
             let max_speed_mps = self.config.classes.get(measurement.class).max_speed_mps;
             if super::update::bound_speed(max_speed_mps, self.step_pose.is_some(), &mut estimate) {
-                self.last_step.speeds_bounded += 1;
+                self.last_step.counts.speeds_bounded += 1;
             }
             let tracker = &self.config.tracker;
             match self.table.insert(|id| {
@@ -67,12 +67,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }) {
                 Ok(track) => {
                     track.birth_sensor_slot = sensor.slot;
-                    self.last_step.initiated += 1;
+                    self.last_step.counts.tracks_initiated += 1;
                     // A confirmation threshold of one hit (or an initial existence at the
                     // threshold) confirms at once.
                     if confirms(track, tracker) {
                         track.status = TrackStatus::Confirmed;
-                        self.last_step.newly_confirmed += 1;
+                        self.last_step.counts.tracks_confirmed += 1;
                     }
                     self.rows[self.table.len() - 1] = RowRecord {
                         prior_position_m: None,
@@ -81,7 +81,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     };
                     self.fates[index] = MeasurementFate::Assigned;
                 }
-                Err(_) => self.last_step.initiations_refused_table_full += 1,
+                Err(_) => self.last_step.counts.initiations_refused_table_full += 1,
             }
         }
     }
@@ -137,7 +137,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         for &(class, slot, hits) in &false_tracks[..false_count] {
             self.learn_false_track(class, slot, hits);
         }
-        self.last_step.deleted = deleted;
+        self.last_step.counts.tracks_deleted = deleted as u64;
     }
 
     /// Merges each track that has shadowed an older track of its class for
@@ -184,7 +184,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
         let merged = &self.merged;
         let removed = retain_with_rows(&mut self.table, &mut self.rows[..], |index, _| !merged[index]);
-        self.last_step.duplicates_merged = removed;
+        self.last_step.counts.duplicate_tracks_merged = removed as u64;
     }
 
     /// The nearest older track (more frames, or as many and a smaller id) of `index`'s class that

@@ -37,6 +37,7 @@ use alloc::vec;
 use arrayvec::ArrayVec;
 use glam::{DMat2, DVec2};
 
+mod counters;
 mod geometry;
 mod late_frames;
 mod lifecycle;
@@ -302,7 +303,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.merge_duplicates();
         observer.stage_finished(Stage::Update);
         self.last_timestamp_s = Some(t);
-        self.stats.frames_tracked += 1;
+        self.last_step.counts.frames_tracked += 1;
         Ok(())
     }
 

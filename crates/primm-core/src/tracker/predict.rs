@@ -86,7 +86,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 *answer = None;
             }
         }
-        self.last_step.predictions_missing = answers.iter().filter(|answer| answer.is_none()).count();
+        let missing = answers.iter().filter(|answer| answer.is_none()).count() as u64;
+        self.last_step.counts.learned_predictions_missing = missing;
+        self.last_step.counts.frames_with_learned_predictions_missing = u64::from(missing > 0);
         let tracks = self.table.tracks_mut();
         for ((answer, request), &row) in
             answers.iter().zip(self.requests.iter()).zip(self.requested_rows.iter())

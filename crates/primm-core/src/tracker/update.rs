@@ -68,7 +68,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.assigned_reflections[i] = reflection;
             let models = &self.models[measurement.class.index()];
             if !sensor.mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
-                self.last_step.updates_from_unknown_sensor += 1;
+                self.last_step.counts.updates_from_unknown_sensor += 1;
             }
         }
     }
@@ -79,7 +79,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     fn bound_speed(&mut self, i: usize, class: ObjectClass) {
         let max_speed_mps = self.config.classes.get(class).max_speed_mps;
         if bound_speed(max_speed_mps, self.step_pose.is_some(), &mut self.table.tracks_mut()[i].estimate) {
-            self.last_step.speeds_bounded += 1;
+            self.last_step.counts.speeds_bounded += 1;
         }
     }
 
@@ -111,8 +111,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
             };
             if let Ok(radial_velocity) = self.update_outcomes[i] {
                 match radial_velocity {
-                    Some(RadialVelocityOutcome::Applied) => self.last_step.radial_velocity_rows_applied += 1,
-                    Some(RadialVelocityOutcome::Gated) => self.last_step.radial_velocity_rows_gated += 1,
+                    Some(RadialVelocityOutcome::Applied) => {
+                        self.last_step.counts.radial_velocity_updates += 1
+                    }
+                    Some(RadialVelocityOutcome::Gated) => {
+                        self.last_step.counts.radial_velocity_updates_gated += 1
+                    }
                     Some(RadialVelocityOutcome::NoLineOfSight) | None => {}
                 }
                 let class = self.table.tracks()[i].class;
@@ -144,14 +148,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 track.record_hit(&measurement, self.assigned_sensors[i].position_m, t);
                 if track.status == TrackStatus::Tentative && confirms(track, tracker) {
                     track.status = TrackStatus::Confirmed;
-                    self.last_step.newly_confirmed += 1;
+                    self.last_step.counts.tracks_confirmed += 1;
                 }
-                self.last_step.assigned += 1;
+                self.last_step.counts.tracks_updated += 1;
                 self.fates[usize::from(index)] = MeasurementFate::Assigned;
             } else {
                 // Numerically unusable: the track coasts and the measurement is free to start a
                 // track of its own.
-                self.last_step.update_failures += 1;
+                self.last_step.counts.update_failures += 1;
                 self.track_to_measurement[i] = None;
             }
         }
@@ -188,7 +192,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     );
                     missed = true;
                 }
-                self.last_step.missed_in_view += usize::from(missed);
+                self.last_step.counts.tracks_missed_in_view += u64::from(missed);
                 let track = &mut self.table.tracks_mut()[i];
                 track.estimate = self.imms[track.class.index()].coast(&self.priors[i]);
                 track.record_miss();

@@ -128,6 +128,9 @@ static void errors() {
     }
     const std::string before = snapshot(tracker);
     const PrimmStats stats_before = tracker.stats();
+    /* Every accepted measurement updated or started one track; no speed needed bounding. */
+    CHECK(stats_before.tracks_updated + stats_before.tracks_initiated == stats_before.measurements_accepted);
+    CHECK(stats_before.speeds_bounded == 0);
     try {
         tracker.step(0.05, two_objects(9));
         CHECK(false);
