@@ -5,7 +5,7 @@
 # and writes OUT_DIR/reflection_models.csv (docs/EVALUATION.md, "One tracker for every radar").
 #   tools/reflection_models.sh [OUT_DIR] [SEQUENCES] [PRESET...]
 # Defaults: out/reflection_models, 24 sequences, presets default extended robustness
-# clutter_turning centroid.
+# clutter_turning centroid; PRIMM_BINARY names a binary to use instead of building one.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/reflection_models}
@@ -14,8 +14,8 @@ shift $(( $# > 2 ? 2 : $# ))
 presets=("$@")
 [ ${#presets[@]} -gt 0 ] || presets=(default extended robustness clutter_turning centroid)
 mkdir -p "$out"
-cargo build --release --quiet -p primm
-primm=target/release/primm
+primm=${PRIMM_BINARY:-target/release/primm}
+[ -n "${PRIMM_BINARY:-}" ] || cargo build --release --quiet -p primm
 for model in outline centre auto; do
     python3 - "$model" "$out/$model.toml" <<'PY'
 import sys

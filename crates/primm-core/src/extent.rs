@@ -349,8 +349,12 @@ mod tests {
     #[test]
     fn seen_from_behind_the_reflection_is_on_the_rear_and_says_little_across_it() {
         // A car driving along +x at 10 m/s, the sensor 20 m behind it.
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(20.0, 0.0), DVec2::new(10.0, 0.0)), DVec2::ZERO, 1.0);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(20.0, 0.0), DVec2::new(10.0, 0.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         assert!(near(reflection.offset_m, DVec2::new(-2.25, 0.0), 0.05), "{reflection:?}");
         // Along x the rear face pins the centre; across it, the reflection is opposite the
         // sensor wherever the car is: the width's uniform spread and the contour spread.
@@ -360,16 +364,24 @@ mod tests {
 
     #[test]
     fn seen_from_a_diagonal_the_reflection_is_the_nearest_corner() {
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(10.0, 10.0), DVec2::new(0.0, 5.0)), DVec2::ZERO, 1.0);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(10.0, 10.0), DVec2::new(0.0, 5.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         // Heading +y: the long axis is y, the width x; the corner toward the origin.
         assert!(near(reflection.offset_m, DVec2::new(-0.9, -2.25), 0.05), "{reflection:?}");
     }
 
     #[test]
     fn abeam_the_reflection_is_on_the_near_side_and_the_position_along_it_is_left_open() {
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(0.5, 10.0), DVec2::new(-8.0, 0.0)), DVec2::ZERO, 1.0);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(0.5, 10.0), DVec2::new(-8.0, 0.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         assert!(near(reflection.offset_m, DVec2::new(0.0, -0.9), 0.05), "{reflection:?}");
         // Along the side (x) the variance is the length's uniform spread.
         assert!(reflection.covariance_m2.x_axis.x > 4.5 * 4.5 / 12.0 * 0.95, "{reflection:?}");
@@ -404,8 +416,12 @@ mod tests {
 
     #[test]
     fn without_a_heading_the_reflection_lies_toward_the_sensor() {
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(0.0, 30.0), DVec2::new(0.3, 0.0)), DVec2::ZERO, 1.0);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(0.0, 30.0), DVec2::new(0.3, 0.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         assert!(near(reflection.offset_m, DVec2::new(0.0, -1.575), 1e-12), "{reflection:?}");
         let spread = reflection.covariance_m2;
         assert!((spread.y_axis.y - 0.675f64.powi(2)).abs() < 1e-12 && (spread.x_axis.x - 0.25).abs() < 1e-12);
@@ -461,7 +477,8 @@ mod tests {
 
     #[test]
     fn a_sensor_at_the_centre_gives_no_offset() {
-        let reflection = expected_reflection(&car(), &prior(DVec2::ZERO, DVec2::new(5.0, 0.0)), DVec2::ZERO, 1.0);
+        let reflection =
+            expected_reflection(&car(), &prior(DVec2::ZERO, DVec2::new(5.0, 0.0)), DVec2::ZERO, 1.0);
         assert_eq!(reflection.offset_m, DVec2::ZERO);
         assert!(reflection.covariance_m2.determinant() > 0.0);
     }

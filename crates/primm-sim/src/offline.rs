@@ -63,7 +63,7 @@ pub fn track_sequence<P: DisplacementPredictor>(
             source,
         })?;
         let outputs =
-            if tracker.last_step().late { tracker.late_frame_outputs() } else { tracker.last_outputs() };
+            if tracker.last_step().late() { tracker.late_frame_outputs() } else { tracker.last_outputs() };
         on_frame(recorded, outputs);
     }
     Ok(())

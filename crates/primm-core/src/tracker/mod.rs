@@ -347,7 +347,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// (before the newer frames were tracked again). Empty after any other step, and when the
     /// late frame itself was refused.
     pub fn late_frame_outputs(&self) -> &[TrackOutput] {
-        if self.last_step.late {
+        if self.last_step.late() {
             &self.late_outputs
         } else {
             &[]
