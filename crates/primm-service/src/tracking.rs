@@ -37,7 +37,7 @@ use iceoryx2::sample_mut_uninit::SampleMutUninit;
 use primm_core::predictor::DisplacementPredictor;
 use primm_core::stage_timing::Stage;
 use primm_core::track::TrackOutput;
-use primm_core::tracker::{StepError, StepSummary, Tracker, TrackerStats};
+use primm_core::tracker::{StepError, StepSummary, Tracker};
 use primm_wire::{
     FrameStatus, LatencyReport, MeasurementFrame, StageLatency, TrackFrame, TrackFrameHeader,
     TrackFrameWriter, FRAME_FLAG_STREAM_END, STAGE_CAPACITY, TRACK_FLAG_LATE_FRAME, TRACK_FLAG_PREDICTED,
@@ -657,34 +657,11 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             c.resets_new_publisher,
             c.resets_interval_too_long,
             c.publish_failures,
-            tracker_counters_line(self.tracker.stats()),
+            summary_lines::tracker_counters_line(self.tracker.stats()),
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
-            + &sensor_lines(&self.tracker)
+            + &summary_lines::sensor_lines(&self.tracker)
     }
-}
-
-/// The sensors' estimates for the summary, one line each after a newline (nothing before any
-/// sensor took a sample).
-fn sensor_lines<P: DisplacementPredictor>(tracker: &Tracker<P>) -> String {
-    let report = tracker.sensors().report(tracker.config()).to_string();
-    if report.is_empty() {
-        report
-    } else {
-        format!("\nsensors (estimated from the data):\n{report}")
-    }
-}
-
-/// The tracker's counters that are not zero, by name: `tracker: name value, ...` (every counter
-/// not named is zero).
-fn tracker_counters_line(stats: &TrackerStats) -> String {
-    let counted: Vec<String> = stats
-        .named_values()
-        .iter()
-        .filter(|(_, value)| *value > 0)
-        .map(|(name, value)| format!("{name} {value}"))
-        .collect();
-    format!("tracker: {} (the other counters are zero)", counted.join(", "))
 }
 
 /// The header of the answer to `frame` (its publish time is stamped when it is sent).
