@@ -657,10 +657,10 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             c.resets_new_publisher,
             c.resets_interval_too_long,
             c.publish_failures,
-            summary_lines::tracker_counters_line(self.tracker.stats()),
+            crate::summary_lines::tracker_counters_line(self.tracker.stats()),
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
-            + &summary_lines::sensor_lines(&self.tracker)
+            + &crate::summary_lines::sensor_lines(&self.tracker)
     }
 }
 
