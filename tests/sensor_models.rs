@@ -161,10 +161,17 @@ fn the_detection_estimate_follows_how_often_a_radar_reports_a_confirmed_car() {
     config.frame.estimation.detection_prior_samples = 20.0;
     let estimation = config.frame.estimation;
     let mut tracker = Tracker::new(config).unwrap();
+    let mut noise = Noise(5);
     for k in 0..3000 {
         let mut frame = Frame::new(k as f64 * 0.05);
         frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
-        let (x_m, y_m, ground_truth_id) = if k % 4 == 3 { (-60.0, 40.0, 9) } else { (20.0, -5.0, 1) };
+        // In the fourth scan the radar reports a false detection somewhere else (never twice at
+        // one place, so it confirms nothing) instead of the car.
+        let (x_m, y_m, ground_truth_id) = if k % 4 == 3 {
+            (-60.0 + 100.0 * noise.next(), 60.0 + 100.0 * noise.next(), 9)
+        } else {
+            (20.0, -5.0, 1)
+        };
         frame.measurements.push(Measurement {
             x_m,
             y_m,
