@@ -24,6 +24,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+// The sensor id that asks for the radars without a configured mount (no sensor id, or one
+// not in `frame.sensors`), which share one set of estimates.
+#define PRIMM_UNMOUNTED_SENSOR -1
+
 // Most live tracks a tracker holds (the size of a buffer that always fits
 // `primm_tracker_tracks`).
 #define PRIMM_MAX_TRACKS 512
@@ -85,6 +89,28 @@ typedef struct PrimmTracker PrimmTracker;
 
 // An object class code, one of the `PRIMM_OBJECT_CLASS_*` constants.
 typedef uint8_t PrimmObjectClass;
+
+// One sensor's estimates for one class.
+typedef struct PrimmSensorEstimates {
+  // Where the sensor's detections lie between the object's centre (0) and the outline (1).
+  double reflection;
+  // The scale the tracker uses for this sensor's detections now: `reflection` for a sensor
+  // whose `reflection` is "auto", else the configured model's (outline: the class's
+  // `extent.offset_scale`; centre: 0).
+  double reflection_used;
+  // Informative updates the reflection estimate has taken.
+  uint64_t reflection_samples;
+  // The detection probability, dimensionless.
+  double detection_probability;
+  // Opportunities (confirmed tracks in view) the detection estimate has taken.
+  uint64_t detection_samples;
+  // The clutter density, 1/m² per scan.
+  double clutter_density_per_m2;
+  // Scans the clutter estimate has taken.
+  uint64_t clutter_scans;
+  // Times any of the three would have left its bounds and was held at them.
+  uint64_t bounded;
+} PrimmSensorEstimates;
 
 // A method code, one of the `PRIMM_METHOD_*` constants: which IMM modes the tracker runs.
 typedef uint32_t PrimmMethod;
@@ -446,6 +472,17 @@ int32_t primm_object_class_from_name(const char *name);
 // # Safety
 // `buf` is NULL or points to `len` writable bytes.
 size_t primm_format_f64(double value, char *buf, size_t len);
+
+// Writes the estimates of sensor `sensor_id` (a configured id, or `PRIMM_UNMOUNTED_SENSOR`)
+// for `class_code` to `*out`. `PRIMM_STATUS_INVALID_ARGUMENT` for an id that is not
+// configured or an unknown class.
+//
+// # Safety
+// `tracker` is NULL or a live handle used by no other thread; `out` is NULL or writable.
+enum PrimmStatus primm_tracker_sensor_estimates(struct PrimmTracker *tracker,
+                                                int32_t sensor_id,
+                                                PrimmObjectClass class_code,
+                                                struct PrimmSensorEstimates *out);
 
 // The default options: the built-in configuration (`config/primm.toml`) with its modes
 // (PR-IMM), the built-in PR model, inference inside `primm_tracker_step`.
