@@ -95,3 +95,58 @@ pub unsafe extern "C" fn primm_tracker_sensor_estimates(
     // SAFETY: forwarded caller contract.
     unsafe { with_tracker(tracker, body) }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::status::PrimmStatus;
+    use crate::tracker::{primm_tracker_create, primm_tracker_destroy, primm_tracker_step};
+    use crate::types::{PrimmMeasurement, PrimmStepSummary, PRIMM_OBJECT_CLASS_CAR};
+    use core::ptr::{null, null_mut};
+
+    #[test]
+    fn a_configured_sensor_reports_its_estimates_and_bad_arguments_are_refused() {
+        let mut tracker = null_mut();
+        // SAFETY: NULL options (the defaults) and a valid out-pointer.
+        assert_eq!(unsafe { primm_tracker_create(null(), &mut tracker) }, PrimmStatus::Ok);
+        for k in 0..40 {
+            let measurement = PrimmMeasurement {
+                x_m: 20.0 + 0.5 * k as f64,
+                y_m: -10.0,
+                radial_velocity_mps: 5.0,
+                rcs_dbsm: 10.0,
+                ground_truth_id: 1,
+                sensor_id: 1,
+                class_code: PRIMM_OBJECT_CLASS_CAR,
+            };
+            let mut summary = PrimmStepSummary::default();
+            // SAFETY: a live tracker, one measurement, a writable summary.
+            let status =
+                unsafe { primm_tracker_step(tracker, 0.05 * k as f64, &measurement, 1, &mut summary) };
+            assert_eq!(status, PrimmStatus::Ok);
+        }
+        let mut out = PrimmSensorEstimates::default();
+        // SAFETY: a live tracker and a writable out-pointer, here and below.
+        let status = unsafe { primm_tracker_sensor_estimates(tracker, 1, PRIMM_OBJECT_CLASS_CAR, &mut out) };
+        assert_eq!(status, PrimmStatus::Ok);
+        assert!(out.clutter_scans == 40, "{out:?}");
+        assert!(out.detection_samples > 0, "{out:?}");
+        assert!((0.0..=1.0).contains(&out.reflection) && (0.0..=1.0).contains(&out.detection_probability));
+        // The shipped model is the outline's: the class's offset scale.
+        assert_eq!(out.reflection_used, 0.5);
+        let status = unsafe {
+            primm_tracker_sensor_estimates(tracker, PRIMM_UNMOUNTED_SENSOR, PRIMM_OBJECT_CLASS_CAR, &mut out)
+        };
+        assert_eq!(status, PrimmStatus::Ok);
+        assert_eq!(out.clutter_scans, 0, "no radar without a mount scanned");
+        for (sensor_id, class_code) in [(99, PRIMM_OBJECT_CLASS_CAR), (-2, PRIMM_OBJECT_CLASS_CAR), (1, 7)] {
+            let status = unsafe { primm_tracker_sensor_estimates(tracker, sensor_id, class_code, &mut out) };
+            assert_eq!(status, PrimmStatus::InvalidArgument, "{sensor_id} {class_code}");
+        }
+        let status =
+            unsafe { primm_tracker_sensor_estimates(tracker, 1, PRIMM_OBJECT_CLASS_CAR, null_mut()) };
+        assert_eq!(status, PrimmStatus::NullArgument);
+        // SAFETY: the handle is live and not used again.
+        unsafe { primm_tracker_destroy(tracker) };
+    }
+}

@@ -170,12 +170,13 @@ static void errors() {
     CHECK(small[0].id == 777);
 
     try {
-        primm::object_class_from_name("bus");
+        primm::object_class_from_name("tram");
         CHECK(false);
     } catch (const primm::Error &error) {
         CHECK(error.status() == PRIMM_STATUS_INVALID_ARGUMENT);
     }
     CHECK(primm::object_class_from_name("pedestrian") == PRIMM_OBJECT_CLASS_PEDESTRIAN);
+    CHECK(primm::object_class_from_name("bus") == PRIMM_OBJECT_CLASS_CAR);
 }
 
 static void spans_and_steps() {
