@@ -267,3 +267,15 @@ fn bad_sensor_model_keys_are_refused_by_name() {
     twice.frame.sensors.push(first);
     assert_eq!(invalid_key(Tracker::new(twice)), "frame.sensors");
 }
+
+#[test]
+fn the_object_list_sensor_file_is_the_shipped_configuration_with_every_radar_at_the_centre() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/sensors/object_list.toml");
+    let object_list = primm_config::from_file(&path).unwrap();
+    let mut expected = Config::default();
+    expected.frame.unmounted_reflection = ReflectionModel::Centre;
+    for mount in expected.frame.sensors.iter_mut() {
+        mount.reflection = ReflectionModel::Centre;
+    }
+    assert_eq!(object_list, expected);
+}
