@@ -159,7 +159,6 @@ fn the_detection_estimate_follows_how_often_a_radar_reports_a_confirmed_car() {
     // Radar 1 scans every frame and reports the standing car in three scans of four.
     let mut config = config(ReflectionModel::Outline);
     config.frame.estimation.detection_prior_samples = 20.0;
-    let estimation = config.frame.estimation;
     let mut tracker = Tracker::new(config).unwrap();
     let mut noise = Noise(5);
     for k in 0..3000 {
@@ -185,7 +184,7 @@ fn the_detection_estimate_follows_how_often_a_radar_reports_a_confirmed_car() {
     }
     let sensors = tracker.sensors();
     let detection = sensors.get(sensors.slot(Some(1))).estimates[ObjectClass::Car.index()].detection;
-    let value = detection.value(&estimation);
+    let value = detection.value();
     assert!(detection.samples > 1000, "{detection:?}");
     assert!((value - 0.75).abs() < 0.08, "{value} {detection:?}");
 }
@@ -193,7 +192,6 @@ fn the_detection_estimate_follows_how_often_a_radar_reports_a_confirmed_car() {
 #[test]
 fn clutter_that_never_confirms_raises_the_clutter_estimate_above_its_prior() {
     let config = config(ReflectionModel::Outline);
-    let estimation = config.frame.estimation;
     let prior = config.classes.car.existence.clutter_density_per_m2;
     let mut tracker = Tracker::new(config).unwrap();
     let mut noise = Noise(11);
@@ -216,7 +214,7 @@ fn clutter_that_never_confirms_raises_the_clutter_estimate_above_its_prior() {
     }
     let sensors = tracker.sensors();
     let clutter = sensors.get(sensors.slot(Some(1))).estimates[ObjectClass::Car.index()].clutter;
-    let value = clutter.value_per_m2(&estimation);
+    let value = clutter.value_per_m2();
     // Ten per scan over a 200 m all-around field of view: 10 / (π · 200²) ≈ 8e-5 /m² of clutter
     // that the sensor's field holds; the estimate sees those whose tracks ended unconfirmed.
     assert!(clutter.scans == 2000, "{clutter:?}");

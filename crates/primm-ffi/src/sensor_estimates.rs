@@ -54,14 +54,13 @@ impl PrimmSensorEstimates {
             sensors.get(slot)
         };
         let estimates = &sensor.estimates[class.index()];
-        let estimation = &config.frame.estimation;
         Ok(PrimmSensorEstimates {
             reflection: estimates.reflection.value,
             reflection_used: sensor.reflection_scale(class, &config.classes.get(class).extent),
             reflection_samples: estimates.reflection.samples,
-            detection_probability: estimates.detection.value(estimation),
+            detection_probability: estimates.detection.value(),
             detection_samples: estimates.detection.samples,
-            clutter_density_per_m2: estimates.clutter.value_per_m2(estimation),
+            clutter_density_per_m2: estimates.clutter.value_per_m2(),
             clutter_scans: estimates.clutter.scans,
             bounded: estimates.reflection.bounded + estimates.detection.bounded + estimates.clutter.bounded,
         })

@@ -209,7 +209,7 @@ impl DetectionEstimate {
     }
 
     /// The estimate, within [`DETECTION_BOUNDS`].
-    pub fn value(&self, _config: &EstimationConfig) -> f64 {
+    pub fn value(&self) -> f64 {
         if !(self.opportunities > 0.0) {
             return self.prior;
         }
@@ -265,7 +265,7 @@ impl ClutterEstimate {
     }
 
     /// The estimate, 1/m², within [`CLUTTER_BOUNDS_PER_M2`].
-    pub fn value_per_m2(&self, _config: &EstimationConfig) -> f64 {
+    pub fn value_per_m2(&self) -> f64 {
         if !(self.exposure_m2 > 0.0) {
             return self.prior_per_m2;
         }
@@ -292,7 +292,7 @@ impl ClutterEstimate {
     }
 
     /// Takes `count` detections found to be false (a tentative track ended unconfirmed).
-    pub fn observe_false(&mut self, _config: &EstimationConfig, count: u32) {
+    pub fn observe_false(&mut self, count: u32) {
         if !(self.exposure_m2 > 0.0) {
             // No scan of the sensor yet to hold them against.
             return;
@@ -357,23 +357,23 @@ mod tests {
     fn a_detection_estimate_moves_from_its_prior_to_the_observed_rate() {
         let config = EstimationConfig::default();
         let mut estimate = DetectionEstimate::new(0.2);
-        assert_eq!(estimate.value(&config), 0.2);
+        assert_eq!(estimate.value(), 0.2);
         for k in 0..10_000 {
             estimate.observe(&config, k % 10 != 0);
         }
-        assert!((estimate.value(&config) - 0.9).abs() < 0.02, "{}", estimate.value(&config));
+        assert!((estimate.value() - 0.9).abs() < 0.02, "{}", estimate.value());
     }
 
     #[test]
     fn a_clutter_estimate_counts_false_detections_per_area_and_scan() {
         let config = EstimationConfig::default();
         let mut estimate = ClutterEstimate::new(1e-4);
-        assert_eq!(estimate.value_per_m2(&config), 1e-4);
+        assert_eq!(estimate.value_per_m2(), 1e-4);
         for _ in 0..20_000 {
             estimate.observe_scan(&config, 1000.0);
-            estimate.observe_false(&config, 2);
+            estimate.observe_false(2);
         }
-        let value = estimate.value_per_m2(&config);
+        let value = estimate.value_per_m2();
         assert!((value - 2e-3).abs() < 1e-4, "{value}");
     }
 
@@ -383,9 +383,9 @@ mod tests {
         let mut estimate = ClutterEstimate::new(1e-4);
         for _ in 0..3000 {
             estimate.observe_scan(&config, 10.0);
-            estimate.observe_false(&config, 50);
+            estimate.observe_false(50);
         }
-        assert_eq!(estimate.value_per_m2(&config), CLUTTER_BOUNDS_PER_M2.1);
+        assert_eq!(estimate.value_per_m2(), CLUTTER_BOUNDS_PER_M2.1);
         assert!(estimate.bounded > 0);
     }
 }

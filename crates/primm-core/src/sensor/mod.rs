@@ -209,16 +209,6 @@ impl SensorSet {
     pub fn iter(&self) -> impl Iterator<Item = &Sensor> {
         self.sensors[..self.mounted].iter().chain(core::iter::once(&self.sensors[UNMOUNTED]))
     }
-
-    /// The estimates of every sensor that has taken a sample of any kind, as (sensor id, class,
-    /// estimates): the mounted ones by id, the unmounted one as `None`.
-    pub fn estimates(&self) -> impl Iterator<Item = (Option<u16>, ObjectClass, &ClassEstimates)> {
-        self.iter().flat_map(|sensor| {
-            ObjectClass::ALL
-                .into_iter()
-                .map(move |class| (sensor.id(), class, &sensor.estimates[class.index()]))
-        })
-    }
 }
 
 /// The estimates of every sensor that took a sample, one line per sensor and class, as the
@@ -238,7 +228,6 @@ impl SensorSet {
 
 impl core::fmt::Display for SensorReport<'_> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        let estimation = &self.config.frame.estimation;
         let mut first = true;
         for sensor in self.sensors.iter() {
             for class in ObjectClass::ALL {
@@ -272,9 +261,9 @@ impl core::fmt::Display for SensorReport<'_> {
                 write!(
                     f,
                     "detection probability {:.3} ({} opportunities), clutter {:.2e} /m² ({} scans), held at bounds {}",
-                    estimates.detection.value(estimation),
+                    estimates.detection.value(),
                     estimates.detection.samples,
-                    estimates.clutter.value_per_m2(estimation),
+                    estimates.clutter.value_per_m2(),
                     estimates.clutter.scans,
                     estimates.reflection.bounded + estimates.detection.bounded + estimates.clutter.bounded,
                 )?;

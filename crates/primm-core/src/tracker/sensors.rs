@@ -89,9 +89,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// A tentative `track` that ends without confirmation: its detections were false, as far
     /// as the tracker can tell; they go to the clutter of the sensor that started it.
     pub(super) fn learn_false_track(&mut self, class: ObjectClass, birth_slot: u8, hits: u32) {
-        let config = self.config.frame.estimation;
         let sensor = self.sensors.get_mut(usize::from(birth_slot));
-        sensor.estimates[class.index()].clutter.observe_false(&config, hits);
+        sensor.estimates[class.index()].clutter.observe_false(hits);
     }
 }
 

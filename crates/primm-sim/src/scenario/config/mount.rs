@@ -112,9 +112,9 @@ impl From<RadarMount> for RadarMountFields {
 }
 
 /// The layout of a sensor whose boresight and half field of view are given in degrees,
-/// converted as a scenario file's `yaw_deg` and `half_fov_deg` are.
-#[cfg(test)]
-fn layout_in_degrees(
+/// converted as a scenario file's `yaw_deg` and `half_fov_deg` are, with the tracker's noise
+/// and measurement-model keys neutral, as a scenario file's mounts have them.
+pub(super) fn layout_in_degrees(
     id: u16,
     x_m: f64,
     y_m: f64,

@@ -226,20 +226,7 @@ const DENSE_PEDESTRIAN_COUNT: u32 = 110;
 /// The one sensor of [`Preset::DenseStatic`]: at the platform's reference point, looking along
 /// its x axis, ±60° and 100 m.
 fn static_sensor_layout() -> SensorMount {
-    SensorMount {
-        id: 0,
-        x_m: 0.0,
-        y_m: 0.0,
-        yaw_rad: 0.0,
-        half_fov_rad: 60f64.to_radians(),
-        max_range_m: 100.0,
-        detection_probability_factor: 1.0,
-        clutter_density_factor: 1.0,
-        range_std_m: 0.0,
-        azimuth_std_rad: 0.0,
-        azimuth_std_max_factor: 1.0,
-        reflection: primm_core::sensor::ReflectionModel::Outline,
-    }
+    super::mount::layout_in_degrees(0, 0.0, 0.0, 0.0, 60.0, 100.0)
 }
 
 /// The faster and more aggressive cars of [`Preset::Robustness`].
