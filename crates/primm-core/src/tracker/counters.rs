@@ -133,6 +133,10 @@ macro_rules! tracker_counters {
             /// extended object (`classes.<class>.extent.absorb_extra_detections`): they started
             /// no track.
             detections_absorbed: tracked,
+            /// Detections of point-cloud radars that joined another detection's group
+            /// (`crate::grouping`): the accepted detections of grouped frames less the
+            /// measurements their groups became.
+            detections_grouped: tracked,
             /// Existing tracks updated by an assigned measurement.
             tracks_updated: tracked,
             /// Tracks without a measurement while a sensor of the frame had them in view (their

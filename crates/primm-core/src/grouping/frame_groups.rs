@@ -1,0 +1,223 @@
+//! The grouping of one frame: which detection joins which group, and each group's measurement.
+//! The workspace is sized once for a full frame; [`FrameGroups::form`] allocates nothing.
+
+use super::linkage::{LinkPoint, LinkRule, Linkage};
+use super::summary::summarise;
+use crate::limits::MAX_MEASUREMENTS_PER_FRAME;
+use crate::measurement::Measurement;
+use alloc::boxed::Box;
+use alloc::vec;
+use glam::DVec2;
+
+const NONE: u16 = u16::MAX;
+const CAPACITY: usize = MAX_MEASUREMENTS_PER_FRAME;
+
+/// One accepted detection handed to the grouping.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detection {
+    /// The detection, in the tracking frame.
+    pub measurement: Measurement,
+    /// Its index in the frame.
+    pub frame_index: u16,
+    /// Its radar's slot in the sensor set.
+    pub sensor_slot: u8,
+    /// Its radar's position in the tracking frame, m.
+    pub sensor_position_m: DVec2,
+    /// Whether its radar's detections are grouped; a detection that is not is a group of its
+    /// own.
+    pub grouped: bool,
+    /// The table row of the confirmed track whose object holds it, if any.
+    pub owner: Option<u16>,
+}
+
+/// The groups of one frame.
+#[derive(Debug, Clone)]
+pub struct FrameGroups {
+    detections: Box<[Option<Detection>]>,
+    /// The detections' measurements, aligned with `detections`.
+    measurements: Box<[Measurement]>,
+    count: usize,
+    group_of: Box<[u16]>,
+    /// Each group's owner track and radar slot (`NONE` owner: a cluster or a single).
+    group_key: Box<[(u16, u8)]>,
+    /// The group of each linkage label.
+    label_group: Box<[u16]>,
+    /// Members of each group in frame order: `members[member_start[g]..member_start[g + 1]]`.
+    members: Box<[u16]>,
+    member_start: Box<[u16]>,
+    /// Where the next member of each group goes while the members are sorted.
+    next_member: Box<[u16]>,
+    points: Box<[LinkPoint]>,
+    /// The detection of each linkage point.
+    point_detection: Box<[u16]>,
+    scratch: Box<[f64]>,
+    linkage: Box<Linkage>,
+    groups: usize,
+}
+
+impl Default for FrameGroups {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl FrameGroups {
+    /// An empty workspace.
+    pub fn new() -> Self {
+        const NO_MEASUREMENT: Measurement = Measurement {
+            x_m: 0.0,
+            y_m: 0.0,
+            radial_velocity_mps: 0.0,
+            rcs_dbsm: 0.0,
+            class: crate::measurement::ObjectClass::Car,
+            sensor_id: None,
+            ground_truth_id: None,
+        };
+        const NO_POINT: LinkPoint =
+            LinkPoint { position_m: DVec2::ZERO, range_m: 0.0, radial_velocity_mps: 0.0, sensor_slot: 0 };
+        FrameGroups {
+            detections: vec![None; CAPACITY].into_boxed_slice(),
+            measurements: vec![NO_MEASUREMENT; CAPACITY].into_boxed_slice(),
+            count: 0,
+            group_of: vec![NONE; CAPACITY].into_boxed_slice(),
+            group_key: vec![(NONE, 0); CAPACITY].into_boxed_slice(),
+            label_group: vec![NONE; CAPACITY].into_boxed_slice(),
+            members: vec![0; CAPACITY].into_boxed_slice(),
+            member_start: vec![0; CAPACITY + 1].into_boxed_slice(),
+            next_member: vec![0; CAPACITY + 1].into_boxed_slice(),
+            points: vec![NO_POINT; CAPACITY].into_boxed_slice(),
+            point_detection: vec![0; CAPACITY].into_boxed_slice(),
+            scratch: vec![0.0; CAPACITY].into_boxed_slice(),
+            linkage: Box::new(Linkage::new()),
+            groups: 0,
+        }
+    }
+
+    /// Forgets the previous frame.
+    pub fn clear(&mut self) {
+        self.count = 0;
+        self.groups = 0;
+    }
+
+    /// Adds a detection; `false` (and nothing added) when the workspace is full.
+    pub fn push(&mut self, detection: Detection) -> bool {
+        if self.count == CAPACITY {
+            return false;
+        }
+        self.detections[self.count] = Some(detection);
+        self.measurements[self.count] = detection.measurement;
+        self.count += 1;
+        true
+    }
+
+    /// The detections added since [`clear`](Self::clear).
+    pub fn detections(&self) -> impl Iterator<Item = &Detection> {
+        self.detections[..self.count].iter().flatten()
+    }
+
+    /// Groups the detections: a grouped detection with an owner joins its owner's group of its
+    /// radar, the other grouped ones are linked by `rule`, and each detection that is not
+    /// grouped is a group of its own. Groups are numbered in the order of their first
+    /// detection. Returns the number of groups.
+    pub fn form(&mut self, rule: &LinkRule) -> usize {
+        self.link_unowned(rule);
+        self.groups = 0;
+        for index in 0..self.count {
+            let Some(detection) = self.detections[index] else { continue };
+            let group = match (detection.grouped, detection.owner) {
+                (false, _) => self.open_group((NONE, detection.sensor_slot)),
+                (true, Some(owner)) => self.group_of_key((owner, detection.sensor_slot)),
+                (true, None) => {
+                    let label = self.linkage.label_of(self.group_of[index] as usize);
+                    if self.label_group[label] == NONE {
+                        self.label_group[label] = self.open_group((NONE, detection.sensor_slot));
+                    }
+                    self.label_group[label]
+                }
+            };
+            self.group_of[index] = group;
+        }
+        self.sort_members();
+        self.groups
+    }
+
+    /// Links the grouped detections without an owner; `group_of` holds each one's linkage
+    /// point until [`form`](Self::form) overwrites it with its group.
+    fn link_unowned(&mut self, rule: &LinkRule) {
+        let mut points = 0;
+        for index in 0..self.count {
+            let Some(detection) = self.detections[index] else { continue };
+            if detection.grouped && detection.owner.is_none() {
+                let position_m = detection.measurement.position();
+                self.points[points] = LinkPoint {
+                    position_m,
+                    range_m: position_m.distance(detection.sensor_position_m),
+                    radial_velocity_mps: detection.measurement.radial_velocity_mps,
+                    sensor_slot: detection.sensor_slot,
+                };
+                self.point_detection[points] = index as u16;
+                self.group_of[index] = points as u16;
+                points += 1;
+            }
+        }
+        let labels = self.linkage.cluster(&self.points[..points], rule);
+        self.label_group[..labels].fill(NONE);
+    }
+
+    fn open_group(&mut self, key: (u16, u8)) -> u16 {
+        self.group_key[self.groups] = key;
+        self.groups += 1;
+        (self.groups - 1) as u16
+    }
+
+    /// The group of an owner track and radar, opened at its first detection.
+    fn group_of_key(&mut self, key: (u16, u8)) -> u16 {
+        match self.group_key[..self.groups].iter().rposition(|&known| known == key) {
+            Some(group) => group as u16,
+            None => self.open_group(key),
+        }
+    }
+
+    /// Lists each group's members in frame order (a counting sort by group).
+    fn sort_members(&mut self) {
+        self.member_start[..=self.groups].fill(0);
+        for index in 0..self.count {
+            if self.detections[index].is_some() {
+                self.member_start[self.group_of[index] as usize + 1] += 1;
+            }
+        }
+        for group in 0..self.groups {
+            self.member_start[group + 1] += self.member_start[group];
+        }
+        self.next_member[..=self.groups].copy_from_slice(&self.member_start[..=self.groups]);
+        for index in 0..self.count {
+            if self.detections[index].is_some() {
+                let group = self.group_of[index] as usize;
+                self.members[self.next_member[group] as usize] = index as u16;
+                self.next_member[group] += 1;
+            }
+        }
+    }
+
+    /// The number of groups of the latest [`form`](Self::form).
+    pub fn groups(&self) -> usize {
+        self.groups
+    }
+
+    /// Group `group`'s members: indices of [`detections`](Self::detections) in frame order.
+    pub fn members(&self, group: usize) -> &[u16] {
+        &self.members[self.member_start[group] as usize..self.member_start[group + 1] as usize]
+    }
+
+    /// The frame index of group `group`'s first detection.
+    pub fn first_frame_index(&self, group: usize) -> u16 {
+        let first = self.members(group)[0] as usize;
+        self.detections[first].map_or(0, |detection| detection.frame_index)
+    }
+
+    /// Group `group`'s measurement ([`summarise`]).
+    pub fn measurement(&mut self, group: usize) -> Measurement {
+        let (start, end) = (self.member_start[group] as usize, self.member_start[group + 1] as usize);
+        summarise(&self.measurements[..self.count], &self.members[start..end], &mut self.scratch)
+    }
+}

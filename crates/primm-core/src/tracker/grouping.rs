@@ -1,0 +1,163 @@
+//! Group the detections of point-cloud radars into object measurements (`crate::grouping`),
+//! after the prediction and before the association: the validated frame then holds one
+//! measurement per group, and the outputs name each group by its first detection's index.
+
+use super::{MeasurementFate, Tracker};
+use crate::grouping::frame_groups::Detection;
+use crate::grouping::DetectionModel;
+use crate::measurement::{FrameView, Measurement};
+use crate::predictor::DisplacementPredictor;
+
+impl<P: DisplacementPredictor> Tracker<P> {
+    /// Hands the frame's accepted detections of radars that deliver points (or may: `auto`)
+    /// to the grouping with the confirmed track whose object holds each, counts what the
+    /// `auto` radars' data say, and, when a radar of the frame delivers points, replaces the
+    /// validated frame's measurements by the groups'. A frame of object radars only is left as
+    /// it is.
+    pub(super) fn group_detections(&mut self) {
+        self.frame_groups.clear();
+        self.grouped_frame = false;
+        let mut any_points = false;
+        let mut any_candidates = false;
+        for index in 0..self.validated.len() {
+            let Some(measurement) = self.validated.accepted(index) else { continue };
+            let slot = self.sensors.slot(measurement.sensor_id);
+            let sensor = self.sensors.get(slot);
+            let candidate = sensor.detections != DetectionModel::Objects;
+            let grouped = sensor.groups_detections();
+            let owner = if candidate { self.owner_of(&measurement) } else { None };
+            let detection = Detection {
+                measurement,
+                frame_index: index as u16,
+                sensor_slot: slot as u8,
+                sensor_position_m: sensor.position_m(self.step_pose),
+                grouped,
+                owner,
+            };
+            // The workspace holds a full frame, so this never refuses.
+            let _ = self.frame_groups.push(detection);
+            any_points |= grouped;
+            any_candidates |= candidate;
+        }
+        if any_candidates {
+            self.learn_points();
+        }
+        if any_points {
+            self.replace_by_groups();
+        }
+    }
+
+    /// The table row of the confirmed track (of any class: labels flip) whose object at its
+    /// prior holds `measurement` ([`crate::extent::lies_on_object`] with the track's class's
+    /// extent). When several do, the nearest one's; but of two tracks of one class whose centres
+    /// lie within the class's `duplicate_distance_m`, which are likely one object followed
+    /// twice, the older one's, so that the younger one starves and ends rather than taking a
+    /// share of the object's detections for ever.
+    fn owner_of(&self, measurement: &Measurement) -> Option<u16> {
+        let position_m = measurement.position();
+        let tracks = self.table.tracks();
+        let mut best: Option<(usize, f64)> = None;
+        for row in 0..tracks.len() {
+            let Some(distance_m2) = self.holds(row, position_m) else { continue };
+            let better = match best {
+                None => true,
+                Some((best_row, best_m2)) => {
+                    let (track, other) = (&tracks[row], &tracks[best_row]);
+                    let apart_m = self.priors[row].fused.mean.distance(self.priors[best_row].fused.mean);
+                    if track.class == other.class
+                        && apart_m <= self.config.classes.get(track.class).duplicate_distance_m
+                    {
+                        track.id < other.id
+                    } else {
+                        distance_m2 < best_m2
+                    }
+                }
+            };
+            if better {
+                best = Some((row, distance_m2));
+            }
+        }
+        best.map(|(row, _)| row as u16)
+    }
+
+    /// When the confirmed track in `row` holds `position_m` on its object at its prior: the
+    /// squared distance from its centre, m².
+    fn holds(&self, row: usize, position_m: glam::DVec2) -> Option<f64> {
+        let track = &self.table.tracks()[row];
+        if !track.status.is_confirmed() {
+            return None;
+        }
+        let prior = &self.priors[row];
+        let extent = &self.config.classes.get(track.class).extent;
+        let centre_m = prior.fused.mean;
+        crate::extent::lies_on_object(extent, centre_m, prior.fused_velocity_mps(), position_m)
+            .then(|| centre_m.distance_squared(position_m))
+    }
+
+    /// Each confirmed track's count of the frame's detections of an `auto` radar on its object
+    /// (every detection its box holds, whichever track owns it: a radar's point cloud tracked
+    /// one detection at a time gives an object several tracks, each holding the object's
+    /// detections) into that radar's [`PointsEstimate`](crate::sensor::points::PointsEstimate),
+    /// one radar at a time.
+    fn learn_points(&mut self) {
+        let config = self.config.frame.grouping;
+        let mut slots = arrayvec::ArrayVec::<u8, { crate::limits::MAX_SENSORS + 1 }>::new();
+        for detection in self.frame_groups.detections() {
+            let auto =
+                self.sensors.get(usize::from(detection.sensor_slot)).detections == DetectionModel::Auto;
+            if auto && detection.owner.is_some() && !slots.contains(&detection.sensor_slot) {
+                // There are at most MAX_SENSORS + 1 slots, so this never overflows.
+                let _ = slots.try_push(detection.sensor_slot);
+            }
+        }
+        let tracks = self.table.len();
+        for slot in slots {
+            self.owned_counts[..tracks].fill(0);
+            for detection in self.frame_groups.detections() {
+                if detection.sensor_slot != slot || detection.owner.is_none() {
+                    continue;
+                }
+                let position_m = detection.measurement.position();
+                for row in 0..tracks {
+                    if self.holds(row, position_m).is_some() {
+                        self.owned_counts[row] += 1;
+                    }
+                }
+            }
+            let estimate = &mut self.sensors.get_mut(usize::from(slot)).points;
+            for &count in self.owned_counts[..tracks].iter().filter(|&&count| count > 0) {
+                estimate.observe(&config, usize::from(count));
+            }
+        }
+    }
+
+    /// Forms the groups and makes them the validated frame's measurements.
+    fn replace_by_groups(&mut self) {
+        let rule = self.config.frame.grouping.link_rule();
+        let groups = self.frame_groups.form(&rule);
+        let detections = self.frame_groups.detections().count();
+        self.validated.set_len(groups);
+        for group in 0..groups {
+            let measurement = self.frame_groups.measurement(group);
+            self.validated.set(group, Some(measurement));
+            self.accepted[group] = true;
+            self.fates[group] = MeasurementFate::Unassigned;
+            self.group_first_index[group] = self.frame_groups.first_frame_index(group);
+        }
+        self.last_step.counts.detections_grouped += (detections - groups) as u64;
+        self.grouped_frame = true;
+    }
+
+    /// After a grouped frame: the measurement index of every row names its group's first
+    /// detection in the frame, as the outputs report it.
+    pub(super) fn name_groups_by_first_detection(&mut self) {
+        if !self.grouped_frame {
+            return;
+        }
+        for row in self.rows[..self.table.len()].iter_mut() {
+            if let Some(group) = row.measurement_index {
+                row.measurement_index = Some(self.group_first_index[usize::from(group)]);
+            }
+        }
+    }
+}
