@@ -3,6 +3,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use crate::io::MeasurementOrigin;
 use primm_core::measurement::ObjectClass;
 use primm_core::readable_number::readable;
 use primm_core::track::TrackStatus;
@@ -34,6 +35,10 @@ pub struct AssociationRecord {
     /// knows it (simulation), m/s.
     #[serde(default)]
     pub true_velocity: Option<DVec2>,
+    /// What produced the measurement (object, clutter or multipath ghost), where the data
+    /// source knows it; `None` when unknown.
+    #[serde(default)]
+    pub origin: Option<MeasurementOrigin>,
     /// Track that this measurement updated or started; `None` when no track took it.
     pub track_id: Option<u64>,
     /// The track's fused one-step prior position before this update (`eq:prior_fusion` for the
@@ -125,6 +130,7 @@ pub(crate) mod test_support {
             measured: DVec2::ZERO,
             true_position: None,
             true_velocity: None,
+            origin: None,
             track_id: track,
             prior: None,
             velocity: None,
@@ -143,6 +149,7 @@ pub(crate) mod test_support {
             measured: position,
             true_position: Some(position),
             true_velocity: None,
+            origin: None,
             track_id: Some(gt),
             prior: None,
             velocity: None,

@@ -30,7 +30,7 @@ use super::config::{
 };
 use super::kinematics::wrap_angle;
 use super::world::{Agent, World};
-use crate::io::{EgoPose, RecordedMeasurement};
+use crate::io::{EgoPose, MeasurementOrigin, RecordedMeasurement};
 use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 
 /// One scheduled scan: time since the start of recording and the index of the sensor in the
@@ -228,6 +228,7 @@ pub(crate) fn scan(
             },
             true_position: Some(truth.position),
             true_velocity: Some(truth.velocity),
+            origin: Some(MeasurementOrigin::Object),
         });
     }
     // Detection lists carry no meaningful order.
@@ -396,6 +397,7 @@ fn extended_detections(
             },
             true_position: Some(target.truth.position),
             true_velocity: Some(target.truth.velocity),
+            origin: Some(MeasurementOrigin::Object),
         });
     }
 }
