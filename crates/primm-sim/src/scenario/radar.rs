@@ -128,6 +128,21 @@ pub(super) struct ScanSensor<'a> {
     pub(super) unit: Normal<f64>,
 }
 
+impl<'a> ScanSensor<'a> {
+    /// The sensor `mount` of `radar` on the ego vehicle at `ego`.
+    fn new(radar: &'a RadarConfig, mount: &'a RadarMount, ego: &EgoPose) -> Self {
+        let (origin, boresight) = sensor_pose(ego, mount);
+        Self {
+            radar,
+            mount,
+            origin,
+            boresight,
+            half_fov: mount.layout.half_fov_rad,
+            unit: Normal::new(0.0, 1.0).expect("unit normal"),
+        }
+    }
+}
+
 /// The box faces of an object turned towards the sensor, weighted by their apparent width.
 pub(super) struct VisibleFaces {
     corners: [DVec2; 4],
@@ -175,15 +190,8 @@ pub(crate) fn scan(
     let radar = &cfg.radar;
     let mount = &radar.sensors[sensor_index];
     let ego = world.ego_pose();
-    let (origin, boresight) = sensor_pose(&ego, mount);
-    let sensor = ScanSensor {
-        radar,
-        mount,
-        origin,
-        boresight,
-        half_fov: mount.layout.half_fov_rad,
-        unit: Normal::new(0.0, 1.0).expect("unit normal"),
-    };
+    let sensor = ScanSensor::new(radar, mount, &ego);
+    let origin = sensor.origin;
     let scan_bias = radar.scan_doppler_bias_mps * sensor.unit.sample(rng);
     let mut out = Vec::new();
     let point_scan = cfg.point_cloud.enabled.then(|| PointScan::new(world, &sensor, cfg, &ego, scan_bias));

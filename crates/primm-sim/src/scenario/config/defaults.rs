@@ -271,7 +271,7 @@ impl Default for PointCloudConfig {
             wheelbase_fraction: 0.6,
             pedestrian_detection_count_probabilities: vec![0.6, 0.4],
             wall_offset_m: 12.0,
-            ghost_probability: 0.1,
+            ghost_probability: 0.3,
             max_ghost_detections: 2,
             ghost_rcs_drop_db: 8.0,
             class_flip_probability: 0.1,
