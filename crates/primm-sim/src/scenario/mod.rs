@@ -18,7 +18,10 @@
 //!   objects (see [`ClutterConfig`]);
 //! * optionally, vehicles measured as extended objects: separate detections from the visible
 //!   contour and corners of each vehicle's box, sometimes several per scan (see
-//!   [`ExtendedObjectConfig`]).
+//!   [`ExtendedObjectConfig`]);
+//! * optionally, detection-level output: several detections per object and scan, wheel
+//!   micro-Doppler, multipath ghosts mirrored in the walls along the roads and wrong class labels
+//!   (see [`PointCloudConfig`]).
 //!
 //! Everything is deterministic given the configuration and a seed. See `docs/scenario.md` for
 //! the full model description, its limits, and every parameter.

@@ -275,8 +275,8 @@ impl EvaluationReport {
         let mut text = render_table(&title, &header, &rows);
         self.append_notes(
             &mut text,
-            "* highest IDF1 / lowest other value in its column; estimated object frames are rows of \
-             confirmed tracks only",
+            "* highest IDF1 / lowest other value in its column (not Tracks/object); estimated object \
+             frames are frames of confirmed tracks only",
         );
         for method in Method::ALL {
             if self.result(method).is_some_and(|r| r.confirmed.is_none()) {
