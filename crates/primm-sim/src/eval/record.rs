@@ -3,6 +3,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use crate::io::MeasurementOrigin;
 use primm_core::measurement::ObjectClass;
 use primm_core::readable_number::readable;
 use primm_core::track::TrackStatus;
@@ -34,6 +35,10 @@ pub struct AssociationRecord {
     /// knows it (simulation), m/s.
     #[serde(default)]
     pub true_velocity: Option<DVec2>,
+    /// What produced the measurement (object, clutter or multipath ghost), where the data
+    /// source knows it; `None` when unknown.
+    #[serde(default)]
+    pub origin: Option<MeasurementOrigin>,
     /// Track that this measurement updated or started; `None` when no track took it.
     pub track_id: Option<u64>,
     /// The track's fused one-step prior position before this update (`eq:prior_fusion` for the
@@ -104,6 +109,38 @@ pub enum EvalError {
     Json(#[from] serde_json::Error),
 }
 
+/// For each row of one sequence, whether it stands for its object frame in the metrics that are
+/// computed row by row (prior RMSE, velocity errors, mode probabilities): the first row, in
+/// input order, of its frame with its ground-truth id and track. With several detections of one
+/// object in one frame taken by one track, the track's prior, velocity and mode probabilities
+/// are those of one update, counted once. A row with neither a ground-truth id nor a track stands
+/// for itself.
+pub fn object_frame_rows(records: &[AssociationRecord]) -> Vec<bool> {
+    first_rows(records, |r| {
+        (r.ground_truth_id.is_some() || r.track_id.is_some()).then_some((
+            r.frame,
+            r.ground_truth_id,
+            r.track_id,
+        ))
+    })
+}
+
+/// For each row of one sequence, whether it is the first row, in input order, of its frame with
+/// its ground-truth id (`false` for rows without one): one per ground-truth object frame.
+pub fn ground_truth_frame_rows(records: &[AssociationRecord]) -> Vec<bool> {
+    let first = first_rows(records, |r| r.ground_truth_id.map(|gt| (r.frame, Some(gt), None)));
+    first.into_iter().zip(records).map(|(first, r)| first && r.ground_truth_id.is_some()).collect()
+}
+
+/// Whether each row is the first with its key; rows without a key are always first.
+fn first_rows(
+    records: &[AssociationRecord],
+    key: impl Fn(&AssociationRecord) -> Option<(u64, Option<u64>, Option<u64>)>,
+) -> Vec<bool> {
+    let mut seen = std::collections::HashSet::new();
+    records.iter().map(|record| key(record).is_none_or(|key| seen.insert(key))).collect()
+}
+
 /// Row indices of one sequence in time order: sorted by frame, ties kept in input order.
 pub(crate) fn time_order(records: &[AssociationRecord]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..records.len()).collect();
@@ -125,6 +162,7 @@ pub(crate) mod test_support {
             measured: DVec2::ZERO,
             true_position: None,
             true_velocity: None,
+            origin: None,
             track_id: track,
             prior: None,
             velocity: None,
@@ -143,6 +181,7 @@ pub(crate) mod test_support {
             measured: position,
             true_position: Some(position),
             true_velocity: None,
+            origin: None,
             track_id: Some(gt),
             prior: None,
             velocity: None,
@@ -192,6 +231,26 @@ mod tests {
         assert_eq!(row.reference_position(), DVec2::new(1.0, 2.0));
         row.true_position = Some(DVec2::new(3.0, 4.0));
         assert_eq!(row.reference_position(), DVec2::new(3.0, 4.0));
+    }
+
+    #[test]
+    fn one_row_stands_for_each_object_frame_and_track() {
+        let rows = [
+            test_support::identity_row(0, Some(1), Some(7)),
+            test_support::identity_row(0, Some(1), Some(7)),
+            test_support::identity_row(0, Some(1), Some(8)),
+            test_support::identity_row(0, Some(1), None),
+            test_support::identity_row(1, Some(1), Some(7)),
+            test_support::identity_row(1, None, Some(7)),
+            test_support::identity_row(1, None, Some(7)),
+            test_support::identity_row(1, None, None),
+            test_support::identity_row(1, None, None),
+        ];
+        assert_eq!(object_frame_rows(&rows), [true, false, true, true, true, true, false, true, true]);
+        assert_eq!(
+            ground_truth_frame_rows(&rows),
+            [true, false, false, false, true, false, false, false, false]
+        );
     }
 
     #[test]
