@@ -1,7 +1,7 @@
 //! The grouping of one frame: which detection joins which group, and each group's measurement.
 //! The workspace is sized once for a full frame; [`FrameGroups::form`] allocates nothing.
 
-use super::linkage::{LinkPoint, LinkRule, Linkage};
+use super::linkage::{LinkPoint, LinkRule, Linkage, NO_OWNER};
 use super::summary::summarise;
 use crate::limits::MAX_MEASUREMENTS_PER_FRAME;
 use crate::measurement::Measurement;
@@ -38,8 +38,6 @@ pub struct FrameGroups {
     measurements: Box<[Measurement]>,
     count: usize,
     group_of: Box<[u16]>,
-    /// Each group's owner track and radar slot (`NONE` owner: a cluster or a single).
-    group_key: Box<[(u16, u8)]>,
     /// The group of each linkage label.
     label_group: Box<[u16]>,
     /// Members of each group in frame order: `members[member_start[g]..member_start[g + 1]]`.
@@ -48,8 +46,6 @@ pub struct FrameGroups {
     /// Where the next member of each group goes while the members are sorted.
     next_member: Box<[u16]>,
     points: Box<[LinkPoint]>,
-    /// The detection of each linkage point.
-    point_detection: Box<[u16]>,
     scratch: Box<[f64]>,
     linkage: Box<Linkage>,
     groups: usize,
@@ -73,20 +69,23 @@ impl FrameGroups {
             sensor_id: None,
             ground_truth_id: None,
         };
-        const NO_POINT: LinkPoint =
-            LinkPoint { position_m: DVec2::ZERO, range_m: 0.0, radial_velocity_mps: 0.0, sensor_slot: 0 };
+        const NO_POINT: LinkPoint = LinkPoint {
+            position_m: DVec2::ZERO,
+            range_m: 0.0,
+            radial_velocity_mps: 0.0,
+            sensor_slot: 0,
+            owner: NO_OWNER,
+        };
         FrameGroups {
             detections: vec![None; CAPACITY].into_boxed_slice(),
             measurements: vec![NO_MEASUREMENT; CAPACITY].into_boxed_slice(),
             count: 0,
             group_of: vec![NONE; CAPACITY].into_boxed_slice(),
-            group_key: vec![(NONE, 0); CAPACITY].into_boxed_slice(),
             label_group: vec![NONE; CAPACITY].into_boxed_slice(),
             members: vec![0; CAPACITY].into_boxed_slice(),
             member_start: vec![0; CAPACITY + 1].into_boxed_slice(),
             next_member: vec![0; CAPACITY + 1].into_boxed_slice(),
             points: vec![NO_POINT; CAPACITY].into_boxed_slice(),
-            point_detection: vec![0; CAPACITY].into_boxed_slice(),
             scratch: vec![0.0; CAPACITY].into_boxed_slice(),
             linkage: Box::new(Linkage::new()),
             groups: 0,
@@ -115,25 +114,23 @@ impl FrameGroups {
         self.detections[..self.count].iter().flatten()
     }
 
-    /// Groups the detections: a grouped detection with an owner joins its owner's group of its
-    /// radar, the other grouped ones are linked by `rule`, and each detection that is not
-    /// grouped is a group of its own. Groups are numbered in the order of their first
-    /// detection. Returns the number of groups.
+    /// Groups the detections: the grouped ones by [`Linkage::cluster`] with their owners (the
+    /// detections of one owner and radar are one group, and groups of two owners never join),
+    /// and each detection that is not grouped is a group of its own. Groups are numbered in the
+    /// order of their first detection. Returns the number of groups.
     pub fn form(&mut self, rule: &LinkRule) -> usize {
-        self.link_unowned(rule);
+        self.link(rule);
         self.groups = 0;
         for index in 0..self.count {
             let Some(detection) = self.detections[index] else { continue };
-            let group = match (detection.grouped, detection.owner) {
-                (false, _) => self.open_group((NONE, detection.sensor_slot)),
-                (true, Some(owner)) => self.group_of_key((owner, detection.sensor_slot)),
-                (true, None) => {
-                    let label = self.linkage.label_of(self.group_of[index] as usize);
-                    if self.label_group[label] == NONE {
-                        self.label_group[label] = self.open_group((NONE, detection.sensor_slot));
-                    }
-                    self.label_group[label]
+            let group = if detection.grouped {
+                let label = self.linkage.label_of(self.group_of[index] as usize);
+                if self.label_group[label] == NONE {
+                    self.label_group[label] = self.open_group();
                 }
+                self.label_group[label]
+            } else {
+                self.open_group()
             };
             self.group_of[index] = group;
         }
@@ -141,21 +138,21 @@ impl FrameGroups {
         self.groups
     }
 
-    /// Links the grouped detections without an owner; `group_of` holds each one's linkage
-    /// point until [`form`](Self::form) overwrites it with its group.
-    fn link_unowned(&mut self, rule: &LinkRule) {
+    /// Links the grouped detections; `group_of` holds each one's linkage point until
+    /// [`form`](Self::form) overwrites it with its group.
+    fn link(&mut self, rule: &LinkRule) {
         let mut points = 0;
         for index in 0..self.count {
             let Some(detection) = self.detections[index] else { continue };
-            if detection.grouped && detection.owner.is_none() {
+            if detection.grouped {
                 let position_m = detection.measurement.position();
                 self.points[points] = LinkPoint {
                     position_m,
                     range_m: position_m.distance(detection.sensor_position_m),
                     radial_velocity_mps: detection.measurement.radial_velocity_mps,
                     sensor_slot: detection.sensor_slot,
+                    owner: detection.owner.unwrap_or(NO_OWNER),
                 };
-                self.point_detection[points] = index as u16;
                 self.group_of[index] = points as u16;
                 points += 1;
             }
@@ -164,18 +161,9 @@ impl FrameGroups {
         self.label_group[..labels].fill(NONE);
     }
 
-    fn open_group(&mut self, key: (u16, u8)) -> u16 {
-        self.group_key[self.groups] = key;
+    fn open_group(&mut self) -> u16 {
         self.groups += 1;
         (self.groups - 1) as u16
-    }
-
-    /// The group of an owner track and radar, opened at its first detection.
-    fn group_of_key(&mut self, key: (u16, u8)) -> u16 {
-        match self.group_key[..self.groups].iter().rposition(|&known| known == key) {
-            Some(group) => group as u16,
-            None => self.open_group(key),
-        }
     }
 
     /// Lists each group's members in frame order (a counting sort by group).
@@ -207,6 +195,12 @@ impl FrameGroups {
     /// Group `group`'s members: indices of [`detections`](Self::detections) in frame order.
     pub fn members(&self, group: usize) -> &[u16] {
         &self.members[self.member_start[group] as usize..self.member_start[group + 1] as usize]
+    }
+
+    /// The owner of group `group` (the confirmed track whose object holds one of its
+    /// detections; a group has at most one), if any.
+    pub fn owner(&self, group: usize) -> Option<u16> {
+        self.members(group).iter().find_map(|&member| self.detections[member as usize].and_then(|d| d.owner))
     }
 
     /// The frame index of group `group`'s first detection.

@@ -3,6 +3,12 @@
 //! (a distance that grows with the range, as the radar's azimuth noise does), close in radial
 //! velocity and from the same radar.
 //!
+//! A point may carry an owner (a confirmed track whose object holds it): the points of one
+//! owner and radar are one group from the start, and two groups of different owners never
+//! join, so a chain of points between two tracked objects stops at the first link that would
+//! join them. The groups then depend on the order of the links, which is the sweep's, fixed by
+//! the points' positions and indices.
+//!
 //! The pairs are found by a sweep over the detections sorted by x, so a frame of `n`
 //! detections costs `O(n log n)` plus the pairs within one link distance along x; the groups
 //! are the components of a union-find forest with path halving. Nothing allocates after
@@ -22,7 +28,12 @@ pub struct LinkPoint {
     pub radial_velocity_mps: f64,
     /// The radar's slot in the sensor set: points of different radars never link.
     pub sensor_slot: u8,
+    /// The owner (a track's table row), or [`NO_OWNER`].
+    pub owner: u16,
 }
+
+/// The owner of a point that no track holds.
+pub const NO_OWNER: u16 = u16::MAX;
 
 /// When two detections link.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,6 +65,10 @@ impl LinkRule {
 #[derive(Debug, Clone)]
 pub struct Linkage {
     parent: [u16; MAX_MEASUREMENTS_PER_FRAME],
+    /// The owner of each root's group, [`NO_OWNER`] when none.
+    owner: [u16; MAX_MEASUREMENTS_PER_FRAME],
+    /// The first point of each owner (a track's table row) in the current frame.
+    first_owned: [u16; crate::limits::MAX_TRACKS],
     /// Point indices sorted by x.
     order: [u16; MAX_MEASUREMENTS_PER_FRAME],
     /// The group of each point after [`Linkage::cluster`]: `0..groups`, numbered in the order
@@ -73,6 +88,8 @@ impl Linkage {
     pub fn new() -> Self {
         Linkage {
             parent: [0; MAX_MEASUREMENTS_PER_FRAME],
+            owner: [NO_OWNER; MAX_MEASUREMENTS_PER_FRAME],
+            first_owned: [u16::MAX; crate::limits::MAX_TRACKS],
             order: [0; MAX_MEASUREMENTS_PER_FRAME],
             labels: [0; MAX_MEASUREMENTS_PER_FRAME],
             groups: 0,
@@ -86,8 +103,10 @@ impl Linkage {
         let n = points.len().min(MAX_MEASUREMENTS_PER_FRAME);
         for index in 0..n {
             self.parent[index] = index as u16;
+            self.owner[index] = points[index].owner;
             self.order[index] = index as u16;
         }
+        self.join_owned(&points[..n]);
         let order = &mut self.order[..n];
         order.sort_unstable_by(|&a, &b| {
             points[a as usize].position_m.x.total_cmp(&points[b as usize].position_m.x)
@@ -109,11 +128,36 @@ impl Linkage {
                     break;
                 }
                 if rule.links(point_a, point_b) {
-                    union(&mut self.parent, a, b);
+                    union(&mut self.parent, &mut self.owner, a, b);
                 }
             }
         }
         self.label(n)
+    }
+
+    /// Joins the points of each owner and radar: each to the owner's first point (of its radar;
+    /// a second radar's points of one owner in one frame, which is rare, are found by a scan
+    /// back over the points).
+    fn join_owned(&mut self, points: &[LinkPoint]) {
+        self.first_owned.fill(u16::MAX);
+        for (index, point) in points.iter().enumerate() {
+            let Some(first) = self.first_owned.get_mut(usize::from(point.owner)) else { continue };
+            if *first == u16::MAX {
+                *first = index as u16;
+                continue;
+            }
+            let same_radar = points[usize::from(*first)].sensor_slot == point.sensor_slot;
+            let partner = if same_radar {
+                Some(usize::from(*first))
+            } else {
+                points[..index]
+                    .iter()
+                    .position(|other| other.owner == point.owner && other.sensor_slot == point.sensor_slot)
+            };
+            if let Some(partner) = partner {
+                union(&mut self.parent, &mut self.owner, partner as u16, index as u16);
+            }
+        }
     }
 
     /// Numbers the components `0..` in the order of their first point.
@@ -158,13 +202,17 @@ fn find(parent: &mut [u16], mut node: u16) -> u16 {
     node
 }
 
-fn union(parent: &mut [u16], a: u16, b: u16) {
+/// Joins the groups of `a` and `b` unless they have different owners.
+fn union(parent: &mut [u16], owner: &mut [u16], a: u16, b: u16) {
     let (root_a, root_b) = (find(parent, a), find(parent, b));
-    if root_a != root_b {
-        // The smaller index becomes the root, so the result does not depend on the sweep.
-        let (low, high) = if root_a < root_b { (root_a, root_b) } else { (root_b, root_a) };
-        parent[high as usize] = low;
+    let (owner_a, owner_b) = (owner[root_a as usize], owner[root_b as usize]);
+    if root_a == root_b || (owner_a != NO_OWNER && owner_b != NO_OWNER && owner_a != owner_b) {
+        return;
     }
+    // The smaller index becomes the root, so the labels do not depend on the sweep.
+    let (low, high) = if root_a < root_b { (root_a, root_b) } else { (root_b, root_a) };
+    parent[high as usize] = low;
+    owner[low as usize] = if owner_a != NO_OWNER { owner_a } else { owner_b };
 }
 
 #[cfg(test)]
@@ -180,7 +228,7 @@ mod tests {
 
     fn point(x: f64, y: f64, radial_velocity_mps: f64, sensor_slot: u8) -> LinkPoint {
         let position_m = DVec2::new(x, y);
-        LinkPoint { position_m, range_m: position_m.length(), radial_velocity_mps, sensor_slot }
+        LinkPoint { position_m, range_m: position_m.length(), radial_velocity_mps, sensor_slot, owner: NO_OWNER }
     }
 
     /// The components by petgraph's union-find over every linking pair, as a label per point
@@ -245,6 +293,16 @@ mod tests {
         let mut linkage = Box::new(Linkage::new());
         assert_eq!(linkage.cluster(&points, &rule()), 2);
         assert_ne!(linkage.label_of(1), linkage.label_of(0));
+    }
+
+    #[test]
+    fn points_of_one_owner_are_one_group_and_two_owners_never_join_through_a_chain() {
+        let owned = |x: f64, owner: u16| LinkPoint { owner, ..point(x, 0.0, 0.0, 0) };
+        // Owner 1 at 10 and 16 m (not linked by distance), a free point at 11.5, owner 2 at 13.
+        let points = [owned(10.0, 1), point(11.5, 0.0, 0.0, 0), owned(13.0, 2), owned(16.0, 1)];
+        let mut linkage = Box::new(Linkage::new());
+        assert_eq!(linkage.cluster(&points, &rule()), 2);
+        assert_eq!([0, 1, 2, 3].map(|index| linkage.label_of(index)), [0, 0, 1, 0]);
     }
 
     proptest! {

@@ -18,6 +18,7 @@
 //! Each group becomes one measurement ([`summary`]). Detections of radars that deliver
 //! objects pass through unchanged.
 
+pub mod contour;
 pub mod frame_groups;
 pub mod linkage;
 pub mod summary;

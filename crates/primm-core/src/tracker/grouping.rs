@@ -17,6 +17,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     pub(super) fn group_detections(&mut self) {
         self.frame_groups.clear();
         self.grouped_frame = false;
+        self.shadowed.fill(false);
         let mut any_points = false;
         let mut any_candidates = false;
         for index in 0..self.validated.len() {
@@ -25,7 +26,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let sensor = self.sensors.get(slot);
             let candidate = sensor.detections != DetectionModel::Objects;
             let grouped = sensor.groups_detections();
-            let owner = if candidate { self.owner_of(&measurement) } else { None };
+            let (owner, shadowed) = if candidate { self.owner_of(&measurement) } else { (None, None) };
+            if let Some(row) = shadowed.filter(|_| grouped) {
+                self.shadowed[usize::from(row)] = true;
+            }
             let detection = Detection {
                 measurement,
                 frame_index: index as u16,
@@ -51,13 +55,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// prior holds `measurement` ([`crate::extent::lies_on_object`] with the track's class's
     /// extent). When several do, the nearest one's; but of two tracks of one class whose centres
     /// lie within the class's `duplicate_distance_m`, which are likely one object followed
-    /// twice, the older one's, so that the younger one starves and ends rather than taking a
-    /// share of the object's detections for ever.
-    fn owner_of(&self, measurement: &Measurement) -> Option<u16> {
+    /// twice, the older one's; the younger one is returned second: it is *shadowed*, and ends
+    /// with the step when it took no measurement ([`Self::end_shadowed_tracks`]).
+    fn owner_of(&self, measurement: &Measurement) -> (Option<u16>, Option<u16>) {
         let position_m = measurement.position();
         let tracks = self.table.tracks();
         let mut best: Option<(usize, f64)> = None;
+        let mut shadowed = None;
         for row in 0..tracks.len() {
+            if !tracks[row].status.is_confirmed() {
+                continue;
+            }
             let Some(distance_m2) = self.holds(row, position_m) else { continue };
             let better = match best {
                 None => true,
@@ -67,7 +75,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     if track.class == other.class
                         && apart_m <= self.config.classes.get(track.class).duplicate_distance_m
                     {
-                        track.id < other.id
+                        let (older, younger) = if track.id < other.id { (row, best_row) } else { (best_row, row) };
+                        shadowed = Some(younger as u16);
+                        older == row
                     } else {
                         distance_m2 < best_m2
                     }
@@ -77,16 +87,27 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 best = Some((row, distance_m2));
             }
         }
-        best.map(|(row, _)| row as u16)
+        (best.map(|(row, _)| row as u16), shadowed)
     }
 
-    /// When the confirmed track in `row` holds `position_m` on its object at its prior: the
-    /// squared distance from its centre, m².
+    /// Before the deletion: marks every shadowed track that took no measurement in this step
+    /// for ending (counted as deleted), a duplicate of the older track that took its object's
+    /// detections; returns how many.
+    pub(super) fn end_shadowed_tracks(&mut self) -> usize {
+        let tracks = self.table.len();
+        let mut ended = 0;
+        for row in 0..tracks {
+            self.ending[row] = self.shadowed[row] && self.rows[row].measurement_index.is_none();
+            ended += usize::from(self.ending[row]);
+        }
+        self.ending[tracks..].fill(false);
+        ended
+    }
+
+    /// When the track in `row` holds `position_m` on its object at its prior: the squared
+    /// distance from its centre, m².
     fn holds(&self, row: usize, position_m: glam::DVec2) -> Option<f64> {
         let track = &self.table.tracks()[row];
-        if !track.status.is_confirmed() {
-            return None;
-        }
         let prior = &self.priors[row];
         let extent = &self.config.classes.get(track.class).extent;
         let centre_m = prior.fused.mean;
@@ -119,7 +140,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }
                 let position_m = detection.measurement.position();
                 for row in 0..tracks {
-                    if self.holds(row, position_m).is_some() {
+                    let confirmed = self.table.tracks()[row].status.is_confirmed();
+                    if confirmed && self.holds(row, position_m).is_some() {
                         self.owned_counts[row] += 1;
                     }
                 }
@@ -138,7 +160,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let detections = self.frame_groups.detections().count();
         self.validated.set_len(groups);
         for group in 0..groups {
-            let measurement = self.frame_groups.measurement(group);
+            let mut measurement = self.frame_groups.measurement(group);
+            self.group_is_centre[group] = self.move_to_centre(group, &mut measurement);
             self.validated.set(group, Some(measurement));
             self.accepted[group] = true;
             self.fates[group] = MeasurementFate::Unassigned;
@@ -146,6 +169,35 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
         self.last_step.counts.detections_grouped += (detections - groups) as u64;
         self.grouped_frame = true;
+    }
+
+    /// Moves the measurement of `group` from the mean of its detections to the centre of its
+    /// object when the group holds several detections and a confirmed track of an extended
+    /// class owns it: by the offset of the visible contour's centroid of the track's box at its
+    /// prior (`crate::grouping::contour`). Returns whether it did; such a measurement is then a
+    /// measurement of the centre (reflection scale 0).
+    fn move_to_centre(&self, group: usize, measurement: &mut Measurement) -> bool {
+        let Some(owner) = self.frame_groups.owner(group) else { return false };
+        if self.frame_groups.members(group).len() < 2 {
+            return false;
+        }
+        let row = usize::from(owner);
+        let class = self.table.tracks()[row].class;
+        let extent = &self.config.classes.get(class).extent;
+        if !extent.enabled {
+            return false;
+        }
+        let prior = &self.priors[row];
+        let sensor_m = self.sensors.of(measurement.sensor_id).position_m(self.step_pose);
+        let offset_m = crate::grouping::contour::visible_contour_offset(
+            extent,
+            prior.fused.mean,
+            prior.fused_velocity_mps(),
+            sensor_m,
+        );
+        measurement.x_m -= offset_m.x;
+        measurement.y_m -= offset_m.y;
+        true
     }
 
     /// After a grouped frame: the measurement index of every row names its group's first

@@ -171,6 +171,14 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     grouped_frame: bool,
     /// The frame index of each group's first detection (when `grouped_frame`).
     group_first_index: Box<[u16; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// Whether each group's measurement is a measurement of its object's centre (when
+    /// `grouped_frame`).
+    group_is_centre: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// Per track: whether an older track of its class nearby took a detection on its object in
+    /// the current grouped frame (`grouping`).
+    shadowed: Box<[bool; MAX_TRACKS]>,
+    /// Per track: whether the deletion ends it as a shadowed duplicate.
+    ending: Box<[bool; MAX_TRACKS]>,
     /// Per track: its detections of one radar in the current frame (`learn_points`).
     owned_counts: Box<[u16; MAX_TRACKS]>,
     /// The current frame as read once from the caller; validation reads only this copy.
@@ -239,7 +247,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             frame_groups: Box::new(crate::grouping::frame_groups::FrameGroups::new()),
             grouped_frame: false,
             group_first_index: Box::new([0; MAX_MEASUREMENTS_PER_FRAME]),
+            group_is_centre: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
             owned_counts: Box::new([0; MAX_TRACKS]),
+            shadowed: Box::new([false; MAX_TRACKS]),
+            ending: Box::new([false; MAX_TRACKS]),
             recorded: Box::new(RecordedFrame::new()),
             validated: Box::new(ValidatedFrame::new()),
             late_outputs: alloc::vec::Vec::with_capacity(if ring.is_enabled() { MAX_TRACKS } else { 0 }),
@@ -313,6 +324,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.coast();
         self.learn_sensors();
         self.initiate(t);
+        self.end_shadowed_tracks();
         self.delete(t);
         self.merge_duplicates();
         self.name_groups_by_first_detection();
