@@ -62,6 +62,11 @@ pub struct GroupingConfig {
     pub link_distance_per_range: f64,
     /// Largest difference of radial velocity between two linked detections, m/s (absent: 2.0).
     pub link_radial_velocity_gap_mps: f64,
+    /// How far beyond its box (the class's extent at the track's prior) a detection still lies
+    /// on a confirmed track's object and joins its group, m (absent: 2.0). Wider than the
+    /// extent's `absorb_margin_m`: the prior's position error and the spread of a point cloud
+    /// over the faces both reach beyond the box.
+    pub owner_margin_m: f64,
     /// With `detections = "auto"`: the share of a radar's confirmed-track scans with several
     /// detections on the track's object above which the radar delivers points, in (0, 1)
     /// (absent: 0.5). It falls back to objects below this share less 0.1.
@@ -78,6 +83,7 @@ impl Default for GroupingConfig {
             link_distance_m: 2.0,
             link_distance_per_range: 0.02,
             link_radial_velocity_gap_mps: 2.0,
+            owner_margin_m: 2.0,
             points_share_threshold: 0.5,
             points_prior_scans: 20.0,
             points_window_scans: 2000.0,
@@ -109,6 +115,9 @@ impl GroupingConfig {
         }
         if !within(self.link_radial_velocity_gap_mps, 0.0, 100.0) {
             return Some(("frame.grouping.link_radial_velocity_gap_mps", "must lie in [0, 100] m/s"));
+        }
+        if !within(self.owner_margin_m, 0.0, 20.0) {
+            return Some(("frame.grouping.owner_margin_m", "must lie in [0, 20] m"));
         }
         if !(self.points_share_threshold > POINTS_SHARE_HYSTERESIS && self.points_share_threshold < 1.0) {
             return Some(("frame.grouping.points_share_threshold", "must lie in (0.1, 1)"));

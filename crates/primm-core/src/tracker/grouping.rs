@@ -66,7 +66,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if !tracks[row].status.is_confirmed() {
                 continue;
             }
-            let Some(distance_m2) = self.holds(row, position_m) else { continue };
+            let margin_m = self.config.frame.grouping.owner_margin_m;
+            let Some(distance_m2) = self.holds(row, position_m, margin_m) else { continue };
             let better = match best {
                 None => true,
                 Some((best_row, best_m2)) => {
@@ -104,19 +105,23 @@ impl<P: DisplacementPredictor> Tracker<P> {
         ended
     }
 
-    /// When the track in `row` holds `position_m` on its object at its prior: the squared
-    /// distance from its centre, m².
-    fn holds(&self, row: usize, position_m: glam::DVec2) -> Option<f64> {
+    /// When the track in `row` holds `position_m` on its object at its prior (its class's box
+    /// grown by `margin_m`): the squared distance from its centre, m².
+    fn holds(&self, row: usize, position_m: glam::DVec2, margin_m: f64) -> Option<f64> {
         let track = &self.table.tracks()[row];
         let prior = &self.priors[row];
-        let extent = &self.config.classes.get(track.class).extent;
+        let extent = crate::extent::ExtentConfig {
+            absorb_margin_m: margin_m,
+            ..self.config.classes.get(track.class).extent
+        };
         let centre_m = prior.fused.mean;
-        crate::extent::lies_on_object(extent, centre_m, prior.fused_velocity_mps(), position_m)
+        crate::extent::lies_on_object(&extent, centre_m, prior.fused_velocity_mps(), position_m)
             .then(|| centre_m.distance_squared(position_m))
     }
 
     /// Each confirmed track's count of the frame's detections of an `auto` radar on its object
-    /// (every detection its box holds, whichever track owns it: a radar's point cloud tracked
+    /// (every detection its box grown by the class's `extent.absorb_margin_m` holds, whichever
+    /// track owns it: a radar's point cloud tracked
     /// one detection at a time gives an object several tracks, each holding the object's
     /// detections) into that radar's [`PointsEstimate`](crate::sensor::points::PointsEstimate),
     /// one radar at a time.
@@ -140,8 +145,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }
                 let position_m = detection.measurement.position();
                 for row in 0..tracks {
-                    let confirmed = self.table.tracks()[row].status.is_confirmed();
-                    if confirmed && self.holds(row, position_m).is_some() {
+                    let track = &self.table.tracks()[row];
+                    let margin_m = self.config.classes.get(track.class).extent.absorb_margin_m;
+                    if track.status.is_confirmed() && self.holds(row, position_m, margin_m).is_some() {
                         self.owned_counts[row] += 1;
                     }
                 }
