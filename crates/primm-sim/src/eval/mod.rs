@@ -60,7 +60,8 @@ pub use interaction::{interaction_flags, InteractionFlags, InteractionRules};
 pub use modes::{ModeProbabilityAccumulator, MODE_NAMES};
 pub use plots::{TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint};
 pub use record::{
-    counts_as_confirmed, ground_truth_frame_rows, object_frame_rows, AssociationRecord, EvalError, Method,
+    counts_as_confirmed, ground_truth_frame_rows, object_classes, object_frame_rows, AssociationRecord,
+    EvalError, Method,
 };
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;

@@ -132,6 +132,39 @@ pub fn ground_truth_frame_rows(records: &[AssociationRecord]) -> Vec<bool> {
     first.into_iter().zip(records).map(|(first, r)| first && r.ground_truth_id.is_some()).collect()
 }
 
+/// The class each row of one sequence is scored under in the per-class metrics: for a row of a
+/// ground-truth object the class most of that object's rows carry (on a tie the class of its
+/// first row in input order), since a detection-level radar labels single detections wrongly now
+/// and then; for a row without one its own class. With one label per object, every row keeps its
+/// own.
+pub fn object_classes(records: &[AssociationRecord]) -> Vec<ObjectClass> {
+    // Per object: its classes with their row counts, in order of first appearance.
+    let mut votes: std::collections::HashMap<u64, Vec<(ObjectClass, usize)>> =
+        std::collections::HashMap::new();
+    for record in records {
+        if let Some(gt) = record.ground_truth_id {
+            let classes = votes.entry(gt).or_default();
+            match classes.iter_mut().find(|(class, _)| *class == record.class) {
+                Some(entry) => entry.1 += 1,
+                None => classes.push((record.class, 1)),
+            }
+        }
+    }
+    let majority: std::collections::HashMap<u64, ObjectClass> = votes
+        .into_iter()
+        .map(|(gt, classes)| {
+            let mut best = classes[0];
+            for &candidate in &classes[1..] {
+                if candidate.1 > best.1 {
+                    best = candidate;
+                }
+            }
+            (gt, best.0)
+        })
+        .collect();
+    records.iter().map(|r| r.ground_truth_id.map_or(r.class, |gt| majority[&gt])).collect()
+}
+
 /// Whether each row is the first with its key; rows without a key are always first.
 fn first_rows(
     records: &[AssociationRecord],
@@ -251,6 +284,24 @@ mod tests {
             ground_truth_frame_rows(&rows),
             [true, false, false, false, true, false, false, false, false]
         );
+    }
+
+    #[test]
+    fn a_row_is_scored_under_its_objects_majority_class() {
+        let labelled =
+            |gt: Option<u64>, class| AssociationRecord { class, ..test_support::identity_row(0, gt, None) };
+        let (car, pedestrian) = (ObjectClass::Car, ObjectClass::Pedestrian);
+        let rows = [
+            labelled(Some(1), car),
+            labelled(Some(1), pedestrian),
+            labelled(Some(1), car),
+            labelled(Some(2), pedestrian),
+            labelled(Some(2), car),
+            labelled(None, pedestrian),
+        ];
+        // Object 1: two car labels against one; object 2: a tie, its first row's class; the
+        // row without an object keeps its own label.
+        assert_eq!(object_classes(&rows), [car, car, car, pedestrian, pedestrian, pedestrian]);
     }
 
     #[test]

@@ -595,6 +595,36 @@ mod tests {
     use crate::scenario::{ClutterConfig, ExtendedObjectConfig, Preset};
 
     #[test]
+    fn point_cloud_validation_names_the_offending_field() {
+        /// Makes one field of the valid point-cloud preset invalid.
+        type Spoil = fn(&mut ScenarioConfig);
+        let cases: [(&str, Spoil); 12] = [
+            ("point_cloud.car_extra_detections_at_reference", |c| {
+                c.point_cloud.car_extra_detections_at_reference = -1.0
+            }),
+            ("point_cloud.reference_range_m", |c| c.point_cloud.reference_range_m = 0.0),
+            ("point_cloud.max_detections_per_car", |c| c.point_cloud.max_detections_per_car = 0),
+            ("point_cloud.wheel_probability", |c| c.point_cloud.wheel_probability = f64::NAN),
+            ("point_cloud.wheelbase_fraction", |c| c.point_cloud.wheelbase_fraction = 1.5),
+            ("point_cloud.pedestrian_detection_count_probabilities", |c| {
+                c.point_cloud.pedestrian_detection_count_probabilities = vec![0.5]
+            }),
+            // Inside the sidewalks, or beyond the middle of a block.
+            ("point_cloud.wall_offset_m", |c| c.point_cloud.wall_offset_m = 9.0),
+            ("point_cloud.wall_offset_m", |c| c.point_cloud.wall_offset_m = 50.0),
+            ("point_cloud.ghost_probability", |c| c.point_cloud.ghost_probability = 2.0),
+            ("point_cloud.max_ghost_detections", |c| c.point_cloud.max_ghost_detections = 65),
+            ("point_cloud.class_flip_probability", |c| c.point_cloud.class_flip_probability = -0.1),
+            ("point_cloud.enabled", |c| c.extended_objects = ExtendedObjectConfig::vehicles()),
+        ];
+        for (field, spoil) in cases {
+            let mut config = Preset::PointCloud.config();
+            spoil(&mut config);
+            assert_eq!(config.validate().unwrap_err().field, field);
+        }
+    }
+
+    #[test]
     fn extended_object_validation_names_the_offending_field() {
         /// Makes one field of a valid extended-object section invalid.
         type Spoil = fn(&mut ExtendedObjectConfig);
