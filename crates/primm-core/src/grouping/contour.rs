@@ -76,7 +76,8 @@ mod tests {
 
     #[test]
     fn a_car_seen_from_straight_behind_shows_its_rear_face_half_a_length_back() {
-        let offset = visible_contour_offset(&car(), DVec2::new(30.0, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO);
+        let offset =
+            visible_contour_offset(&car(), DVec2::new(30.0, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO);
         assert!((offset - DVec2::new(-2.25, 0.0)).length() < 1e-9, "{offset}");
     }
 
@@ -97,7 +98,8 @@ mod tests {
         let offset = visible_contour_offset(&extent, DVec2::new(0.0, 20.0), DVec2::ZERO, DVec2::ZERO);
         let radius = 0.25 * (extent.length_m + extent.width_m);
         assert!((offset - DVec2::new(0.0, -QUARTER_PI * radius)).length() < 1e-12, "{offset}");
-        let inside = visible_contour_offset(&extent, DVec2::new(0.5, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO);
+        let inside =
+            visible_contour_offset(&extent, DVec2::new(0.5, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO);
         assert_eq!(inside, DVec2::ZERO);
     }
 }

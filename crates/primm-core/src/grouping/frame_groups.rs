@@ -203,10 +203,23 @@ impl FrameGroups {
         self.members(group).iter().find_map(|&member| self.detections[member as usize].and_then(|d| d.owner))
     }
 
-    /// The frame index of group `group`'s first detection.
-    pub fn first_frame_index(&self, group: usize) -> u16 {
-        let first = self.members(group)[0] as usize;
-        self.detections[first].map_or(0, |detection| detection.frame_index)
+    /// The frame index of group `group`'s representative: its detection nearest to the mean
+    /// of its detections (the first of them on a tie), which the outputs name.
+    pub fn representative_frame_index(&self, group: usize) -> u16 {
+        let members = self.members(group);
+        let mean_m = members
+            .iter()
+            .map(|&member| self.measurements[member as usize].position())
+            .fold(DVec2::ZERO, |sum, position| sum + position)
+            / members.len() as f64;
+        let mut best = (members[0], f64::INFINITY);
+        for &member in members {
+            let distance_m2 = self.measurements[member as usize].position().distance_squared(mean_m);
+            if distance_m2 < best.1 {
+                best = (member, distance_m2);
+            }
+        }
+        self.detections[best.0 as usize].map_or(0, |detection| detection.frame_index)
     }
 
     /// Group `group`'s measurement ([`summarise`]).

@@ -228,7 +228,13 @@ mod tests {
 
     fn point(x: f64, y: f64, radial_velocity_mps: f64, sensor_slot: u8) -> LinkPoint {
         let position_m = DVec2::new(x, y);
-        LinkPoint { position_m, range_m: position_m.length(), radial_velocity_mps, sensor_slot, owner: NO_OWNER }
+        LinkPoint {
+            position_m,
+            range_m: position_m.length(),
+            radial_velocity_mps,
+            sensor_slot,
+            owner: NO_OWNER,
+        }
     }
 
     /// The components by petgraph's union-find over every linking pair, as a label per point

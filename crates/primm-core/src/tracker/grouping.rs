@@ -1,6 +1,7 @@
 //! Group the detections of point-cloud radars into object measurements (`crate::grouping`),
 //! after the prediction and before the association: the validated frame then holds one
-//! measurement per group, and the outputs name each group by its first detection's index.
+//! measurement per group, and the outputs name each group by its representative detection's
+//! index (the one nearest to the group's mean).
 
 use super::{MeasurementFate, Tracker};
 use crate::grouping::frame_groups::Detection;
@@ -52,11 +53,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// The table row of the confirmed track (of any class: labels flip) whose object at its
-    /// prior holds `measurement` ([`crate::extent::lies_on_object`] with the track's class's
-    /// extent). When several do, the nearest one's; but of two tracks of one class whose centres
-    /// lie within the class's `duplicate_distance_m`, which are likely one object followed
-    /// twice, the older one's; the younger one is returned second: it is *shadowed*, and ends
-    /// with the step when it took no measurement ([`Self::end_shadowed_tracks`]).
+    /// prior holds `measurement` (its class's box grown by [`Self::owner_margin_m`]). When
+    /// several do, the nearest one's; but of two tracks that are likely one object followed
+    /// twice ([`Self::duplicates`]), the older one's. The younger one is returned second: it is
+    /// *shadowed*, and ends with the step when it took no measurement
+    /// ([`Self::end_shadowed_tracks`]).
     fn owner_of(&self, measurement: &Measurement) -> (Option<u16>, Option<u16>) {
         let position_m = measurement.position();
         let tracks = self.table.tracks();
@@ -66,17 +67,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if !tracks[row].status.is_confirmed() {
                 continue;
             }
-            let margin_m = self.config.frame.grouping.owner_margin_m;
-            let Some(distance_m2) = self.holds(row, position_m, margin_m) else { continue };
+            let Some(distance_m2) = self.holds(row, position_m, self.owner_margin_m(row)) else { continue };
             let better = match best {
                 None => true,
                 Some((best_row, best_m2)) => {
-                    let (track, other) = (&tracks[row], &tracks[best_row]);
-                    let apart_m = self.priors[row].fused.mean.distance(self.priors[best_row].fused.mean);
-                    if track.class == other.class
-                        && apart_m <= self.config.classes.get(track.class).duplicate_distance_m
-                    {
-                        let (older, younger) = if track.id < other.id { (row, best_row) } else { (best_row, row) };
+                    let (older, younger) =
+                        if tracks[row].id < tracks[best_row].id { (row, best_row) } else { (best_row, row) };
+                    if self.duplicates(older, younger) {
                         shadowed = Some(younger as u16);
                         older == row
                     } else {
@@ -89,6 +86,32 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         (best.map(|(row, _)| row as u16), shadowed)
+    }
+
+    /// How far beyond its box a detection still joins the group of the track in `row`: the
+    /// grouping's `owner_margin_m` for an extended class, whose point cloud spreads over its
+    /// faces, the class's `extent.absorb_margin_m` for a point-like one (pedestrians walking
+    /// side by side stay apart).
+    fn owner_margin_m(&self, row: usize) -> f64 {
+        let extent = &self.config.classes.get(self.table.tracks()[row].class).extent;
+        if extent.enabled {
+            self.config.frame.grouping.owner_margin_m
+        } else {
+            extent.absorb_margin_m
+        }
+    }
+
+    /// Whether the tracks in rows `older` and `younger` follow one object: of one class with
+    /// centres within its `duplicate_distance_m`, or the younger one's centre on the older
+    /// one's object (its class's box grown by `extent.absorb_margin_m`; a pedestrian track
+    /// started on a car by a wrong label).
+    fn duplicates(&self, older: usize, younger: usize) -> bool {
+        let tracks = self.table.tracks();
+        let younger_m = self.priors[younger].fused.mean;
+        let apart_m = self.priors[older].fused.mean.distance(younger_m);
+        let section = self.config.classes.get(tracks[older].class);
+        (tracks[older].class == tracks[younger].class && apart_m <= section.duplicate_distance_m)
+            || self.holds(older, younger_m, section.extent.absorb_margin_m).is_some()
     }
 
     /// Before the deletion: marks every shadowed track that took no measurement in this step
@@ -171,7 +194,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             self.validated.set(group, Some(measurement));
             self.accepted[group] = true;
             self.fates[group] = MeasurementFate::Unassigned;
-            self.group_first_index[group] = self.frame_groups.first_frame_index(group);
+            self.group_first_index[group] = self.frame_groups.representative_frame_index(group);
         }
         self.last_step.counts.detections_grouped += (detections - groups) as u64;
         self.grouped_frame = true;
@@ -206,9 +229,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
         true
     }
 
-    /// After a grouped frame: the measurement index of every row names its group's first
-    /// detection in the frame, as the outputs report it.
-    pub(super) fn name_groups_by_first_detection(&mut self) {
+    /// After a grouped frame: the measurement index of every row names its group's
+    /// representative detection in the frame, as the outputs report it.
+    pub(super) fn name_groups_by_representative(&mut self) {
         if !self.grouped_frame {
             return;
         }

@@ -169,7 +169,7 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     frame_groups: Box<crate::grouping::frame_groups::FrameGroups>,
     /// Whether the current frame's measurements are groups.
     grouped_frame: bool,
-    /// The frame index of each group's first detection (when `grouped_frame`).
+    /// The frame index of each group's representative detection (when `grouped_frame`).
     group_first_index: Box<[u16; MAX_MEASUREMENTS_PER_FRAME]>,
     /// Whether each group's measurement is a measurement of its object's centre (when
     /// `grouped_frame`).
@@ -327,7 +327,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.end_shadowed_tracks();
         self.delete(t);
         self.merge_duplicates();
-        self.name_groups_by_first_detection();
+        self.name_groups_by_representative();
         observer.stage_finished(Stage::Update);
         self.last_timestamp_s = Some(t);
         self.last_step.counts.frames_tracked += 1;
