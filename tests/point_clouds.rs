@@ -210,3 +210,76 @@ fn a_full_frame_of_point_cloud_detections_is_grouped() {
     assert_eq!(outputs, MAX_MEASUREMENTS_PER_FRAME / 4);
     assert_eq!(tracker.last_step().counts.detections_grouped, 3 * MAX_MEASUREMENTS_PER_FRAME as u64 / 4);
 }
+
+#[test]
+fn late_point_cloud_frames_give_the_tracks_and_the_estimates_of_in_order_arrival() {
+    let frames = cars(160, 5);
+    let mut in_order = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    for frame in &frames {
+        in_order.step(frame).unwrap();
+    }
+    // Every third pair of frames swapped: each of those frames arrives 50 ms late.
+    let mut shuffled = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    let mut order: Vec<usize> = (0..frames.len()).collect();
+    for pair in order.chunks_mut(6) {
+        pair.swap(0, 1);
+    }
+    for &index in &order {
+        shuffled.step(&frames[index]).unwrap();
+    }
+    assert!(shuffled.stats().late_frames_tracked > 20, "{:?}", shuffled.stats());
+    assert_eq!(shuffled.last_outputs(), in_order.last_outputs());
+    let (a, b) = (shuffled.sensors().of(Some(3)), in_order.sensors().of(Some(3)));
+    assert!(b.groups_detections());
+    assert_eq!(a.points, b.points);
+    assert_eq!(shuffled.stats().detections_grouped, in_order.stats().detections_grouped);
+}
+
+#[test]
+fn the_tracks_started_on_one_car_before_an_auto_radar_turned_to_points_end_but_one_per_car() {
+    // Objects first: every detection of the two cars starts a track, several are confirmed per
+    // car; once the radar turns to points the younger ones are shadowed and end.
+    let frames = cars(300, 5);
+    let mut tracker = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    let mut most_confirmed = 0;
+    for frame in &frames {
+        let confirmed = tracker.step(frame).unwrap().iter().filter(|o| o.status.is_confirmed()).count();
+        most_confirmed = most_confirmed.max(confirmed);
+    }
+    assert!(most_confirmed > 2, "{most_confirmed}");
+    let survivors: Vec<_> = tracker.tracks().iter().filter(|t| t.status.is_confirmed()).collect();
+    assert_eq!(survivors.len(), 2, "{survivors:?}");
+    assert!(tracker.sensors().of(Some(3)).groups_detections());
+}
+
+#[test]
+fn the_point_cloud_sensor_file_is_the_shipped_configuration_with_every_radar_delivering_points() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/sensors/point_cloud.toml");
+    assert_eq!(primm_config::from_file(&path).unwrap(), config(DetectionModel::Points));
+}
+
+#[test]
+fn bad_point_cloud_keys_are_refused_by_name() {
+    let text = primm_config::DEFAULT_CONFIG_TOML.replacen(
+        "range_std_m = 0.12",
+        "range_std_m = 0.12\ndetections = \"cloud\"",
+        1,
+    );
+    let error = primm_config::from_toml_str(&text).unwrap_err().to_string();
+    assert!(error.contains("cloud") && error.contains("points"), "{error}");
+    let refused = |change: fn(&mut Config)| {
+        let mut config = Config::default();
+        change(&mut config);
+        match Tracker::new(config) {
+            Err(primm_core::config::ConfigError::Invalid { key, .. }) => key,
+            other => panic!("expected an invalid key, got {other:?}"),
+        }
+    };
+    assert_eq!(refused(|c| c.frame.grouping.link_distance_m = -1.0), "frame.grouping.link_distance_m");
+    assert_eq!(refused(|c| c.frame.grouping.owner_margin_m = f64::NAN), "frame.grouping.owner_margin_m");
+    assert_eq!(
+        refused(|c| c.frame.grouping.points_share_threshold = 1.0),
+        "frame.grouping.points_share_threshold"
+    );
+    assert_eq!(refused(|c| c.frame.grouping.points_prior_scans = 0.0), "frame.grouping");
+}
