@@ -418,6 +418,12 @@ pub struct PrimmStats {
     /// Tracks started in the world frame by a measurement whose sensor has no configured
     /// mount: their line of sight starts at the vehicle's reference point.
     pub initiations_from_unknown_sensor: u64,
+    /// Unassigned measurements that started no track as the mirror image of a confirmed
+    /// track in a wall along its heading (multipath ghosts).
+    pub initiations_refused_as_ghost: u64,
+    /// Tentative tracks ended because their measurement was the mirror image of a confirmed
+    /// track (multipath ghosts).
+    pub tentative_tracks_ended_as_ghost: u64,
     /// Measurements tracked (accepted by validation).
     pub measurements_accepted: u64,
     /// Measurements rejected for an unknown class code.

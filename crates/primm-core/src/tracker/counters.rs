@@ -59,6 +59,13 @@ macro_rules! tracker_counters {
             /// Tracks started in the world frame by a measurement whose sensor has no configured
             /// mount: their line of sight starts at the vehicle's reference point.
             initiations_from_unknown_sensor: tracked,
+            /// Unassigned measurements that started no track because they lie where a wall
+            /// along a confirmed track's heading would mirror it, moving as its image
+            /// (multipath ghosts; ARCHITECTURE.md, "Point clouds").
+            initiations_refused_as_ghost: tracked,
+            /// Tentative tracks ended because their measurement of the step was the mirror image
+            /// of a confirmed track (multipath ghosts, as `initiations_refused_as_ghost`).
+            tentative_tracks_ended_as_ghost: tracked,
             /// Measurements tracked (accepted by validation).
             measurements_accepted: tracked,
             /// Measurements rejected for an unknown class code.

@@ -114,14 +114,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
             || self.holds(older, younger_m, section.extent.absorb_margin_m).is_some()
     }
 
-    /// Before the deletion: marks every shadowed track that took no measurement in this step
-    /// for ending (counted as deleted), a duplicate of the older track that took its object's
-    /// detections; returns how many.
-    pub(super) fn end_shadowed_tracks(&mut self) -> usize {
+    /// Before the deletion: marks for ending (counted as deleted) every shadowed track that took
+    /// no measurement in this step, a duplicate of the older track that took its object's
+    /// detections, and every tentative track whose measurement of this step was a ghost of a
+    /// confirmed track (`ghosts`); returns how many.
+    pub(super) fn end_shadowed_and_ghost_tracks(&mut self) -> usize {
         let tracks = self.table.len();
         let mut ended = 0;
         for row in 0..tracks {
             self.ending[row] = self.shadowed[row] && self.rows[row].measurement_index.is_none();
+            if !self.ending[row] && self.follows_a_ghost(row) {
+                self.ending[row] = true;
+                self.last_step.counts.tentative_tracks_ended_as_ghost += 1;
+            }
             ended += usize::from(self.ending[row]);
         }
         self.ending[tracks..].fill(false);

@@ -28,6 +28,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
             // Where the history's line of sight starts: the radial-velocity row's radar position.
             let sensor = self.measurement_sensors[index];
+            if self.mirrors_a_track(&measurement, sensor.position_m, tracks_before) {
+                self.last_step.counts.initiations_refused_as_ghost += 1;
+                continue;
+            }
             if !sensor.mounted && self.step_pose.is_some() {
                 self.last_step.counts.initiations_from_unknown_sensor += 1;
             }

@@ -39,6 +39,7 @@ use glam::{DMat2, DVec2};
 
 mod counters;
 mod geometry;
+mod ghosts;
 mod grouping;
 mod late_frames;
 mod lifecycle;
@@ -324,7 +325,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.coast();
         self.learn_sensors();
         self.initiate(t);
-        self.end_shadowed_tracks();
+        self.end_shadowed_and_ghost_tracks();
         self.delete(t);
         self.merge_duplicates();
         self.name_groups_by_representative();
