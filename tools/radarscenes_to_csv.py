@@ -56,7 +56,7 @@ LABEL_TO_CLASS = {
 }
 
 # Largest number of measurements primm accepts in one frame.
-MAX_MEASUREMENTS_PER_FRAME = 256
+MAX_MEASUREMENTS_PER_FRAME = 1024
 
 HEADER = [
     "frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y",
