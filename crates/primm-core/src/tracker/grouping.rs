@@ -138,10 +138,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
     fn holds(&self, row: usize, position_m: glam::DVec2, margin_m: f64) -> Option<f64> {
         let track = &self.table.tracks()[row];
         let prior = &self.priors[row];
-        let extent = crate::extent::ExtentConfig {
-            absorb_margin_m: margin_m,
-            ..self.config.classes.get(track.class).extent
-        };
+        let section = &self.config.classes.get(track.class).extent;
+        // Beyond the circle through the grown box's corners (the disc lies within it too).
+        let reach_m2 = crate::math::square(0.5 * section.length_m + margin_m)
+            + crate::math::square(0.5 * section.width_m + margin_m);
+        if prior.fused.mean.distance_squared(position_m) > reach_m2 {
+            return None;
+        }
+        let extent = crate::extent::ExtentConfig { absorb_margin_m: margin_m, ..*section };
         let centre_m = prior.fused.mean;
         crate::extent::lies_on_object(&extent, centre_m, prior.fused_velocity_mps(), position_m)
             .then(|| centre_m.distance_squared(position_m))
@@ -149,10 +153,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
 
     /// Each confirmed track's count of the frame's detections of an `auto` radar on its object
     /// (every detection its box grown by the class's `extent.absorb_margin_m` holds, whichever
-    /// track owns it: a radar's point cloud tracked
-    /// one detection at a time gives an object several tracks, each holding the object's
-    /// detections) into that radar's [`PointsEstimate`](crate::sensor::points::PointsEstimate),
-    /// one radar at a time.
+    /// track owns it: a radar's point cloud tracked one detection at a time gives an object
+    /// several tracks, each holding the object's detections) into that radar's
+    /// [`PointsEstimate`](crate::sensor::points::PointsEstimate), one radar at a time.
     fn learn_points(&mut self) {
         let config = self.config.frame.grouping;
         let mut slots = arrayvec::ArrayVec::<u8, { crate::limits::MAX_SENSORS + 1 }>::new();
