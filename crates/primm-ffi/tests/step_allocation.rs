@@ -184,7 +184,15 @@ fn crossing_frames() -> Vec<Vec<PrimmMeasurement>> {
 #[test]
 fn stepping_dense_crossing_clusters_through_the_solver_allocates_nothing() {
     let frames = crossing_frames();
-    let options = PrimmTrackerOptions { method: PRIMM_METHOD_IMM, ..primm_tracker_options_default() };
+    // The scene packs eight cars closer than their own size, so confirmed tracks hold several
+    // detections each, as under a point cloud, and `detections = "auto"` would group them; the
+    // radar is declared an object radar, as the scene is here to load the assignment solver.
+    let config = c"[frame]\nunmounted_detections = \"objects\"\n";
+    let options = PrimmTrackerOptions {
+        method: PRIMM_METHOD_IMM,
+        config_toml: config.as_ptr(),
+        ..primm_tracker_options_default()
+    };
     let mut tracker = null_mut();
     // SAFETY: valid options and out-pointer.
     assert_eq!(unsafe { primm_tracker_create(&options, &mut tracker) }, PrimmStatus::Ok);
