@@ -662,7 +662,7 @@ mod tests {
         type Spoil = fn(&mut ClutterConfig);
         let cases: [(&str, Spoil); 15] = [
             ("clutter.mean_false_detections_per_scan", |c| c.mean_false_detections_per_scan = -1.0),
-            ("clutter.mean_false_detections_per_scan", |c| c.mean_false_detections_per_scan = 1000.0),
+            ("clutter.mean_false_detections_per_scan", |c| c.mean_false_detections_per_scan = 2000.0),
             ("clutter.mean_false_detections_per_scan", |c| c.mean_false_detections_per_scan = f64::NAN),
             ("clutter.min_range_m", |c| c.min_range_m = 0.0),
             ("clutter.min_range_m", |c| {
