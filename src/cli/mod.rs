@@ -8,10 +8,13 @@ pub mod eval;
 pub mod generate;
 pub mod latency_out;
 pub mod latency_plot;
+pub mod record;
+pub mod replay;
 pub mod score;
 pub mod serve;
 pub mod soak;
 pub mod track;
+pub mod track_mcap;
 pub mod tracker_args;
 #[cfg(feature = "tunnel")]
 pub mod tunnel;

@@ -1,5 +1,6 @@
 //! `primm track`: offline tracking of a measurement CSV file into a track CSV file.
 
+use super::track_mcap::OfflineRecording;
 use super::TrackerArgs;
 use clap::Args as ClapArgs;
 use primm_core::mode::Method;
@@ -7,6 +8,7 @@ use primm_core::tracker::{StepError, Tracker};
 use primm_core::validation::FrameError;
 use primm_predictor::onnx::ModelError;
 use primm_predictor::predictor_for;
+use primm_record::transforms::RadarPose;
 use primm_sim::io::association_csv::AssociationCsvWriter;
 use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_sim::io::{read_sequence_file, CsvError, TooManyMeasurements};
@@ -37,6 +39,10 @@ pub struct Args {
     /// per second, percentiles) on stdout.
     #[arg(long, value_name = "FILE")]
     pub timing: Option<PathBuf>,
+    /// Also write the run as an MCAP recording (the topics of `primm record`, the ground truth
+    /// included; docs/recording.md), to open in Foxglove or replay with `primm replay`.
+    #[arg(long, value_name = "FILE")]
+    pub mcap: Option<PathBuf>,
 }
 
 /// Why `primm track` failed.
@@ -76,6 +82,12 @@ pub enum TrackError {
     /// Writing an output file failed.
     #[error(transparent)]
     Write(#[from] std::io::Error),
+    /// The MCAP file could not be written.
+    #[error(transparent)]
+    Mcap(#[from] primm_record::McapFileError),
+    /// A message could not be written into the MCAP file.
+    #[error(transparent)]
+    McapMessage(#[from] primm_record::SinkError),
     /// The tracker rejected a frame.
     #[error("frame {frame}: {source}")]
     Step {
@@ -109,6 +121,13 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         None => None,
     };
     let frames = sequence.to_frames()?;
+    let mut recording = match &args.mcap {
+        Some(path) => {
+            let radars = tracker.config().frame.sensors.iter().map(RadarPose::from).collect();
+            Some(OfflineRecording::create(path, radars, frames.len())?)
+        }
+        None => None,
+    };
     let mut step_ns: Vec<u64> = Vec::with_capacity(frames.len());
     tracker.reset();
     // Frames in file order, which is arrival order: a late frame (within
@@ -118,13 +137,19 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         let start = std::time::Instant::now();
         match tracker.step(frame) {
             Ok(_) => {}
-            Err(StepError::InvalidFrame(FrameError::TooLate { .. })) => {
+            Err(StepError::InvalidFrame(error @ FrameError::TooLate { .. })) => {
                 eprintln!("frame {}: older than the late-frame window reaches; skipped", recorded.index);
+                if let Some(recording) = recording.as_mut() {
+                    recording.write_rejected(recorded, &StepError::InvalidFrame(error))?;
+                }
                 continue;
             }
             Err(source) => return Err(TrackError::Step { frame: recorded.index, source }),
         };
         step_ns.push(start.elapsed().as_nanos() as u64);
+        if let Some(recording) = recording.as_mut() {
+            recording.write_tracked(recorded, &tracker)?;
+        }
         if tracker.last_step().late {
             continue;
         }
@@ -135,22 +160,14 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         }
     }
     writer.finish()?;
+    if let Some(recording) = recording {
+        recording.finish()?;
+    }
     if let Some(associations) = associations {
         associations.finish()?;
     }
     if let Some(path) = &args.timing {
-        use std::io::Write as _;
-        let file = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .map_err(|source| TrackError::Open { path: path.clone(), source })?;
-        let mut out = std::io::BufWriter::new(file);
-        for ns in &step_ns {
-            writeln!(out, "{ns}")?;
-        }
-        out.flush()?;
-        println!("{}", timing_json(args.method, &mut step_ns));
+        write_timing(path, args.method, &mut step_ns)?;
     }
     let stats = tracker.stats();
     eprintln!(
@@ -162,6 +179,27 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         stats.tracks_deleted,
         args.output.display()
     );
+    Ok(())
+}
+
+/// Appends the step times to `path`, one per line in ns, and prints their summary.
+fn write_timing(
+    path: &Path,
+    method: primm_core::mode::Method,
+    step_ns: &mut [u64],
+) -> Result<(), TrackError> {
+    use std::io::Write as _;
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .map_err(|source| TrackError::Open { path: path.to_owned(), source })?;
+    let mut out = std::io::BufWriter::new(file);
+    for ns in step_ns.iter() {
+        writeln!(out, "{ns}")?;
+    }
+    out.flush()?;
+    println!("{}", timing_json(method, step_ns));
     Ok(())
 }
 
