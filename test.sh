@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Runs every test of primm: formatting, the Rust workspace, then the Python tools' tests.
 #
-# Needs only a Rust toolchain, Python 3 (with venv) and a C compiler: the Python packages the
-# tests use (tools/requirements-test.txt) are installed into a local virtual environment,
-# .venv-test/, on the first run and whenever that file changes.
+# Needs what README.md, "Prerequisites", lists (Rust, Python 3 with venv, C and C++ compilers,
+# readelf): the Python packages the tests use (tools/requirements-test.txt) are installed into a
+# local virtual environment, .venv-test/, on the first run and whenever that file changes.
 set -euo pipefail
 cd "$(dirname "$0")"
 

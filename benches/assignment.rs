@@ -118,8 +118,10 @@ fn bench_association(c: &mut Criterion) {
     for n in SIZES {
         let (tracks, priors, frame, accepted) = association_scene(n);
         let mut associator = Associator::new();
-        let sensors =
-            vec![primm_core::sensor_noise::MeasurementSensor::unknown(glam::DVec2::ZERO); accepted.len()];
+        let sensors = vec![
+            primm_core::sensor_noise::MeasurementSensor::unknown(glam::DVec2::ZERO, 0.5);
+            accepted.len()
+        ];
         let mut track_to_measurement = vec![None; n];
         group.bench_function(BenchmarkId::new("clustered", n), |bencher| {
             bencher.iter(|| {
@@ -147,7 +149,7 @@ fn bench_association(c: &mut Criterion) {
                     let rows: Vec<usize> = (0..n).filter(|&i| tracks[i].class == class).collect();
                     let columns: Vec<usize> =
                         (0..n).filter(|&j| frame.measurements[j].class == class).collect();
-                    let gate = config.classes.get(class).gate_m;
+                    let gate = config.classes.get(class).paper_gate_m;
                     for (r, &i) in rows.iter().enumerate() {
                         for (k, &j) in columns.iter().enumerate() {
                             let cost = association_cost(

@@ -24,6 +24,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+// The sensor id that asks for the radars without a configured mount (no sensor id, or one
+// not in `frame.sensors`), which share one set of estimates.
+#define PRIMM_UNMOUNTED_SENSOR -1
+
 // Most live tracks a tracker holds (the size of a buffer that always fits
 // `primm_tracker_tracks`).
 #define PRIMM_MAX_TRACKS 512
@@ -46,7 +50,7 @@
 
 // The ABI version of this header (see the crate documentation of primm-ffi for the policy):
 // compare it with `primm_abi_version()`, the ABI version of the linked library.
-#define PRIMM_ABI_VERSION 1
+#define PRIMM_ABI_VERSION 2
 
 // Result of a C API call.
 typedef enum PrimmStatus {
@@ -85,6 +89,28 @@ typedef struct PrimmTracker PrimmTracker;
 
 // An object class code, one of the `PRIMM_OBJECT_CLASS_*` constants.
 typedef uint8_t PrimmObjectClass;
+
+// One sensor's estimates for one class.
+typedef struct PrimmSensorEstimates {
+  // Where the sensor's detections lie between the object's centre (0) and the outline (1).
+  double reflection;
+  // The scale the tracker uses for this sensor's detections now: `reflection` for a sensor
+  // whose `reflection` is "auto", else the configured model's (outline: the class's
+  // `extent.offset_scale`; centre: 0).
+  double reflection_used;
+  // Informative updates the reflection estimate has taken.
+  uint64_t reflection_samples;
+  // The detection probability, dimensionless.
+  double detection_probability;
+  // Opportunities (confirmed tracks in view) the detection estimate has taken.
+  uint64_t detection_samples;
+  // The clutter density, 1/m² per scan.
+  double clutter_density_per_m2;
+  // Scans the clutter estimate has taken.
+  uint64_t clutter_scans;
+  // Times any of the three would have left its bounds and was held at them.
+  uint64_t bounded;
+} PrimmSensorEstimates;
 
 // A method code, one of the `PRIMM_METHOD_*` constants: which IMM modes the tracker runs.
 typedef uint32_t PrimmMethod;
@@ -162,7 +188,7 @@ typedef struct PrimmStepSummary {
   // Measurements of the largest cluster solved in this step (0 if none was).
   size_t largest_solved_cluster_measurements;
   // Newer frames tracked again because this frame was late (0 for a frame in order).
-  size_t replayed_frames;
+  size_t frames_replayed;
   // Whether the frame was late (older than the newest frame tracked before it, within
   // `tracker.max_frame_delay_s`) and was tracked in its place. The tracks are then those at
   // the newest frame's time (`primm_tracker_newest_timestamp`), and their
@@ -255,7 +281,8 @@ typedef struct PrimmTrack {
   double age_s;
 } PrimmTrack;
 
-// The tracker's counters since it was built (`TrackerStats` of primm-core).
+// The tracker's counters since it was built: `TrackerStats` of primm-core, field for field,
+// in the order of primm-core's list of counters (`tracker_counters!`), which documents each.
 typedef struct PrimmStats {
   // Frames tracked.
   uint64_t frames_tracked;
@@ -267,16 +294,20 @@ typedef struct PrimmStats {
   uint64_t frames_rejected_interval_too_long;
   // Frames rejected because they carried too many measurements.
   uint64_t frames_rejected_too_many_measurements;
-  // Frames rejected because their ego pose was not finite or absurdly far out.
+  // Frames rejected because their ego pose was not finite or absurdly far out (only
+  // when tracking in the world frame).
   uint64_t frames_rejected_invalid_ego_pose;
-  // Frames tracked in the world frame.
+  // Frames tracked in the world frame (they carried an ego pose and the configuration
+  // asks for the world frame).
   uint64_t frames_in_world_frame;
-  // Frames tracked in the vehicle frame although the configuration asks for the world frame
-  // (they carried no ego pose).
+  // Frames tracked in the vehicle frame although the configuration asks for the world
+  // frame, because they carried no ego pose.
   uint64_t frames_without_ego_pose;
-  // Times the live tracks were moved between the world and the vehicle frame.
+  // Times the live tracks were moved between the world and the vehicle frame, because
+  // a stream started or stopped carrying ego poses.
   uint64_t tracking_frame_changes;
-  // Tracks started in the world frame by a measurement of a sensor without configured mount.
+  // Tracks started in the world frame by a measurement whose sensor has no configured
+  // mount: their line of sight starts at the vehicle's reference point.
   uint64_t initiations_from_unknown_sensor;
   // Measurements tracked (accepted by validation).
   uint64_t measurements_accepted;
@@ -288,54 +319,75 @@ typedef struct PrimmStats {
   uint64_t measurements_rejected_out_of_range;
   // Tracks started.
   uint64_t tracks_initiated;
-  // Tracks confirmed.
+  // Tracks confirmed (a track started and confirmed at once included).
   uint64_t tracks_confirmed;
   // Tracks deleted.
   uint64_t tracks_deleted;
   // Unassigned measurements that could not start a track because the table was full.
   uint64_t initiations_refused_table_full;
-  // Track-frames in which the PR mode had no usable learned displacement and sat out (none
-  // given, or rejected).
+  // Track-frames in which the PR mode had no usable learned displacement and sat out:
+  // the predictor gave none (missed deadline, failed or hung inference) or its answer
+  // was rejected (the three `learned_predictions_rejected_*` counters). Tracks of a
+  // class outside `predictor.classes` are never requested and not counted.
   uint64_t learned_predictions_missing;
   // Frames in which at least one track had no usable learned displacement.
   uint64_t frames_with_learned_predictions_missing;
   // Learned displacements rejected for a NaN or infinite component (included in
   // `learned_predictions_missing`).
   uint64_t learned_predictions_rejected_non_finite;
-  // Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
-  // (included in `learned_predictions_missing`).
+  // Learned displacements rejected as faster than
+  // `predictor.max_displacement_speed_mps` (included in `learned_predictions_missing`).
   uint64_t learned_predictions_rejected_implausible;
-  // Learned displacements rejected for a covariance that is not finite, symmetric, positive
-  // definite and of plausible size (included in `learned_predictions_missing`).
+  // Learned displacements rejected for a covariance that is not finite, symmetric,
+  // positive definite and of plausible size (included in
+  // `learned_predictions_missing`).
   uint64_t learned_predictions_rejected_invalid_covariance;
   // Kalman updates refused for numerical reasons (the track coasted instead).
   uint64_t update_failures;
   // Calls to `primm_tracker_reset`.
   uint64_t resets;
-  // Frames with a measurement whose sensor has no configured mount (or no sensor id): such a
-  // radar is taken to look where its detections of the frame lie.
+  // Frames with a measurement whose sensor has no configured mount (or no sensor id):
+  // such a radar is taken to look where its detections of the frame lie
+  // (`frame.unknown_sensor_*`), and a track there that it missed loses existence.
   uint64_t frames_with_unknown_sensor;
   // Tracks merged into an older track of the same object.
   uint64_t duplicate_tracks_merged;
-  // Late frames tracked in their place.
+  // Late frames tracked in their place: older than the newest
+  // tracked frame, within `tracker.max_frame_delay_s` and the recorded frames.
   uint64_t late_frames_tracked;
-  // Newer frames tracked again after a late frame.
+  // Newer frames tracked again after a late frame (each late frame replays the frames
+  // it went before).
   uint64_t frames_replayed;
-  // Frames rejected for being older than the late-frame window reaches.
+  // Frames rejected because they were older than the newest tracked frame by more
+  // than the late-frame window (`tracker.max_frame_delay_s`, `tracker.replay_frames`)
+  // reaches.
   uint64_t frames_rejected_too_late;
-  // Ego poses that jumped (odometry resets).
+  // Ego poses that jumped further or turned faster than `tracker.max_ego_speed_mps`
+  // and `tracker.max_ego_yaw_rate_radps` allow since the previous frame: odometry
+  // resets, across which the tracks kept their place around the vehicle.
   uint64_t odometry_resets;
-  // Track updates with the measurement's radial velocity applied as a measurement of the
-  // velocity.
+  // Track updates in which the measurement's radial velocity was applied as a
+  // measurement of the velocity (`classes.<class>.radial_velocity_update`).
   uint64_t radial_velocity_updates;
-  // Track updates whose radial-velocity row was gated out.
+  // Track updates whose radial-velocity row lay beyond
+  // `radial_velocity_update.gate_std` in every mode and was left out.
   uint64_t radial_velocity_updates_gated;
+  // Track updates and initiations after which a velocity estimate was faster than the
+  // class's `max_speed_mps` and was scaled back onto it (steps with an ego pose only).
+  uint64_t speeds_bounded;
   // Updates and initiations of a class with a radial-velocity row or an extent whose
-  // measurement's sensor has no configured mount.
+  // measurement's sensor has no configured mount: seen from the vehicle's reference
+  // point.
   uint64_t updates_from_unknown_sensor;
-  // Unassigned measurements absorbed as extra detections of a confirmed extended track's
-  // object.
+  // Unassigned measurements absorbed as extra detections of a confirmed track's
+  // extended object (`classes.<class>.extent.absorb_extra_detections`): they started
+  // no track.
   uint64_t detections_absorbed;
+  // Existing tracks updated by an assigned measurement.
+  uint64_t tracks_updated;
+  // Tracks without a measurement while a sensor of the frame had them in view (their
+  // existence fell); tracks out of every scanning sensor's view are not counted.
+  uint64_t tracks_missed_in_view;
 } PrimmStats;
 
 // The modes the configuration names (`imm.modes`; PR, CV, CA and CT in the defaults).
@@ -399,8 +451,12 @@ size_t primm_last_error_message(char *buf, size_t len);
 // `two_wheeler`; a static string), or NULL for an unknown code.
 const char *primm_object_class_name(PrimmObjectClass class_code);
 
-// The class code of a class name (`car`, `pedestrian`, `two_wheeler`; NUL-terminated), or -1
-// for NULL or an unknown name.
+// The class code of a class label (NUL-terminated), or -1 for NULL or a label that names no
+// class. Accepts what `primm track` accepts in a measurement file: the class names (`car`,
+// `pedestrian`, `two_wheeler`) and other data sets' names of the same objects (`truck`, `bus`,
+// `person`, `bicycle`, `motorcycle`, ...), in any letter case, with `-` or a space for `_`,
+// surrounding white space ignored (`ObjectClass::from_label` of primm-core, one mapping for
+// both).
 //
 // # Safety
 // `name` is NULL or a NUL-terminated string.
@@ -416,6 +472,17 @@ int32_t primm_object_class_from_name(const char *name);
 // # Safety
 // `buf` is NULL or points to `len` writable bytes.
 size_t primm_format_f64(double value, char *buf, size_t len);
+
+// Writes the estimates of sensor `sensor_id` (a configured id, or `PRIMM_UNMOUNTED_SENSOR`)
+// for `class_code` to `*out`. `PRIMM_STATUS_INVALID_ARGUMENT` for an id that is not
+// configured or an unknown class.
+//
+// # Safety
+// `tracker` is NULL or a live handle used by no other thread; `out` is NULL or writable.
+enum PrimmStatus primm_tracker_sensor_estimates(struct PrimmTracker *tracker,
+                                                int32_t sensor_id,
+                                                PrimmObjectClass class_code,
+                                                struct PrimmSensorEstimates *out);
 
 // The default options: the built-in configuration (`config/primm.toml`) with its modes
 // (PR-IMM), the built-in PR model, inference inside `primm_tracker_step`.

@@ -106,7 +106,7 @@ class AbiMismatch : public std::runtime_error {
     std::uint32_t library_abi_version_;
 };
 
-/* The release version of the linked library, e.g. "0.1.0". */
+/* The release version of the linked library, e.g. "0.2.0". */
 inline const char *version() noexcept { return primm_version(); }
 
 /* The ABI version of the linked library (compare PRIMM_ABI_VERSION). */

@@ -1,6 +1,6 @@
 //! `primm`: command-line host of the PR-IMM tracker. Each subcommand lives in `src/cli/`.
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 mod cli;
 
 use std::process::ExitCode;
@@ -29,6 +29,8 @@ enum Command {
     Replay(cli::replay::Args),
     /// Generate simulated radar sequences as measurement CSV files.
     Generate(cli::generate::Args),
+    /// The true reflection offset, detection probability and clutter density of simulated sensors.
+    SensorTruth(cli::sensor_truth::Args),
     /// Track a measurement CSV file offline into a track CSV file.
     Track(cli::track::Args),
     /// Evaluate methods on a data set and print the paper's tables.
@@ -39,11 +41,17 @@ enum Command {
     Soak(cli::soak::Args),
     /// Benchmark the tracking service: latency files, plots, a summary, the highest lossless rate.
     BenchService(cli::bench_service::Args),
+    /// Print the configuration in effect (`show`) or the description of every key (`parameters`).
+    Config(cli::config::Args),
     /// Plot HdrHistogram interval logs (.hlog) by percentile into one SVG to compare runs.
     LatencyPlot(cli::latency_plot::Args),
     /// Relay the service's streams to other hosts through the iceoryx2 link tunnel over zenoh.
     #[cfg(feature = "tunnel")]
     Tunnel(cli::tunnel::Args),
+    /// Print the shell completion script (bash, elvish, fish, powershell, zsh).
+    Completions(cli::completions::Args),
+    /// Print the manual page, or write one page per subcommand into a directory.
+    Man(cli::man::Args),
 }
 
 /// Why a subcommand failed: its own error.
@@ -70,6 +78,9 @@ enum CommandError {
     /// `primm generate` failed.
     #[error(transparent)]
     Generate(#[from] cli::generate::GenerateError),
+    /// `primm sensor-truth` failed.
+    #[error(transparent)]
+    SensorTruth(#[from] cli::sensor_truth::SensorTruthError),
     /// `primm track` failed.
     #[error(transparent)]
     Track(#[from] cli::track::TrackError),
@@ -85,6 +96,9 @@ enum CommandError {
     /// `primm bench-service` failed.
     #[error(transparent)]
     BenchService(#[from] cli::bench_service::BenchServiceError),
+    /// `primm config` failed.
+    #[error(transparent)]
+    Config(#[from] cli::config::ConfigCommandError),
     /// `primm latency-plot` failed.
     #[error(transparent)]
     LatencyPlot(#[from] cli::latency_plot::LatencyPlotError),
@@ -92,6 +106,12 @@ enum CommandError {
     #[cfg(feature = "tunnel")]
     #[error(transparent)]
     Tunnel(#[from] cli::tunnel::TunnelError),
+    /// `primm completions` failed.
+    #[error(transparent)]
+    Completions(#[from] cli::completions::CompletionsError),
+    /// `primm man` failed.
+    #[error(transparent)]
+    Man(#[from] cli::man::ManError),
 }
 
 fn main() -> ExitCode {
@@ -105,14 +125,18 @@ fn main() -> ExitCode {
         Command::Record(args) => cli::record::run(&args).map_err(Into::into),
         Command::Replay(args) => cli::replay::run(&args).map_err(Into::into),
         Command::Generate(args) => cli::generate::run(&args).map_err(Into::into),
+        Command::SensorTruth(args) => cli::sensor_truth::run(&args).map_err(Into::into),
         Command::Track(args) => cli::track::run(&args).map_err(Into::into),
         Command::Eval(args) => cli::eval::run(&args).map_err(Into::into),
         Command::Score(args) => cli::score::run(&args).map_err(Into::into),
         Command::Soak(args) => cli::soak::run(&args).map_err(Into::into),
         Command::BenchService(args) => cli::bench_service::run(&args).map_err(Into::into),
+        Command::Config(args) => cli::config::run(&args).map_err(Into::into),
         Command::LatencyPlot(args) => cli::latency_plot::run(&args).map_err(Into::into),
         #[cfg(feature = "tunnel")]
         Command::Tunnel(args) => cli::tunnel::run(&args).map_err(Into::into),
+        Command::Completions(args) => cli::completions::run(&args, Cli::command()).map_err(Into::into),
+        Command::Man(args) => cli::man::run(&args, Cli::command()).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

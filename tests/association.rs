@@ -92,7 +92,7 @@ fn score(
             &measurement,
             &config.association,
         );
-        assert!(cost <= config.classes.get(class).gate_m, "an assigned pair lies outside the gate");
+        assert!(cost <= config.classes.get(class).paper_gate_m, "an assigned pair lies outside the gate");
         pairs += 1;
         total += cost;
     }
@@ -108,7 +108,7 @@ fn dense_optimum(scene: &Scene, config: &Config, class: ObjectClass) -> (usize, 
     if rows.is_empty() || columns.is_empty() {
         return (0, 0.0);
     }
-    let gate = config.classes.get(class).gate_m;
+    let gate = config.classes.get(class).paper_gate_m;
     let mut costs = vec![f64::INFINITY; rows.len() * columns.len()];
     for (r, &i) in rows.iter().enumerate() {
         for (c, &j) in columns.iter().enumerate() {
@@ -147,7 +147,7 @@ fn clustered_association_matches_a_dense_solve_per_class_on_random_scenes() {
                 &scene.priors,
                 &scene.frame,
                 &scene.accepted,
-                &vec![MeasurementSensor::unknown(glam::DVec2::ZERO); scene.accepted.len()],
+                &vec![MeasurementSensor::unknown(glam::DVec2::ZERO, 0.5); scene.accepted.len()],
                 &config,
                 &mut track_to_measurement,
             )
@@ -203,7 +203,7 @@ fn tracks_far_apart_are_paired_without_the_solver() {
     let accepted = vec![true; 50];
     let mut associator = Associator::new();
     let mut track_to_measurement = vec![None; 50];
-    let sensors = vec![MeasurementSensor::unknown(glam::DVec2::ZERO); accepted.len()];
+    let sensors = vec![MeasurementSensor::unknown(glam::DVec2::ZERO, 0.5); accepted.len()];
     associator
         .associate(&tracks, &priors, &frame, &accepted, &sensors, &config, &mut track_to_measurement)
         .unwrap();
@@ -236,6 +236,8 @@ fn each_assigned_car_gets_the_reflection_of_its_measurements_sensor_exactly_as_t
                     position_m: radars[rng.random_range(0..radars.len())],
                     mounted: true,
                     noise_m2: glam::DMat2::ZERO,
+                    slot: 0,
+                    reflection_scale: config.classes.car.extent.offset_scale,
                 })
                 .collect();
             let mut track_to_measurement = vec![None; scene.tracks.len()];
@@ -265,6 +267,7 @@ fn each_assigned_car_gets_the_reflection_of_its_measurements_sensor_exactly_as_t
                     &config.classes.car.extent,
                     &scene.priors[i].object_prior(),
                     sensors[usize::from(*index)].position_m,
+                    sensors[usize::from(*index)].reflection_scale,
                 );
                 // The memo may not hold it (more sensors than it keeps); if it does, exactly.
                 if let Some(shared) = shared {

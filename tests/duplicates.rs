@@ -12,8 +12,8 @@ fn config(duplicate_updates: u32) -> Config {
     config.tracker.duplicate_updates = duplicate_updates;
     config.association.cost = primm_core::config::AssociationCost::Paper;
     // A gate tighter than the two reflection points' distance, so that the second starts a track.
-    config.classes.car.gate_m = 1.0;
-    config.classes.pedestrian.gate_m = 0.5;
+    config.classes.car.paper_gate_m = 1.0;
+    config.classes.pedestrian.paper_gate_m = 0.5;
     config
 }
 
@@ -73,7 +73,7 @@ fn two_tracks_trading_one_objects_measurements_are_merged_into_the_older() {
 #[test]
 fn two_pedestrians_side_by_side_measured_in_the_same_scans_are_never_merged() {
     let mut config = config(2);
-    config.classes.pedestrian.gate_m = Config::default().classes.pedestrian.gate_m;
+    config.classes.pedestrian.paper_gate_m = Config::default().classes.pedestrian.paper_gate_m;
     let mut tracker = Tracker::new(config).unwrap();
     for k in 0..60 {
         let t = 0.03 * k as f64;

@@ -111,7 +111,7 @@ fn misses_outside_every_scanning_sensors_view_only_apply_survival() {
         );
         assert_eq!(first.status, TrackStatus::Confirmed, "out of view is not coasting");
     }
-    assert_eq!(tracker.last_step().missed_in_view, 0, "the first track was out of view");
+    assert_eq!(tracker.last_step().counts.tracks_missed_in_view, 0, "the first track was out of view");
 }
 
 #[test]
@@ -122,7 +122,7 @@ fn a_coasting_track_is_confirmed_again_by_its_next_detection() {
     }
     let coasting = tracker.step(&frame(0.2, &[car([40.0, 30.0], Some(3), 2)])).unwrap();
     assert_eq!(coasting.iter().find(|o| o.id == 1).unwrap().status, TrackStatus::Coasting);
-    assert_eq!(tracker.last_step().missed_in_view, 1);
+    assert_eq!(tracker.last_step().counts.tracks_missed_in_view, 1);
     let back = tracker.step(&frame(0.25, &[car(LEFT, Some(3), 1)])).unwrap();
     assert_eq!(of(back, 1).status, TrackStatus::Confirmed);
 }
@@ -151,7 +151,7 @@ fn a_measurement_of_an_unknown_sensor_counts_a_miss_within_its_sector_and_is_cou
         };
         let first = tracker.tracks().iter().find(|t| t.id == 1).unwrap();
         assert!((first.existence_probability - expected).abs() < 1e-12, "everywhere: {everywhere}");
-        assert_eq!(tracker.last_step().missed_in_view, usize::from(missed));
+        assert_eq!(tracker.last_step().counts.tracks_missed_in_view, u64::from(missed));
         assert_eq!(tracker.stats().frames_with_unknown_sensor, 1);
     }
     let config = config(Lifecycle::Counts);

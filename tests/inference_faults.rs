@@ -179,7 +179,7 @@ fn physics_baseline(frames: &[Frame]) -> Vec<(usize, usize, usize)> {
         .map(|frame| {
             tracker.step(frame).unwrap();
             let s = tracker.last_step();
-            (s.live_tracks, s.confirmed_tracks, s.assigned)
+            (s.live_tracks, s.confirmed_tracks, s.counts.tracks_updated as usize)
         })
         .collect()
 }
@@ -201,7 +201,7 @@ fn run<P: DisplacementPredictor>(
         let summary = *tracker.last_step();
         check_tracker(tracker).unwrap_or_else(|violation| panic!("frame {k}: {violation}"));
         assert_eq!(
-            (summary.live_tracks, summary.confirmed_tracks, summary.assigned),
+            (summary.live_tracks, summary.confirmed_tracks, summary.counts.tracks_updated as usize),
             baseline[k],
             "frame {k}: the physics modes track as without PR"
         );
@@ -228,9 +228,15 @@ fn wrong_answers_are_rejected(answer: WrongAnswer, selection: Selection) {
     let mut total_wrong = 0;
     for (k, (summary, &wrong)) in summaries.iter().zip(&wrong_per_frame).enumerate() {
         let (non_finite, implausible) = if answer.is_non_finite() { (wrong, 0) } else { (0, wrong) };
-        assert_eq!(summary.predictions_rejected_non_finite, non_finite, "frame {k}");
-        assert_eq!(summary.predictions_rejected_implausible, implausible, "frame {k}");
-        assert_eq!(summary.predictions_missing, wrong, "frame {k}: only the wrong answers are missing");
+        assert_eq!(summary.counts.learned_predictions_rejected_non_finite as usize, non_finite, "frame {k}");
+        assert_eq!(
+            summary.counts.learned_predictions_rejected_implausible as usize, implausible,
+            "frame {k}"
+        );
+        assert_eq!(
+            summary.counts.learned_predictions_missing as usize, wrong,
+            "frame {k}: only the wrong answers are missing"
+        );
         if !selection.hits_frame(frames[k].timestamp_s) {
             assert_eq!(wrong, 0, "frame {k} is outside the selection");
         }
@@ -298,8 +304,9 @@ fn a_displacement_just_above_the_configured_speed_bound_is_implausible_and_one_b
         for frame in frames().iter().take(20) {
             tracker.step(frame).unwrap();
             check_tracker(&tracker).unwrap();
-            requested +=
-                tracker.last_step().live_tracks + tracker.last_step().deleted - tracker.last_step().initiated;
+            requested += tracker.last_step().live_tracks
+                + (tracker.last_step().counts.tracks_deleted as usize)
+                - (tracker.last_step().counts.tracks_initiated as usize);
         }
         let rejected = tracker.stats().learned_predictions_rejected_implausible as usize;
         assert!(requested > 0);
@@ -322,8 +329,8 @@ fn non_finite_answers_through_the_inference_thread_are_rejected_for_the_selected
         |_, _| wrong_per_frame.push(*wrong.lock().unwrap()),
     );
     for (k, (summary, &wrong)) in summaries.iter().zip(&wrong_per_frame).enumerate() {
-        assert_eq!(summary.predictions_rejected_non_finite, wrong, "frame {k}");
-        assert_eq!(summary.predictions_missing, wrong, "frame {k}");
+        assert_eq!(summary.counts.learned_predictions_rejected_non_finite as usize, wrong, "frame {k}");
+        assert_eq!(summary.counts.learned_predictions_missing as usize, wrong, "frame {k}");
     }
     assert!(wrong_per_frame.iter().sum::<usize>() > 0);
     assert_eq!(tracker.predictor().stats().deadline_misses, 0);
@@ -355,10 +362,15 @@ fn late_answers_cost_exactly_the_late_frames_and_are_counted_as_deadline_misses(
     let late_frames: Vec<usize> = (0..frames.len()).filter(|&k| is_late(k)).collect();
     assert!(!late_frames.is_empty());
     for (k, summary) in summaries.iter().enumerate() {
-        let requested = summary.live_tracks + summary.deleted - summary.initiated;
+        let requested = summary.live_tracks + (summary.counts.tracks_deleted as usize)
+            - (summary.counts.tracks_initiated as usize);
         let expected_missing = if is_late(k) { requested } else { 0 };
-        assert_eq!(summary.predictions_missing, expected_missing, "frame {k}");
-        assert_eq!(summary.predictions_rejected_non_finite + summary.predictions_rejected_implausible, 0);
+        assert_eq!(summary.counts.learned_predictions_missing as usize, expected_missing, "frame {k}");
+        assert_eq!(
+            (summary.counts.learned_predictions_rejected_non_finite as usize)
+                + (summary.counts.learned_predictions_rejected_implausible as usize),
+            0
+        );
     }
     let stats = *tracker.predictor().stats();
     assert_eq!(stats.deadline_misses as usize, late_frames.len());
@@ -399,9 +411,10 @@ fn a_hung_inference_thread_is_detected_and_counted_frames_go_on_without_pr_and_d
         },
     );
     for (k, summary) in summaries.iter().enumerate() {
-        let requested = summary.live_tracks + summary.deleted - summary.initiated;
+        let requested = summary.live_tracks + (summary.counts.tracks_deleted as usize)
+            - (summary.counts.tracks_initiated as usize);
         let expected_missing = if k >= hang_from { requested } else { 0 };
-        assert_eq!(summary.predictions_missing, expected_missing, "frame {k}");
+        assert_eq!(summary.counts.learned_predictions_missing as usize, expected_missing, "frame {k}");
     }
     let hung_seen_at = hung_seen_at.expect("the hang is detected");
     assert!(hung_seen_at > hang_from, "a hang is a batch held past the threshold, not a single miss");
@@ -484,9 +497,10 @@ fn a_panicking_inference_thread_retires_the_predictor_and_later_frames_go_withou
     let mut tracker = Tracker::with_predictor(pr_imm(), threaded).unwrap();
     let summaries = run(&mut tracker, &frames, |_, _| {}, |_, _| {});
     for (k, summary) in summaries.iter().enumerate() {
-        let requested = summary.live_tracks + summary.deleted - summary.initiated;
+        let requested = summary.live_tracks + (summary.counts.tracks_deleted as usize)
+            - (summary.counts.tracks_initiated as usize);
         let expected_missing = if k >= panic_frame { requested } else { 0 };
-        assert_eq!(summary.predictions_missing, expected_missing, "frame {k}");
+        assert_eq!(summary.counts.learned_predictions_missing as usize, expected_missing, "frame {k}");
     }
     let stats = *tracker.predictor().stats();
     assert_eq!(stats.inference_panics, 1);

@@ -68,12 +68,21 @@ fn a_four_radar_sequence_delivered_out_of_order_within_the_window_gives_the_same
     let order = arrival_order(frames.len(), 6, 7);
     assert!(order.windows(2).any(|pair| pair[1] < pair[0]), "the arrival order must shuffle");
     let mut shuffled = Tracker::new(imm_config()).unwrap();
-    let (mut arrived, mut newest, mut prefix_checks) = (0usize, 0usize, 0);
+    let (mut arrived, mut newest, mut prefix_checks, mut late_checks) = (0usize, 0usize, 0, 0);
+    let mut has_arrived = vec![false; frames.len()];
     for &index in &order {
         shuffled.step(&frames[index]).unwrap_or_else(|error| panic!("frame {index}: {error}"));
-        let late = shuffled.last_step().late;
+        has_arrived[index] = true;
+        let late = shuffled.last_step().late();
         let outputs = shuffled.last_outputs();
         assert_eq!(late, index < newest, "frame {index} after {newest}");
+        assert_eq!(late, !shuffled.late_frame_outputs().is_empty(), "frame {index}");
+        // A late frame's own outputs, once every older frame is in: those of in-order arrival
+        // after that frame.
+        if late && has_arrived[..index].iter().all(|&arrived| arrived) {
+            assert_eq!(shuffled.late_frame_outputs(), &in_order[index][..], "late frame {index}");
+            late_checks += 1;
+        }
         newest = newest.max(index);
         arrived += 1;
         // Whenever the frames that arrived are exactly the first ones, the tracks are those of
@@ -84,6 +93,7 @@ fn a_four_radar_sequence_delivered_out_of_order_within_the_window_gives_the_same
         }
     }
     assert!(prefix_checks > 20, "{prefix_checks}");
+    assert!(late_checks > 20, "{late_checks}");
     assert_eq!(shuffled.newest_timestamp_s(), Some(frames.last().unwrap().timestamp_s));
     let stats = shuffled.stats();
     assert!(stats.late_frames_tracked > 50, "{stats:?}");
@@ -144,9 +154,9 @@ fn a_frame_just_inside_the_window_is_tracked_in_its_place() {
     let late = two_cars(newest - 0.14);
     tracker.step(&late).unwrap();
     let step = *tracker.last_step();
-    assert!(step.late);
+    assert!(step.late());
     // It went between the frames at 0.85 and 0.9 s: the three newer ones were tracked again.
-    assert_eq!(step.replayed_frames, 3);
+    assert_eq!(step.counts.frames_replayed, 3);
     assert_eq!(tracker.stats().late_frames_tracked, 1);
     // The same as tracking it in order.
     let mut in_order = Tracker::new(imm_config()).unwrap();

@@ -200,7 +200,7 @@ fn initial_velocity_lies_along_the_line_of_sight_with_the_measured_radial_speed(
     let config = common::config();
     assert!(
         ((along.transpose() * velocity_covariance * along)[(0, 0)]
-            - config.classes.car.radial_velocity_std_mps.powi(2))
+            - config.classes.car.initial_radial_speed_std_mps.powi(2))
         .abs()
             < 1e-12
     );

@@ -119,7 +119,7 @@ fn switched_off_the_row_is_never_applied_nor_counted() {
     let mut tracker = Tracker::new(config(false)).unwrap();
     for (frame, _) in &frames {
         tracker.step(frame).unwrap();
-        assert_eq!(tracker.last_step().radial_velocity_rows_applied, 0);
+        assert_eq!(tracker.last_step().counts.radial_velocity_updates, 0);
     }
     let stats = tracker.stats();
     assert_eq!(
@@ -219,7 +219,7 @@ fn for_extended_cars_the_detections_own_line_of_sight_gives_truer_velocities_tha
 }
 
 #[test]
-fn the_line_of_sight_key_reads_all_three_directions_and_defaults_to_predicted() {
+fn the_line_of_sight_key_reads_all_three_directions_and_a_file_without_it_keeps_the_shipped_one() {
     // The shipped file, with the car's key replaced (its first occurrence is in the car section).
     let shipped = primm_config::DEFAULT_CONFIG_TOML;
     let key = "line_of_sight = \"measured\"\n";
@@ -229,7 +229,8 @@ fn the_line_of_sight_key_reads_all_three_directions_and_defaults_to_predicted() 
             .map(|config| config.classes.get(ObjectClass::Car).radial_velocity_update.line_of_sight)
     };
     assert_eq!(read(key).unwrap(), RadialLineOfSight::Measured);
-    assert_eq!(read("").unwrap(), RadialLineOfSight::Predicted);
+    // A file is laid over the shipped one: leaving the key out keeps the shipped direction.
+    assert_eq!(read("").unwrap(), RadialLineOfSight::Measured);
     assert_eq!(read("line_of_sight = \"predicted\"\n").unwrap(), RadialLineOfSight::Predicted);
     assert_eq!(read("line_of_sight = \"reflection\"\n").unwrap(), RadialLineOfSight::Reflection);
     assert!(read("line_of_sight = \"centre\"\n").is_err());

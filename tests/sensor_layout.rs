@@ -46,9 +46,10 @@ fn the_config_file_the_core_default_and_the_generator_mount_the_same_radars() {
 }
 
 #[test]
-fn every_preset_mounts_the_default_radars() {
+fn every_preset_with_sensor_ids_mounts_the_default_radars() {
     let reference = Preset::Default.config().radar.sensor_layout();
-    for preset in Preset::ALL {
+    // A preset without sensor ids (a static sensor) gives the tracker no mount to look up.
+    for preset in Preset::ALL.into_iter().filter(|preset| preset.config().output.sensor_id) {
         assert_same_radars(preset.name(), &preset.config().radar.sensor_layout(), &reference);
     }
 }

@@ -84,7 +84,7 @@ fn malformed_frames_are_rejected_and_counted_and_the_next_good_frame_is_tracked(
     let (status, stdout) = serve.wait(Duration::from_secs(10));
     assert!(status.success());
     assert!(stdout.contains("frames: 25 received, 22 tracked, 3 rejected, 0 lost"), "{stdout}");
-    assert!(stdout.contains("1 rejected; tracks"), "{stdout}");
+    assert!(stdout.contains("measurements_rejected_non_finite 1,"), "{stdout}");
 }
 
 #[test]

@@ -115,20 +115,25 @@ fn with_the_learned_predictor_every_frame_comes_back_with_the_tracks_of_a_synchr
     assert!(status.success(), "{status}: {stdout}");
     assert!(stdout.contains("frames: 60 received, 60 tracked, 0 rejected, 0 lost"), "{stdout}");
     assert!(stdout.contains("learned_wait"), "{stdout}");
-    // The first frame has no tracks yet, so there is nothing to predict for it. Whether a batch
-    // meets even a one-second deadline depends on the machine; the offline run has a
-    // displacement for every frame. So: with every batch on time the served tracks must equal
-    // the offline ones frame for frame (the served tracker got every displacement from its
-    // inference thread); after a miss they may part, and the test says so instead of failing.
-    let on_time =
-        "learned predictor (inference thread, deadline 1000.0 ms): 59 batches, 59 on time, 0 deadline misses";
-    if stdout.contains(on_time) {
+    // The first frame has no tracks yet, so there is nothing to predict for it; from the second
+    // on the service also hands over each next frame's batch ahead of it. Whether a batch meets
+    // even a one-second deadline depends on the machine; the offline run has a displacement for
+    // every frame. So: with no deadline missed the served tracks must equal the offline ones
+    // frame for frame (the served tracker got every displacement from its inference thread, in
+    // the frame or ahead of it); after a miss they may part, and the test says so instead of
+    // failing.
+    let report = "learned predictor (inference thread, deadline 1000.0 ms): ";
+    let line = stdout.lines().find(|line| line.contains(report)).unwrap_or_else(|| panic!("{stdout}"));
+    let counts: Vec<u64> = line[line.find(report).unwrap() + report.len()..]
+        .split(", ")
+        .take(3)
+        .map(|part| part.split(' ').next().unwrap().parse().unwrap())
+        .collect();
+    let [batches, _on_time, misses] = counts[..] else { panic!("{line}") };
+    assert!(batches >= 59, "{line}");
+    if misses == 0 {
         assert_eq!(replay.first_difference, None, "served tracks differ from the synchronous offline run");
     } else {
-        assert!(
-            stdout.contains("learned predictor (inference thread, deadline 1000.0 ms): 59 batches"),
-            "{stdout}"
-        );
         println!(
             "a batch missed the one-second deadline on this machine; tracks first differ at frame {:?}",
             replay.first_difference

@@ -92,16 +92,19 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
         range_std_m: 0.2,
         azimuth_std_rad: 0.03,
         azimuth_std_max_factor: 2.0,
+        reflection: primm_core::sensor::ReflectionModel::Outline,
         ..CoordinatesConfig::default().sensors[0]
     };
     let noise = SensorNoise::of(&mount, None);
     scene.sensors = (0..measurement_count)
         .map(|j| match j % 2 {
-            0 => MeasurementSensor::unknown(DVec2::ZERO),
+            0 => MeasurementSensor::unknown(DVec2::ZERO, 0.5),
             _ => MeasurementSensor {
                 position_m: mount.position(),
                 mounted: true,
                 noise_m2: noise.covariance_m2(scene.frame.measurements[j].position() - mount.position()),
+                slot: 0,
+                reflection_scale: 0.5,
             },
         })
         .collect();
@@ -121,7 +124,7 @@ fn pair_cost(scene: &Scene, config: &Config, track: usize, measurement: usize) -
                 m,
                 &config.association,
             );
-            (cost <= section.gate_m).then_some(cost)
+            (cost <= section.paper_gate_m).then_some(cost)
         }
         AssociationCost::Likelihood => {
             let [[xx, xy], [yx, yy]] = section.measurement_noise_covariance_m2;
@@ -131,7 +134,8 @@ fn pair_cost(scene: &Scene, config: &Config, track: usize, measurement: usize) -
             let s = prior.covariance + noise;
             let nu = m.position() - prior.mean;
             let dv = m.radial_velocity_mps - scene.tracks[track].last_radial_velocity_mps;
-            let distance = nu.dot(s.inverse() * nu) + (dv / section.radial_velocity_residual_std_mps).powi(2);
+            let distance =
+                nu.dot(s.inverse() * nu) + (dv / section.likelihood_radial_velocity_std_mps).powi(2);
             (distance <= config.association.likelihood_gate_chi2).then(|| distance + s.determinant().ln())
         }
     }
@@ -336,7 +340,7 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
                 &scene.priors[i].fused,
                 DMat2::from_cols(DVec2::new(xx, yx), DVec2::new(xy, yy)),
                 track.last_radial_velocity_mps,
-                section.radial_velocity_residual_std_mps,
+                section.likelihood_radial_velocity_std_mps,
                 likelihood.association.likelihood_gate_chi2,
             )
             .unwrap();
@@ -366,5 +370,5 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
 
 /// Sensors at the reference point, without mounts (the costs here treat every class as a point).
 fn sensors(accepted: &[bool]) -> Vec<MeasurementSensor> {
-    vec![MeasurementSensor::unknown(glam::DVec2::ZERO); accepted.len()]
+    vec![MeasurementSensor::unknown(glam::DVec2::ZERO, 0.5); accepted.len()]
 }

@@ -140,6 +140,8 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
                 position_m,
                 mounted: true,
                 noise_m2: glam::DMat2::from_diagonal(DVec2::new(0.01, 0.2 * (i % 2) as f64)),
+                slot: 0,
+                reflection_scale: 0.5,
             })
             .collect();
         // The reflections the tracker computes once per frame and hands to the loop.
@@ -147,7 +149,11 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
             .iter()
             .enumerate()
             .map(|(i, track)| {
-                models[track.class.index()].expected_reflection(&plain[i].object_prior(), sensor_positions[i])
+                models[track.class.index()].expected_reflection(
+                    &plain[i].object_prior(),
+                    sensor_positions[i],
+                    0.5,
+                )
             })
             .collect();
         let mut dispatched_tracks = tracks.clone();
@@ -169,7 +175,7 @@ fn dispatched_loops_equal_the_baseline_loops_and_the_plain_imm_calls_bit_for_bit
                 Some(z) => {
                     let models = &models[track.class.index()];
                     let reflection =
-                        models.expected_reflection(&plain[i].object_prior(), sensor_positions[i]);
+                        models.expected_reflection(&plain[i].object_prior(), sensor_positions[i], 0.5);
                     let radial_velocity =
                         models.radial_velocity_observation(&z, &sensors[i], reflection.offset_m);
                     assert!(radial_velocity.is_some());

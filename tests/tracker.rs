@@ -9,7 +9,7 @@ use primm_core::measurement::{
 };
 use primm_core::mode::Method;
 use primm_core::track::{TrackOutput, TrackStatus};
-use primm_core::tracker::{StepError, Tracker};
+use primm_core::tracker::{StepError, Tracker, TrackerStats};
 use primm_core::validation::FrameError;
 use std::collections::HashMap;
 
@@ -233,7 +233,8 @@ fn a_frame_with_a_non_finite_timestamp_is_rejected_and_changes_nothing() {
     assert_eq!(snapshot(&tracker), before);
     assert_eq!(tracker.stats().frames_rejected_non_finite_timestamp, 1);
     let summary = tracker.last_step();
-    assert_eq!((summary.measurements_accepted, summary.measurements_rejected), (0, 0));
+    assert_eq!((summary.counts.measurements_accepted, summary.measurements_rejected()), (0, 0));
+    assert_eq!(summary.counts.frames_rejected_non_finite_timestamp, 1);
     assert_eq!(summary.live_tracks, before.len());
     tracker.step(&frames[20]).unwrap();
 }
@@ -337,7 +338,7 @@ fn a_bad_measurement_is_rejected_alone_and_the_rest_of_the_frame_is_tracked() {
     assert_eq!(stats.measurements_rejected_out_of_range, 1);
     assert_eq!(stats.measurements_rejected_unknown_class, 1);
     let summary = tracker.last_step();
-    assert_eq!((summary.measurements_accepted, summary.measurements_rejected), (good, 4));
+    assert_eq!((summary.counts.measurements_accepted, summary.measurements_rejected()), (good as u64, 4));
 }
 
 #[test]
@@ -363,7 +364,7 @@ fn a_full_table_refuses_new_tracks_and_keeps_the_old_ones() {
     assert_eq!(full.len(), MAX_TRACKS);
     tracker.step(&frame_at(2)).unwrap();
     assert_eq!(tracker.stats().initiations_refused_table_full, MAX_MEASUREMENTS_PER_FRAME as u64);
-    assert_eq!(tracker.last_step().initiations_refused_table_full, MAX_MEASUREMENTS_PER_FRAME);
+    assert_eq!(tracker.last_step().counts.initiations_refused_table_full, MAX_MEASUREMENTS_PER_FRAME as u64);
     // Nothing was evicted to make room: the surviving tracks are old ones.
     assert!(tracker.tracks().iter().all(|t| full.contains(&t.id)));
 }
@@ -387,45 +388,32 @@ fn each_step_summarises_its_frame_and_the_summaries_add_up_to_the_statistics() {
     frames.extend((1..=40).map(|k| Frame::new(last_s + 0.05 * k as f64)));
     let mut tracker = Tracker::new(Config::default()).unwrap();
     let mut into = Tracker::new(Config::default()).unwrap();
-    let mut sums = [0u64; 5];
+    let mut sums = TrackerStats::default();
     for frame in &frames {
         let outputs = tracker.step(frame).unwrap().to_vec();
         let summary = *tracker.last_step();
         assert_eq!(summary.live_tracks, outputs.len());
         assert_eq!(summary.confirmed_tracks, outputs.iter().filter(|o| o.status.is_confirmed()).count());
         assert_eq!(
-            summary.assigned + summary.initiated,
-            outputs.iter().filter(|o| o.measurement_index.is_some()).count()
+            summary.counts.tracks_updated + summary.counts.tracks_initiated,
+            outputs.iter().filter(|o| o.measurement_index.is_some()).count() as u64
         );
         assert_eq!(
-            (summary.measurements_accepted, summary.measurements_rejected),
-            (frame.measurements.len(), 0)
+            (summary.counts.measurements_accepted, summary.measurements_rejected()),
+            (frame.measurements.len() as u64, 0)
         );
+        assert_eq!(summary.counts.frames_tracked, 1);
         let mut sunk = 0;
         assert_eq!(into.step_into(frame, |_| sunk += 1).unwrap(), summary);
         assert_eq!(sunk, summary.live_tracks);
-        for (sum, count) in sums.iter_mut().zip([
-            summary.measurements_accepted,
-            summary.initiated,
-            summary.newly_confirmed,
-            summary.deleted,
-            summary.predictions_missing,
-        ]) {
-            *sum += count as u64;
-        }
+        sums.add(&summary.counts);
     }
-    let stats = tracker.stats();
-    assert_eq!(
-        sums,
-        [
-            stats.measurements_accepted,
-            stats.tracks_initiated,
-            stats.tracks_confirmed,
-            stats.tracks_deleted,
-            stats.learned_predictions_missing
-        ]
+    // Every counter, by the same name: the totals are the steps' counts added up.
+    assert_eq!(&sums, tracker.stats());
+    assert!(
+        sums.tracks_initiated > 0 && sums.tracks_deleted == sums.tracks_initiated,
+        "every track started was deleted"
     );
-    assert!(sums[1] > 0 && sums[3] == sums[1], "every track started was deleted");
     tracker.reset();
     assert_eq!(tracker.last_step().live_tracks, 0);
 }

@@ -154,7 +154,7 @@ fn late_frames_tracked_in_their_place_allocate_nothing() {
     let allocations = count_allocations(|| {
         for frame in &order {
             tracker.step(*frame).expect("within the late-frame window");
-            late += u64::from(tracker.last_step().late);
+            late += u64::from(tracker.last_step().late());
         }
     });
     assert_eq!(allocations, 0);

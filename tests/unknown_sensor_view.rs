@@ -33,7 +33,7 @@ fn frames() -> Vec<Frame> {
 
 /// Each live track's (confirmed, existence probability) after the last frame, and how many
 /// times a track missed a detection in view over the whole run.
-fn run(config: Config) -> (Vec<(bool, f64)>, usize) {
+fn run(config: Config) -> (Vec<(bool, f64)>, u64) {
     let mut tracker = Tracker::new(config).unwrap();
     let (mut last, mut missed) = (Vec::new(), 0);
     for frame in frames() {
@@ -43,7 +43,7 @@ fn run(config: Config) -> (Vec<(bool, f64)>, usize) {
             .iter()
             .map(|o| (o.status.is_confirmed(), o.existence_probability))
             .collect();
-        missed += tracker.last_step().missed_in_view;
+        missed += tracker.last_step().counts.tracks_missed_in_view;
     }
     (last, missed)
 }

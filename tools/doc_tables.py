@@ -11,11 +11,16 @@ RESULTS_PATH is relative to the repository root. What is rendered depends on the
 
 * ``.csv``: the first row that is not a ``# `` comment is the header, every further row a row of
   the table, each cell verbatim (bold markers, units and thousands separators included). Comment
-  lines at the top name the command that produced the figures and its date.
+  lines at the top name the command that produced the figures and its date. Comment lines of the
+  form ``# release: VERSION``, ``# commit: SHA`` and ``# measured: DATE`` record what was
+  measured (``tools/release_figures.sh`` writes them); a file with a ``release`` line is rendered
+  with a line under its table that names the release, the commit and the date, and
+  ``tools/check_release_figures.py`` checks them against the workspace's version.
 * ``.md`` (the files the benchmarks write under ``benches/results/``): a markdown table of that
   file, the first unless ``table="N"`` selects the N-th.
 * ``.txt``: the file's text verbatim, in a ``text`` code fence (the text tables `primm eval`
-  prints).
+  prints); where it opens with ``# release:`` and the other comment lines below, those are left
+  out of the fence and rendered as for a ``.csv``.
 
 Options for tables (``.csv`` and ``.md``):
 
@@ -138,6 +143,34 @@ def markdown_tables(text: str) -> list[list[list[str]]]:
     return tables
 
 
+METADATA = re.compile(r"^# (?P<key>release|commit|measured|command|host): (?P<value>.+?)\s*$")
+
+
+def read_metadata(path: Path) -> dict[str, str]:
+    """The ``# key: value`` lines at the top of a results file (release, commit, measured, ...)."""
+    metadata = {}
+    for line in path.read_text(encoding="utf-8").split("\n"):
+        if not line.startswith("#"):
+            break
+        match = METADATA.match(line)
+        if match:
+            metadata[match.group("key")] = match.group("value")
+    return metadata
+
+
+def provenance(metadata: dict[str, str]) -> list[str]:
+    """The line under a table whose results file records the release it was measured on."""
+    if "release" not in metadata:
+        return []
+    parts = [f"primm {metadata['release']}"]
+    if "commit" in metadata:
+        parts.append(f"commit {metadata['commit'][:10]}")
+    if "measured" in metadata:
+        parts.append(metadata["measured"])
+    host = f"; {metadata['host']}" if "host" in metadata else ""
+    return ["", f"*Measured on {', '.join(parts)}{host}.*"]
+
+
 def read_csv(path: Path) -> list[list[str]]:
     lines = path.read_text(encoding="utf-8").split("\n")
     while lines and lines[0].startswith("#"):
@@ -207,12 +240,19 @@ def render(results: str, options: dict[str, str], where: str) -> list[str]:
     if suffix == ".txt":
         if options:
             raise DocTableError(f"{where}: a .txt results file takes no options")
-        text = path.read_text(encoding="utf-8").rstrip("\n")
-        return ["```text"] + text.split("\n") + ["```"]
+        lines = path.read_text(encoding="utf-8").rstrip("\n").split("\n")
+        metadata = read_metadata(path)
+        if metadata:
+            while lines and lines[0].startswith("# "):
+                lines.pop(0)
+        return ["```text"] + lines + ["```"] + provenance(metadata)
     if suffix == ".csv":
         if "table" in options:
             raise DocTableError(f"{where}: table= selects a table of a .md results file only")
         rows = read_csv(path)
+        if not rows:
+            raise DocTableError(f"{where}: {results} holds no rows")
+        return render_rows(apply_options(rows, options, where)) + provenance(read_metadata(path))
     elif suffix == ".md":
         tables = markdown_tables(path.read_text(encoding="utf-8"))
         number = int(options.get("table", "1"))

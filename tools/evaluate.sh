@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Reproduces docs/EVALUATION.md: generates the evaluation split (default preset) and the robustness
-# split (a second generator configuration), then runs `primm eval` on both.
+# The paper's tables for two presets: generates the evaluation split of the default and the
+# robustness preset, then runs `primm eval` on both (docs/EVALUATION.md's headline table comes
+# from tools/release_figures.sh, which covers six presets).
 #   tools/evaluate.sh [OUT_DIR]      (default: out/evaluation)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -2,6 +2,7 @@
 # Installs primm's C and C++ API into PREFIX:
 #
 #   PREFIX/include/primm.h, primm.hpp        the C header and the C++17 wrapper
+#   PREFIX/include/primm_wire.h              the shared-memory payloads, for subscribers in C
 #   PREFIX/lib/libprimm_ffi.a                the static library
 #   PREFIX/lib/libprimm_ffi.so.ABI           the shared library (soname libprimm_ffi.so.ABI),
 #   PREFIX/lib/libprimm_ffi.so -> .so.ABI    ABI being PRIMM_ABI_VERSION of primm.h
@@ -73,6 +74,7 @@ pointer_bytes=$((pointer_bytes / 8))
 
 mkdir -p "$prefix/include" "$prefix/lib/cmake/primm" "$prefix/lib/pkgconfig"
 install -m 644 "$root/include/primm.h" "$root/include/primm.hpp" "$prefix/include/"
+install -m 644 "$root/crates/primm-wire/include/primm_wire.h" "$prefix/include/"
 install -m 644 "$library_dir/libprimm_ffi.a" "$prefix/lib/libprimm_ffi.a"
 install -m 755 "$library_dir/libprimm_ffi.so" "$prefix/lib/libprimm_ffi.so.$abi_version"
 ln -sfn "libprimm_ffi.so.$abi_version" "$prefix/lib/libprimm_ffi.so"

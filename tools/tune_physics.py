@@ -136,7 +136,7 @@ PARAMETERS = [
         (".constant_acceleration", "jerk_psd_m2_per_s5"),
         (".coordinated_turn", "acceleration_psd_m2_per_s3"),
         (".coordinated_turn", "turn_rate_psd_rad2_per_s3"),
-        ("", "gate_m"),
+        ("", "paper_gate_m"),
         ("", "initial_tangential_speed_std_mps"),
     )
 ]
@@ -178,14 +178,14 @@ TRACK_PARAMETERS = [
     ("tracker", "confirmation_existence_probability"),
     ("tracker", "deletion_existence_probability"),
     ("tracker", "existence_persistence_time_s"),
-    ("classes.car", "gate_m"),
-    ("classes.pedestrian", "gate_m"),
+    ("classes.car", "paper_gate_m"),
+    ("classes.pedestrian", "paper_gate_m"),
 ]
 # The likelihood cost's gate and spreads, which replace the paper cost's gates in the set.
 LIKELIHOOD_PARAMETERS = [
     ("association", "likelihood_gate_chi2"),
-    ("classes.car", "radial_velocity_residual_std_mps"),
-    ("classes.pedestrian", "radial_velocity_residual_std_mps"),
+    ("classes.car", "likelihood_radial_velocity_std_mps"),
+    ("classes.pedestrian", "likelihood_radial_velocity_std_mps"),
 ]
 # The radial-velocity row of the physics modes' update, per class (scored like ``physics``).
 RADIAL_VELOCITY_PARAMETERS = [
@@ -589,7 +589,7 @@ def track_parameters(config: dict) -> list:
     """The knobs of the ``tracks`` set for a configuration: the likelihood cost's gate and spreads
     replace the paper cost's gates when the configuration uses it."""
     if config.get("association", {}).get("cost") == "likelihood":
-        return [parameter for parameter in TRACK_PARAMETERS if parameter[1] != "gate_m"] + LIKELIHOOD_PARAMETERS
+        return [parameter for parameter in TRACK_PARAMETERS if parameter[1] != "paper_gate_m"] + LIKELIHOOD_PARAMETERS
     return list(TRACK_PARAMETERS)
 
 

@@ -89,7 +89,7 @@ def initial_velocity(cls: dict, x: float, y: float, vr: float):
     along = np.array([x / rng, y / rng]) if rng > 1e-6 else np.array([1.0, 0.0])
     across = np.array([-along[1], along[0]])
     mean = along * vr
-    cov = np.outer(along, along) * cls["radial_velocity_std_mps"] ** 2 + np.outer(across, across) * cls[
+    cov = np.outer(along, along) * cls["initial_radial_speed_std_mps"] ** 2 + np.outer(across, across) * cls[
         "initial_tangential_speed_std_mps"
     ] ** 2
     return mean, cov
@@ -195,7 +195,7 @@ def stonesoup_parts(cls: dict) -> dict:
     measurement_model = LinearGaussian(ndim_state=4, mapping=(0, 2), noise_covar=np.array(cls["measurement_noise_covariance_m2"]))
     predictor = KalmanPredictor(transition)
     updater = KalmanUpdater(measurement_model)
-    hypothesiser = DistanceHypothesiser(predictor, updater, measure=Euclidean(mapping=(0, 1), mapping2=(0, 1)), missed_distance=cls["gate_m"])
+    hypothesiser = DistanceHypothesiser(predictor, updater, measure=Euclidean(mapping=(0, 1), mapping2=(0, 1)), missed_distance=cls["paper_gate_m"])
     return {
         "predictor": predictor,
         "updater": updater,
@@ -306,7 +306,7 @@ class PeerTracker:
             for j, m in enumerate(detections):
                 distance = math.hypot(m[2] - track.prior[0], m[3] - track.prior[1])
                 c = distance + association["velocity_weight_s"] * min(abs(m[4] - track.last_vr), association["velocity_cap_mps"])
-                if c <= cls["gate_m"]:
+                if c <= cls["paper_gate_m"]:
                     cost[i, j] = c
         rows, cols = linear_sum_assignment(cost)
         return [(tracks[r], detections[c]) for r, c in zip(rows, cols) if cost[r, c] < FORBIDDEN]

@@ -13,7 +13,9 @@
  * names (frame, t, gt_id, class, x, y, vr, rcs required; sensor_id and the ego pose ego_x,
  * ego_y, ego_yaw optional; others ignored),
  * fields are trimmed, lines starting with '#' are comments, and a row with an empty class is
- * the one row of a frame without measurements. Rows of one frame are consecutive.
+ * the one row of a frame without measurements. Rows of one frame are consecutive. Classes are
+ * read by primm_object_class_from_name, which accepts what `primm track` accepts (car, truck,
+ * bus, person, Bicycle, ...: docs/scenario.md).
  *
  * Output: header frame,t,track_id,class,x,y,prior_x,prior_y,gt_id,mu_pr,mu_cv,mu_ca,mu_ct,status,
  * existence_probability and
@@ -241,8 +243,9 @@ static void print_upper_triangle(FILE *out, const double covariance[16]) {
 /* Tracks one frame (with its ego pose, or NULL) and writes the rows of the tracks a measurement
  * updated; with `world_columns`, each row ends with the world-frame estimate (empty without).
  * Frames come in file order, which is arrival order: a late frame is tracked in its place and
- * writes no rows (its tracks are those of the newest frame); one older than the late-frame
- * window is skipped, as `primm track` does. */
+ * writes no rows here (the C API hands out the tracks at the newest frame's time, while
+ * `primm track` writes the late frame's own rows, so the two files differ for such input); one
+ * older than the late-frame window is skipped, as `primm track` does. */
 static void track_frame(PrimmTracker *tracker, FILE *out, uint64_t frame, double timestamp_s,
                         const PrimmEgoPose *pose, const PrimmMeasurement *measurements, size_t count,
                         PrimmTrack *tracks, int world_columns) {

@@ -311,8 +311,9 @@ void write_track_row(std::FILE *out, std::uint64_t frame, double timestamp_s, co
 
 /* Tracks one frame (with its ego pose, or none) and writes the rows of the tracks a measurement
  * updated. Frames come in file order, which is arrival order: a late frame is tracked in its
- * place and writes no rows (its tracks are those of the newest frame); one older than the
- * late-frame window is skipped, as `primm track` does. */
+ * place and writes no rows here (the C API hands out the tracks at the newest frame's time,
+ * while `primm track` writes the late frame's own rows, so the two files differ for such input);
+ * one older than the late-frame window is skipped, as `primm track` does. */
 void track_frame(primm::Tracker &tracker, std::FILE *out, std::uint64_t frame, double timestamp_s,
                  const std::optional<PrimmEgoPose> &pose, primm::Span<const PrimmMeasurement> measurements,
                  primm::Span<PrimmTrack> buffer, bool world_columns) {

@@ -1,28 +1,35 @@
 #!/usr/bin/env python3
 """Reads the tracks the primm tracker publishes on ``primm/tracks`` with the iceoryx2 Python
-package (``pip install iceoryx2``) and prints them.
+package and prints them.
 
-The samples are read in place from shared memory through the ctypes declarations of
-``primm_wire.py``. The script sleeps on the event service of the same name until the tracker
+Install the wire types first (once, into the Python you run this with):
+
+    pip install "crates/primm-wire/python[subscribe]"   # primm_wire and iceoryx2==0.10.0
+
+The samples are read in place from shared memory through the ctypes declarations of the
+``primm_wire`` module. The script sleeps on the event service of the same name until the tracker
 notifies, and opens the service with the same QoS as every primm program.
 
-    python3 examples/python/subscriber.py [--service-prefix PREFIX] [--frames N] [--json]
+    python3 examples/python/subscriber.py [--service-prefix PREFIX] [--frames N] [--json] [--record FILE]
 
-With ``--json`` it prints one JSON object per track frame instead of a table. Like every primm
-program it works in the iceoryx2 domain that ``PRIMM_ICEORYX2_DOMAIN`` names (iceoryx2's default
-domain when unset), so it also reads the tracks a ``primm tunnel`` brings from another host.
+With ``--json`` it prints one JSON object per track frame instead of a table. With ``--record
+FILE`` it also appends every track frame to FILE as it lies in shared memory (217 168 bytes each,
+the layout of ``primm_track_frame`` in ``primm_wire.h``); ``examples/c/subscriber.c`` reads such
+a file with that header alone. Like every primm program it works in the iceoryx2 domain that
+``PRIMM_ICEORYX2_DOMAIN`` names (iceoryx2's default domain when unset), so it also reads the
+tracks a ``primm tunnel`` brings from another host.
 """
 
 import argparse
+import ctypes
 import json
 import os
 import sys
 
-import iceoryx2 as iox2
+from primm_wire import CLASS_NAMES, QOS, STATUS_NAMES, TRACKS, TrackFrame, service_name
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "crates", "primm-wire", "python"))
-from primm_wire import CLASS_NAMES, QOS, STATUS_NAMES, TRACKS, TrackFrame, service_name  # noqa: E402
+# The iceoryx2 package, imported in main() so that --help works without it.
+iox2 = None
 
 
 def iceoryx2_config():
@@ -94,12 +101,29 @@ def print_table(record):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--service-prefix", default=os.environ.get("PRIMM_SERVICE_PREFIX", ""))
     parser.add_argument("--frames", type=int, default=0, help="exit after this many track frames (0: never)")
     parser.add_argument("--timeout-s", type=float, default=0.0, help="exit after this long without a frame (0: never)")
     parser.add_argument("--json", action="store_true", help="one JSON object per track frame")
+    parser.add_argument(
+        "--record",
+        metavar="FILE",
+        help="also append every track frame to FILE as it lies in shared memory (examples/c/subscriber.c reads it)",
+    )
     args = parser.parse_args()
+
+    global iox2
+    try:
+        import iceoryx2
+    except ImportError:
+        print(
+            'subscriber.py: the iceoryx2 Python package is missing: pip install "crates/primm-wire/python[subscribe]"',
+            file=sys.stderr,
+        )
+        return 2
+    iox2 = iceoryx2
+    record_file = open(args.record, "ab") if args.record else None
 
     iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
     node = iox2.NodeBuilder.new().config(iceoryx2_config()).create(iox2.ServiceType.Ipc)
@@ -119,7 +143,11 @@ def main():
             if sample is None:
                 break
             got_any = True
-            record = frame_record(sample.payload().contents)
+            frame = sample.payload().contents
+            record = frame_record(frame)
+            if record_file is not None:
+                record_file.write(ctypes.string_at(ctypes.addressof(frame), ctypes.sizeof(TrackFrame)))
+                record_file.flush()
             sample.delete()
             received += 1
             if args.json:
@@ -131,6 +159,8 @@ def main():
         idle_s = 0.0 if got_any else idle_s + 0.1
         if args.timeout_s and idle_s >= args.timeout_s:
             break
+    if record_file is not None:
+        record_file.close()
     return 0
 
 

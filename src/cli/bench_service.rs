@@ -57,6 +57,10 @@ pub struct TrackerSettings {
     /// Let the tracker spin on its input instead of sleeping until notified.
     #[arg(long)]
     pub busy_poll: bool,
+    /// Run the learned mode only when a frame arrives, not ahead of it (`primm serve
+    /// --no-speculation`).
+    #[arg(long)]
+    pub no_speculation: bool,
     /// The tracker's real-time settings (docs/realtime-tuning.md); the benchmark's own client
     /// threads stay unpinned.
     #[command(flatten)]
@@ -76,6 +80,9 @@ impl TrackerSettings {
         }
         if self.busy_poll {
             arguments.push("--busy-poll".into());
+        }
+        if self.no_speculation {
+            arguments.push("--no-speculation".into());
         }
         arguments.extend(self.realtime.to_arguments().into_iter().map(OsString::from));
         if let Some(address) = self.view.foxglove {
@@ -581,6 +588,7 @@ mod tests {
             tracker: TrackerArgs { engine: Some(InferenceEngine::Tract), ..TrackerArgs::default() },
             inference_threads: Some(2),
             busy_poll: true,
+            no_speculation: true,
             realtime: TrackerRealtimeArgs::default(),
             view: FoxgloveArgs::default(),
         };
@@ -591,7 +599,16 @@ mod tests {
             .collect();
         assert_eq!(
             arguments,
-            ["--method", "pr-imm", "--engine", "tract", "--inference-threads", "2", "--busy-poll"]
+            [
+                "--method",
+                "pr-imm",
+                "--engine",
+                "tract",
+                "--inference-threads",
+                "2",
+                "--busy-poll",
+                "--no-speculation"
+            ]
         );
     }
 
@@ -602,6 +619,7 @@ mod tests {
             tracker: TrackerArgs::default(),
             inference_threads: None,
             busy_poll: false,
+            no_speculation: false,
             realtime: TrackerRealtimeArgs {
                 thread: primm_service::realtime::RealtimeArgs {
                     cpu_affinity: Some("1".parse().unwrap()),

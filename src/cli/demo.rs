@@ -21,7 +21,14 @@ mod two_hosts;
 
 /// Arguments of `primm demo`.
 #[derive(Debug, Clone, clap::Args)]
-#[command(about = "Run tracker, publisher and subscriber over shared memory on a built-in scenario")]
+#[command(
+    about = "Run tracker, publisher and subscriber over shared memory on a built-in scenario",
+    after_help = "\
+Examples:
+  primm demo                                  # IMM, 20 s scenario: accuracy and latency per stage
+  primm demo --method pr-imm                  # the full PR-IMM, PR on two inference threads
+  primm demo --method pr-imm --latency-out lat/   # also .hlog/.hgrm per stage and SVG plots"
+)]
 pub struct Args {
     /// Seed of the generated scenario.
     #[arg(long, default_value_t = DEFAULT_SCENARIO_SEED)]

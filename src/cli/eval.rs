@@ -22,7 +22,12 @@ fn parse_truth(text: &str) -> Result<Truth, String> {
 /// Arguments of `primm eval`.
 #[derive(Debug, Clone, ClapArgs)]
 #[command(
-    about = "Evaluate methods on a data set (a directory of measurement CSV files) and print the paper's tables"
+    about = "Evaluate methods on a data set (a directory of measurement CSV files) and print the paper's tables",
+    after_help = "\
+Examples:
+  primm eval --data data/evaluation                              # all six methods, text tables
+  primm eval --data data/evaluation --methods imm,pr-imm --json eval.json --plots plots
+  primm eval --data data/validation --methods imm,pr,pr-imm --displacement-oracle"
 )]
 pub struct Args {
     /// Directory of measurement CSV files (one sequence per file).

@@ -62,6 +62,13 @@ pub enum PresetChoice {
     /// The clutter-turning scene with extended vehicles.
     #[value(name = "extended_clutter_turning", alias = "extended-clutter-turning")]
     ExtendedClutterTurning,
+    /// The default scene seen by object-list radars: each detected object at its true centre
+    /// plus noise.
+    Centroid,
+    /// One static roadside radar in dense traffic (25 to 45 objects in view), frames every 50
+    /// to 80 ms without ego pose or sensor id, a little clutter.
+    #[value(name = "dense_static", alias = "dense-static")]
+    DenseStatic,
 }
 
 impl From<PresetChoice> for Preset {
@@ -76,13 +83,22 @@ impl From<PresetChoice> for Preset {
             PresetChoice::ExtendedTurning => Preset::ExtendedTurning,
             PresetChoice::ExtendedClutter => Preset::ExtendedClutter,
             PresetChoice::ExtendedClutterTurning => Preset::ExtendedClutterTurning,
+            PresetChoice::Centroid => Preset::Centroid,
+            PresetChoice::DenseStatic => Preset::DenseStatic,
         }
     }
 }
 
 /// Arguments of `primm generate`.
 #[derive(Debug, Clone, ClapArgs)]
-#[command(about = "Generate simulated radar sequences (one CSV file per sequence in DIR/<split>/)")]
+#[command(
+    about = "Generate simulated radar sequences (one CSV file per sequence in DIR/<split>/)",
+    after_help = "\
+Examples:
+  primm generate --output data                                   # train, validation and evaluation splits
+  primm generate --output clutter --split evaluation --preset clutter
+  primm generate --output short --split evaluation --sequences 2 --duration-s 5"
+)]
 pub struct Args {
     /// Output directory; sequences go to DIR/train, DIR/validation and DIR/evaluation.
     #[arg(long, value_name = "DIR")]

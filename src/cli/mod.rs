@@ -3,14 +3,18 @@
 //! `primm subscribe` run the loops of the `primm-publisher` and `primm-subscriber` packages.
 
 pub mod bench_service;
+pub mod completions;
+pub mod config;
 pub mod demo;
 pub mod eval;
 pub mod generate;
 pub mod latency_out;
 pub mod latency_plot;
+pub mod man;
 pub mod record;
 pub mod replay;
 pub mod score;
+pub mod sensor_truth;
 pub mod serve;
 pub mod soak;
 pub mod track;

@@ -27,7 +27,12 @@ use std::time::Duration;
 /// Arguments of `primm serve`.
 #[derive(Debug, Clone, clap::Args)]
 #[command(
-    about = "Track frames from primm/measurements and publish primm/tracks and primm/latency over shared memory"
+    about = "Track frames from primm/measurements and publish primm/tracks and primm/latency over shared memory",
+    after_help = "\
+Examples:
+  primm serve --method imm                    # then: primm publish --scenario, primm subscribe
+  primm serve --method pr-imm --config my.toml
+  primm serve --method pr-imm --cpu-affinity 2 --inference-cpu-affinity 3 --realtime-priority 80 --lock-memory"
 )]
 pub struct Args {
     /// The tracker's configuration, model (run on dedicated inference threads with the
@@ -57,6 +62,10 @@ pub struct Args {
     /// step, and the learned mode sits the prediction out). See docs/integrating.md.
     #[arg(long, value_enum, default_value = "frame", value_name = "WHEN")]
     pub publish_time: PublishTimeArg,
+    /// Predict the learned mode only when a frame arrives, not ahead of it for the next frame's
+    /// guessed time once the previous answer is sent (same results; for comparison).
+    #[arg(long)]
+    pub no_speculation: bool,
     /// Latency files (`--latency-out DIR`).
     #[command(flatten)]
     pub latency_files: LatencyOutArgs,
@@ -198,6 +207,7 @@ fn serve<P: DisplacementPredictor>(
             PublishTimeArg::Frame => PublishTime::Frame,
             PublishTimeArg::Now => PublishTime::Now,
         },
+        speculate: !args.no_speculation,
     };
     let names = options.names.clone();
     let mut service = TrackingService::new(tracker, options)?;

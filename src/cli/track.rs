@@ -4,11 +4,13 @@ use super::track_mcap::OfflineRecording;
 use super::TrackerArgs;
 use clap::Args as ClapArgs;
 use primm_core::mode::Method;
+use primm_core::predictor::DisplacementPredictor;
 use primm_core::tracker::{StepError, Tracker};
 use primm_core::validation::FrameError;
 use primm_predictor::onnx::ModelError;
-use primm_predictor::predictor_for;
 use primm_record::transforms::RadarPose;
+use primm_predictor::split::{on_inference_threads, InferenceThreadsError};
+use primm_predictor::{load_predictor, predictor_for};
 use primm_sim::io::association_csv::AssociationCsvWriter;
 use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_sim::io::{read_sequence_file, CsvError, TooManyMeasurements};
@@ -16,7 +18,14 @@ use std::path::{Path, PathBuf};
 
 /// Arguments of `primm track`.
 #[derive(Debug, Clone, ClapArgs)]
-#[command(about = "Track a measurement CSV file offline and write the track CSV file")]
+#[command(
+    about = "Track a measurement CSV file offline and write the track CSV file",
+    after_help = "\
+Examples:
+  primm track --input data/evaluation/evaluation_0000.csv --output tracks.csv --method imm
+  primm track --input scene.csv --output tracks.csv --config my.toml --associations assoc.csv
+  primm track --input scene.csv --output tracks.csv --method pr-imm --timing steps.txt"
+)]
 pub struct Args {
     /// Measurement CSV file.
     #[arg(long, value_name = "FILE")]
@@ -34,7 +43,8 @@ pub struct Args {
     /// `primm score`).
     #[arg(long, value_name = "FILE")]
     pub associations: Option<PathBuf>,
-    /// Time every tracker step (the CSV reading and writing excluded) and append one line per
+    /// Time every tracker step (the CSV reading and writing excluded; the speculation of
+    /// `--inference-threads` included) and append one line per
     /// frame with its step time in nanoseconds to FILE; prints a one-line JSON summary (frames
     /// per second, percentiles) on stdout.
     #[arg(long, value_name = "FILE")]
@@ -43,7 +53,30 @@ pub struct Args {
     /// included; docs/recording.md), to open in Foxglove or replay with `primm replay`.
     #[arg(long, value_name = "FILE")]
     pub mcap: Option<PathBuf>,
+    /// Run the PR model on COUNT inference threads (1 to 8) instead of on the tracking thread,
+    /// each step handing them the next frame's requests ahead for its guessed time
+    /// (speculation); the threads spin briefly before parking, so give each one a core of its
+    /// own (on an oversubscribed host this is many times slower). Every frame waits for its
+    /// answers (up to a minute, not the service's deadline), so the tracks are the same bit for
+    /// bit as without.
+    #[arg(long, value_name = "COUNT", value_parser = clap::value_parser!(u8).range(1..=8))]
+    pub inference_threads: Option<u8>,
 }
+
+/// How long `primm track --inference-threads` waits for a frame's learned predictions: far
+/// beyond any inference time, so that no frame goes without them and offline results do not
+/// depend on timing.
+const OFFLINE_INFERENCE_WAIT: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// How long the tracking and inference threads of `primm track --inference-threads` spin
+/// before parking (`ThreadedPredictor::set_spin`): offline frames follow each other within
+/// this, so no batch waits for a wake-up.
+const OFFLINE_SPIN: std::time::Duration = std::time::Duration::from_micros(500);
+
+/// The fewest requests each inference thread of `primm track --inference-threads` takes before a
+/// batch is shared further: offline batches are small (a few pedestrians per radar scan), and
+/// each row costs about as much as handing a thread its part.
+const OFFLINE_MIN_REQUESTS_PER_PART: usize = 4;
 
 /// Why `primm track` failed.
 #[derive(Debug, thiserror::Error)]
@@ -54,6 +87,9 @@ pub enum TrackError {
     /// The learned predictor's model could not be loaded.
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// The inference threads could not be started.
+    #[error(transparent)]
+    InferenceThreads(#[from] InferenceThreadsError),
     /// The configuration is invalid for the tracker.
     #[error(transparent)]
     Tracker(#[from] primm_core::config::ConfigError),
@@ -103,11 +139,30 @@ fn create(path: &Path) -> Result<std::fs::File, TrackError> {
     std::fs::File::create(path).map_err(|source| TrackError::Create { path: path.to_owned(), source })
 }
 
+/// The predictor of `primm track`: the method's, synchronous, or the PR model on `threads`
+/// inference threads without a deadline in practice.
+fn track_predictor(
+    args: &Args,
+    threads: Option<u8>,
+    engine: primm_config::InferenceEngine,
+) -> Result<Box<dyn DisplacementPredictor + Send>, TrackError> {
+    let model = args.tracker.model.as_deref();
+    let Some(threads) = threads else { return Ok(predictor_for(args.method, model, engine)?) };
+    let mut split =
+        on_inference_threads(load_predictor(model, engine)?, usize::from(threads), OFFLINE_INFERENCE_WAIT)?
+            .with_min_requests_per_part(OFFLINE_MIN_REQUESTS_PER_PART);
+    for part in split.parts_mut() {
+        part.set_spin(OFFLINE_SPIN);
+    }
+    Ok(Box::new(split))
+}
+
 /// Runs `primm track`.
 pub fn run(args: &Args) -> Result<(), TrackError> {
     let settings = args.tracker.load_settings()?;
     let config = settings.tracker.with_modes(args.method.modes());
-    let predictor = predictor_for(args.method, args.tracker.model.as_deref(), settings.inference.engine)?;
+    let threads = args.inference_threads.filter(|_| args.method.needs_predictor());
+    let predictor = track_predictor(args, threads, settings.inference.engine)?;
     let mut tracker = Tracker::with_predictor(config, predictor)?;
     let sequence = read_sequence_file(&args.input)?;
     let file = create(&args.output)?;
@@ -131,8 +186,9 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
     let mut step_ns: Vec<u64> = Vec::with_capacity(frames.len());
     tracker.reset();
     // Frames in file order, which is arrival order: a late frame (within
-    // `tracker.max_frame_delay_s`) is tracked in its place and writes no rows of its own; one
-    // older than that is rejected, counted and skipped.
+    // `tracker.max_frame_delay_s`) is tracked in its place and writes the rows of the tracks as
+    // they were right after it (the rows of the newer frames, written when they came, stay);
+    // one older than that is rejected, counted and skipped.
     for (recorded, frame) in sequence.frames.iter().zip(&frames) {
         let start = std::time::Instant::now();
         match tracker.step(frame) {
@@ -146,14 +202,15 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
             }
             Err(source) => return Err(TrackError::Step { frame: recorded.index, source }),
         };
+        if threads.is_some() {
+            tracker.speculate();
+        }
         step_ns.push(start.elapsed().as_nanos() as u64);
         if let Some(recording) = recording.as_mut() {
             recording.write_tracked(recorded, &tracker)?;
         }
-        if tracker.last_step().late {
-            continue;
-        }
-        let outputs = tracker.last_outputs();
+        let outputs =
+            if tracker.last_step().late() { tracker.late_frame_outputs() } else { tracker.last_outputs() };
         writer.write_frame(recorded.index, recorded.timestamp_s, outputs)?;
         if let Some(associations) = associations.as_mut() {
             associations.write_frame(recorded.index, recorded.measurements.len(), outputs)?;
@@ -179,6 +236,10 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         stats.tracks_deleted,
         args.output.display()
     );
+    let sensors = tracker.sensors().report(tracker.config()).to_string();
+    if !sensors.is_empty() {
+        eprintln!("sensors (estimated from the data):\n{sensors}");
+    }
     Ok(())
 }
 

@@ -72,35 +72,50 @@ def copy_of_the_repository(tmp_path: Path) -> Path:
 
 def test_a_changed_figure_fails_the_check_and_write_repairs_it(tmp_path: Path) -> None:
     copy = copy_of_the_repository(tmp_path)
-    results = copy / "docs/results/reliability_max_rate.csv"
+    results = copy / "docs/results/benchmarks_tunnel.csv"
     text = results.read_text(encoding="utf-8")
-    assert "11 200 Hz" in text
-    results.write_text(text.replace("11 200 Hz", "11 300 Hz"), encoding="utf-8")
+    assert "2324.5" in text
+    results.write_text(text.replace("2324.5", "2325.5"), encoding="utf-8")
 
     failed = run("--root", str(copy), "--check")
     assert failed.returncode == 1
-    assert re.search(r"docs/RELIABILITY\.md:\d+: the table differs from its results file docs/results/reliability_max_rate\.csv", failed.stderr)
-    assert "-| IMM | 11 200 Hz |" in failed.stderr
-    assert "+| IMM | 11 300 Hz |" in failed.stderr
+    assert re.search(r"docs/BENCHMARKS\.md:\d+: the table differs from its results file docs/results/benchmarks_tunnel\.csv", failed.stderr)
+    assert "-| tunnel (zenoh, loopback) | tracks | 594.9 | 726.0 | 2324.5 |" in failed.stderr
+    assert "+| tunnel (zenoh, loopback) | tracks | 594.9 | 726.0 | 2325.5 |" in failed.stderr
 
     written = run("--root", str(copy), "--write")
     assert written.returncode == 0, written.stderr
-    assert "| IMM | 11 300 Hz | 11 600 Hz |" in (copy / "docs/RELIABILITY.md").read_text(encoding="utf-8")
     assert run("--root", str(copy), "--check").returncode == 0
     # Nothing but that one figure changed.
-    before = (ROOT / "docs/RELIABILITY.md").read_text(encoding="utf-8")
-    assert (copy / "docs/RELIABILITY.md").read_text(encoding="utf-8") == before.replace("| IMM | 11 200 Hz |", "| IMM | 11 300 Hz |")
+    before = (ROOT / "docs/BENCHMARKS.md").read_text(encoding="utf-8")
+    assert (copy / "docs/BENCHMARKS.md").read_text(encoding="utf-8") == before.replace("| 2324.5 |", "| 2325.5 |")
 
 
-def test_a_table_of_a_benchmark_results_file_follows_that_file(tmp_path: Path) -> None:
-    copy = copy_of_the_repository(tmp_path)
-    results = copy / "benches/results/peers.md"
-    results.write_text(results.read_text(encoding="utf-8").replace("| 458.7x |", "| 460.0x |"), encoding="utf-8")
-    failed = run("--root", str(copy), "--check")
+def test_a_results_file_that_names_its_release_is_rendered_with_it_under_the_table(tmp_path: Path) -> None:
+    results = tmp_path / "docs" / "results" / "r.csv"
+    results.parent.mkdir(parents=True)
+    results.write_text(
+        "# what was run\n# release: 1.2.3\n# commit: 0123456789abcdef\n# measured: 2026-12-04\na,b\nx,1\n", encoding="utf-8"
+    )
+    doc = tmp_path / "docs" / "R.md"
+    doc.write_text("<!-- table: docs/results/r.csv -->\n<!-- /table -->\n", encoding="utf-8")
+    assert run("--root", str(tmp_path), "--write", str(doc)).returncode == 0
+    rendered = doc.read_text(encoding="utf-8")
+    assert "| x | 1 |\n\n*Measured on primm 1.2.3, commit 0123456789, 2026-12-04.*\n<!-- /table -->" in rendered
+    results.write_text(results.read_text(encoding="utf-8").replace("1.2.3", "1.2.4"), encoding="utf-8")
+    failed = run("--root", str(tmp_path), "--check", str(doc))
     assert failed.returncode == 1
-    assert "benches/results/peers.md" in failed.stderr
-    assert run("--root", str(copy), "--write").returncode == 0
-    assert "| 460.0x |" in (copy / "docs/BENCHMARKS.md").read_text(encoding="utf-8")
+    assert "+*Measured on primm 1.2.4" in failed.stderr
+
+
+def test_a_text_results_file_keeps_its_release_lines_out_of_the_fence(tmp_path: Path) -> None:
+    (tmp_path / "t.txt").write_text("# primm eval\n# release: 0.2.0\n# commit: abcdef0\nTable II\n", encoding="utf-8")
+    doc_tables.ROOT, saved = tmp_path, doc_tables.ROOT
+    try:
+        lines = doc_tables.render("t.txt", {}, "test")
+    finally:
+        doc_tables.ROOT = saved
+    assert lines == ["```text", "Table II", "```", "", "*Measured on primm 0.2.0, commit abcdef0.*"]
 
 
 def test_columns_digits_and_labels_select_round_and_relabel(tmp_path: Path) -> None:

@@ -442,16 +442,16 @@ def test_the_oracle_flag_reaches_every_primm_eval_call(tmp_path, monkeypatch):
 def test_the_tracks_set_moves_probabilities_through_their_odds_and_other_knobs_by_factor():
     assert tune_physics.scaled_value("detection_probability", 0.5, 3.0) == 0.75
     assert 0.0 < tune_physics.scaled_value("deletion_existence_probability", 0.9, 100.0) < 1.0
-    assert tune_physics.scaled_value("gate_m", 4.0, 0.5) == 2.0
+    assert tune_physics.scaled_value("paper_gate_m", 4.0, 0.5) == 2.0
     config = tomllib.loads(shipped_text())
     for section, key in tune_physics.TRACK_PARAMETERS + tune_physics.LIKELIHOOD_PARAMETERS:
         tune_physics.get_value(config, section, key)  # every knob exists in the shipped file
     config["association"]["cost"] = "likelihood"
     likelihood = tune_physics.track_parameters(config)
     assert ("association", "likelihood_gate_chi2") in likelihood
-    assert all(key != "gate_m" for _, key in likelihood)
+    assert all(key != "paper_gate_m" for _, key in likelihood)
     config["association"]["cost"] = "paper"
-    assert ("classes.car", "gate_m") in tune_physics.track_parameters(config)
+    assert ("classes.car", "paper_gate_m") in tune_physics.track_parameters(config)
 
 
 def test_the_tracks_objective_rewards_confirmed_identity_and_punishes_false_tracks_and_idf1_lost(tmp_path):

@@ -1,30 +1,42 @@
 //! # primm-config: the tracker configuration as a TOML file
 //!
 //! `primm-core` keeps its [`Config`] a plain, validated value so that it needs no parser. This
-//! crate reads the TOML form of it: [`settings_from_toml_str`] and [`settings_from_file`] parse,
-//! reject unknown keys and values of the wrong type, then validate, with an error that names
-//! the offending key. A file also says how the learned model runs ([`InferenceConfig`]: engine,
+//! crate reads the TOML form of it: [`settings_from_toml_str`] and [`settings_from_file`] lay
+//! the file over the shipped defaults key by key (a file of one key is the shipped
+//! configuration with that key changed), reject unknown keys, renamed keys and values of the
+//! wrong type with the line of the file, then validate, with an error that names the offending
+//! key. [`Settings::difference_from_defaults`] is what a configuration changes, as TOML;
+//! [`parameters_markdown`] documents every key (`docs/parameters.md`). A file also says how the learned model runs ([`InferenceConfig`]: engine,
 //! inference threads, deadline), which the tracker never reads; [`Settings`] holds both, and
 //! [`from_toml_str`] and [`from_file`] return the tracker's part alone.
 //! [`DEFAULT_CONFIG_TOML`] is the documented default file, `config/primm.toml`, embedded; a
 //! test checks that it parses to exactly [`Settings::default`].
 //!
 //! ```
-//! let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 8.4", "gate_m = 4.5");
-//! let config = primm_config::from_toml_str(&text)?;
-//! assert_eq!(config.classes.car.gate_m, 4.5);
+//! let config = primm_config::from_toml_str("[classes.car]\npaper_gate_m = 4.5\n")?;
+//! let mut expected = primm_core::config::Config::default();
+//! expected.classes.car.paper_gate_m = 4.5;
+//! assert_eq!(config, expected);
 //!
-//! let error = primm_config::from_toml_str(&text.replace("gate_m = 4.5", "gate_m = -1.0"));
-//! assert!(error.unwrap_err().to_string().contains("classes.car.gate_m"));
+//! let error = primm_config::from_toml_str("[classes.car]\npaper_gate_m = -1.0\n");
+//! assert!(error.unwrap_err().to_string().contains("classes.car.paper_gate_m"));
 //! # Ok::<(), primm_config::ConfigError>(())
 //! ```
 
+mod difference;
 mod file;
 mod inference;
+mod layers;
+mod parameters;
+mod renamed;
 
 pub use inference::{InferenceConfig, InferenceEngine, UnknownEngine, MAX_INFERENCE_THREADS};
+pub use parameters::parameters_markdown;
 use primm_core::config::Config;
+pub use renamed::RenamedKey;
 use std::path::Path;
+/// Why a configuration could not be written as TOML.
+pub use toml::ser::Error as TomlWriteError;
 
 /// The default configuration file (`config/primm.toml`), embedded.
 pub const DEFAULT_CONFIG_TOML: &str = include_str!("../../../config/primm.toml");
@@ -64,22 +76,27 @@ pub enum ConfigError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// The TOML is malformed, a key is unknown or a value has the wrong type.
+    /// The TOML is malformed, a key is unknown or a value has the wrong type (the message
+    /// shows the line).
     #[error("configuration is not valid TOML for primm: {0}")]
     Parse(#[from] toml::de::Error),
+    /// A key was renamed; the error names the new key and the line.
+    #[error(transparent)]
+    RenamedKey(#[from] RenamedKey),
     /// A value is out of its valid range; the error names the key.
     #[error(transparent)]
     Invalid(#[from] primm_core::config::ConfigError),
 }
 
-/// Parses and validates a whole TOML document.
+/// Parses a TOML document laid over the shipped defaults (every key it leaves out keeps the
+/// value of `config/primm.toml`) and validates the result.
 pub fn settings_from_toml_str(text: &str) -> Result<Settings, ConfigError> {
-    let settings = Settings::from(toml::from_str::<file::FileLayout>(text)?);
+    let settings = Settings::from(layers::layered_file(text)?);
     settings.validate()?;
     Ok(settings)
 }
 
-/// Reads, parses and validates a whole TOML file.
+/// Reads a TOML file, lays it over the shipped defaults and validates the result.
 pub fn settings_from_file(path: &Path) -> Result<Settings, ConfigError> {
     let text = std::fs::read_to_string(path)
         .map_err(|source| ConfigError::Io { path: path.display().to_string(), source })?;
@@ -124,7 +141,7 @@ mod tests {
     #[test]
     fn a_configuration_survives_a_round_trip_through_toml() {
         let mut config = Config::default();
-        config.classes.pedestrian.gate_m = 2.25;
+        config.classes.pedestrian.paper_gate_m = 2.25;
         let text = to_toml_string(&config).unwrap();
         assert_eq!(from_toml_str(&text).unwrap(), config);
     }
@@ -147,7 +164,7 @@ mod tests {
 
     #[test]
     fn an_unknown_key_is_a_parse_error_that_names_it() {
-        let text = DEFAULT_CONFIG_TOML.replace("gate_m = 8.4", "gate_m = 8.4\ngate_meters = 1.0");
+        let text = DEFAULT_CONFIG_TOML.replace("paper_gate_m = 8.4", "paper_gate_m = 8.4\ngate_meters = 1.0");
         let error = from_toml_str(&text).unwrap_err();
         assert!(matches!(error, ConfigError::Parse(_)), "{error:?}");
         assert!(error.to_string().contains("gate_meters"), "{error}");

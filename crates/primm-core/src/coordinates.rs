@@ -82,6 +82,14 @@ pub struct CoordinatesConfig {
     /// See `unknown_sensor_margin_rad`, m (absent: 10).
     #[cfg_attr(feature = "serde", serde(default = "default_unknown_sensor_margin_m"))]
     pub unknown_sensor_margin_m: f64,
+    /// Where the detections of radars without a configured mount lie on an extended object:
+    /// `"outline"`, `"centre"` or `"auto"` (absent: outline; `crate::sensor`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub unmounted_reflection: crate::sensor::ReflectionModel,
+    /// How fast the sensors' running estimates move (absent: the defaults of
+    /// [`EstimationConfig`](crate::sensor::estimates::EstimationConfig)).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub estimation: crate::sensor::estimates::EstimationConfig,
 }
 
 /// `frame.unknown_sensor_margin_rad` when absent.
@@ -117,6 +125,7 @@ impl Default for CoordinatesConfig {
             range_std_m: 0.12,
             azimuth_std_rad: 0.0105,
             azimuth_std_max_factor: 1.0,
+            reflection: crate::sensor::ReflectionModel::Outline,
         };
         let mut sensors = ArrayVec::new();
         sensors.push(mount(1, 3.66, -0.87, -85.0));
@@ -128,6 +137,8 @@ impl Default for CoordinatesConfig {
             sensors,
             unknown_sensor_margin_rad: DEFAULT_UNKNOWN_SENSOR_MARGIN_RAD,
             unknown_sensor_margin_m: DEFAULT_UNKNOWN_SENSOR_MARGIN_M,
+            unmounted_reflection: crate::sensor::ReflectionModel::Outline,
+            estimation: crate::sensor::estimates::EstimationConfig::default(),
         }
     }
 }
@@ -145,6 +156,9 @@ impl CoordinatesConfig {
         }
         if !(self.unknown_sensor_margin_m.is_finite() && self.unknown_sensor_margin_m >= 0.0) {
             return Some(("frame.unknown_sensor_margin_m", "must be a finite number >= 0"));
+        }
+        if let Some(problem) = self.estimation.problem() {
+            return Some(problem);
         }
         for (index, mount) in self.sensors.iter().enumerate() {
             if !(mount.x_m.is_finite() && mount.y_m.is_finite() && mount.yaw_rad.is_finite()) {

@@ -154,6 +154,14 @@ pub struct FieldOfView {
 }
 
 impl FieldOfView {
+    /// The area of the field of view, m²: the sector of its opening angle out to its range.
+    pub fn area_m2(&self) -> f64 {
+        crate::sensor::estimates::sector_area_m2(
+            math::acos(self.cos_half_angle.clamp(-1.0, 1.0)),
+            self.max_range_m,
+        )
+    }
+
     /// The field of view of `mount` in the tracking frame: the world frame when `pose` is the
     /// step's ego pose, else the vehicle frame.
     pub fn of(mount: &SensorMount, pose: Option<EgoPose>) -> Self {
@@ -229,6 +237,7 @@ mod tests {
             range_std_m: 0.0,
             azimuth_std_rad: 0.0,
             azimuth_std_max_factor: 1.0,
+            reflection: crate::sensor::ReflectionModel::Outline,
         }
     }
 

@@ -144,22 +144,32 @@ const HEADING_STD_BOX_RAD: f64 = 0.6;
 const HEADING_STD_DISC_RAD: f64 = 1.0;
 
 /// The expected reflection of an object of `extent` with prior `object`, seen by a sensor at
-/// `sensor_m` (all in one frame); see the module documentation for the box and disc models.
+/// `sensor_m` (all in one frame), for a sensor whose detections lie `scale` of the way from the
+/// centre (0) to the outline (1): the outline's offset and spread, scaled (the sensor's
+/// measurement model, `crate::sensor`; see the module documentation for the box and disc
+/// models). At scale 0, a point.
 pub fn expected_reflection(
     extent: &ExtentConfig,
     object: &ObjectPrior,
     sensor_m: DVec2,
+    scale: f64,
 ) -> ExpectedReflection {
-    let reflection = on_the_outline(extent, object, sensor_m);
-    let scale = extent.offset_scale;
+    if !(scale > 0.0) {
+        return ExpectedReflection::POINT;
+    }
+    let reflection = outline_reflection(extent, object, sensor_m);
     ExpectedReflection {
         offset_m: reflection.offset_m * scale,
         covariance_m2: reflection.covariance_m2 * (scale * scale),
     }
 }
 
-/// [`expected_reflection`] on the outline itself (`offset_scale` 1).
-fn on_the_outline(extent: &ExtentConfig, object: &ObjectPrior, sensor_m: DVec2) -> ExpectedReflection {
+/// [`expected_reflection`] on the outline itself (scale 1).
+pub fn outline_reflection(
+    extent: &ExtentConfig,
+    object: &ObjectPrior,
+    sensor_m: DVec2,
+) -> ExpectedReflection {
     let to_sensor = sensor_m - object.centre_m;
     let range = to_sensor.length();
     if !(range > 1e-6) {
@@ -339,8 +349,12 @@ mod tests {
     #[test]
     fn seen_from_behind_the_reflection_is_on_the_rear_and_says_little_across_it() {
         // A car driving along +x at 10 m/s, the sensor 20 m behind it.
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(20.0, 0.0), DVec2::new(10.0, 0.0)), DVec2::ZERO);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(20.0, 0.0), DVec2::new(10.0, 0.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         assert!(near(reflection.offset_m, DVec2::new(-2.25, 0.0), 0.05), "{reflection:?}");
         // Along x the rear face pins the centre; across it, the reflection is opposite the
         // sensor wherever the car is: the width's uniform spread and the contour spread.
@@ -350,16 +364,24 @@ mod tests {
 
     #[test]
     fn seen_from_a_diagonal_the_reflection_is_the_nearest_corner() {
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(10.0, 10.0), DVec2::new(0.0, 5.0)), DVec2::ZERO);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(10.0, 10.0), DVec2::new(0.0, 5.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         // Heading +y: the long axis is y, the width x; the corner toward the origin.
         assert!(near(reflection.offset_m, DVec2::new(-0.9, -2.25), 0.05), "{reflection:?}");
     }
 
     #[test]
     fn abeam_the_reflection_is_on_the_near_side_and_the_position_along_it_is_left_open() {
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(0.5, 10.0), DVec2::new(-8.0, 0.0)), DVec2::ZERO);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(0.5, 10.0), DVec2::new(-8.0, 0.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         assert!(near(reflection.offset_m, DVec2::new(0.0, -0.9), 0.05), "{reflection:?}");
         // Along the side (x) the variance is the length's uniform spread.
         assert!(reflection.covariance_m2.x_axis.x > 4.5 * 4.5 / 12.0 * 0.95, "{reflection:?}");
@@ -394,15 +416,19 @@ mod tests {
 
     #[test]
     fn without_a_heading_the_reflection_lies_toward_the_sensor() {
-        let reflection =
-            expected_reflection(&car(), &prior(DVec2::new(0.0, 30.0), DVec2::new(0.3, 0.0)), DVec2::ZERO);
+        let reflection = expected_reflection(
+            &car(),
+            &prior(DVec2::new(0.0, 30.0), DVec2::new(0.3, 0.0)),
+            DVec2::ZERO,
+            1.0,
+        );
         assert!(near(reflection.offset_m, DVec2::new(0.0, -1.575), 1e-12), "{reflection:?}");
         let spread = reflection.covariance_m2;
         assert!((spread.y_axis.y - 0.675f64.powi(2)).abs() < 1e-12 && (spread.x_axis.x - 0.25).abs() < 1e-12);
         // An uncertain heading is no heading either.
         let mut unsure = prior(DVec2::new(0.0, 30.0), DVec2::new(5.0, 0.0));
         unsure.velocity_covariance_m2 = DMat2::from_diagonal(DVec2::splat(100.0));
-        let reflection = expected_reflection(&car(), &unsure, DVec2::ZERO);
+        let reflection = expected_reflection(&car(), &unsure, DVec2::ZERO, 1.0);
         assert!(near(reflection.offset_m, DVec2::new(0.0, -1.575), 1e-12), "{reflection:?}");
     }
 
@@ -411,7 +437,7 @@ mod tests {
         let extent = car();
         let at = |speed: f64, angle: f64| {
             let velocity = DVec2::new(angle.cos(), angle.sin()) * speed;
-            expected_reflection(&extent, &prior(DVec2::new(20.0, 3.0), velocity), DVec2::ZERO)
+            expected_reflection(&extent, &prior(DVec2::new(20.0, 3.0), velocity), DVec2::ZERO, 1.0)
         };
         let mut previous = at(1.0, 0.3).offset_m;
         for k in 1..=100 {
@@ -451,7 +477,8 @@ mod tests {
 
     #[test]
     fn a_sensor_at_the_centre_gives_no_offset() {
-        let reflection = expected_reflection(&car(), &prior(DVec2::ZERO, DVec2::new(5.0, 0.0)), DVec2::ZERO);
+        let reflection =
+            expected_reflection(&car(), &prior(DVec2::ZERO, DVec2::new(5.0, 0.0)), DVec2::ZERO, 1.0);
         assert_eq!(reflection.offset_m, DVec2::ZERO);
         assert!(reflection.covariance_m2.determinant() > 0.0);
     }

@@ -52,6 +52,7 @@
 extern crate alloc;
 
 pub mod association;
+pub mod class_label;
 pub mod config;
 pub mod coordinates;
 pub mod displacement_check;
@@ -72,6 +73,7 @@ pub mod predictor;
 pub mod readable_number;
 mod recorded_frame;
 mod replay;
+pub mod sensor;
 pub mod sensor_noise;
 pub mod stage_timing;
 pub mod track;

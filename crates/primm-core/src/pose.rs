@@ -176,6 +176,10 @@ pub struct SensorMount {
     /// grows as 1 / cos of the angle from the boresight up to this factor (absent: 1, constant).
     #[cfg_attr(feature = "serde", serde(default = "one"))]
     pub azimuth_std_max_factor: f64,
+    /// Where the sensor's detections of an extended object lie: `"outline"`, `"centre"` or
+    /// `"auto"` (absent: outline, the class's `extent.offset_scale`; `crate::sensor`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub reflection: crate::sensor::ReflectionModel,
 }
 
 /// The default of [`SensorMount::half_fov_rad`]: all around.

@@ -129,6 +129,47 @@ impl PredictionRequest {
         self.len > 0 && self.step_start_s > self.anchor_time_s
     }
 
+    /// Whether `self`, a request built ahead of its frame (speculatively, for a guessed
+    /// prediction time), is `actual` for a predictor whose answer depends only on the model
+    /// input ([`AnswerDependence::ModelInput`]): the same features bit for
+    /// bit (the time feature `t_l − t_k` included, so a guessed time that differs in the last
+    /// bits of an `f64` still matches when every `f32` feature is the same), the same history
+    /// length, anchor, anchor time, sensor position, step start and remembered `f(t_{k−1})`,
+    /// and the same `f32` step length `t_k − t_{k−1}` (the shift [`at_time`](Self::at_time)
+    /// applies for the step start). Everything a predictor computes from such a request is
+    /// then computed from the same numbers, so its answer is the same bit for bit.
+    pub fn same_model_input(&self, actual: &PredictionRequest) -> bool {
+        let step = |request: &PredictionRequest| {
+            ((request.prediction_time_s - request.step_start_s) as f32).to_bits()
+        };
+        let same_features = self
+            .features
+            .iter()
+            .flatten()
+            .zip(actual.features.iter().flatten())
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        let same_remembered = match (self.step_start_displacement_m, actual.step_start_displacement_m) {
+            (None, None) => true,
+            (Some(a), Some(b)) => same_bits(a, b),
+            _ => false,
+        };
+        same_features
+            && same_remembered
+            && self.len == actual.len
+            && same_bits(self.anchor_m, actual.anchor_m)
+            && self.anchor_time_s.to_bits() == actual.anchor_time_s.to_bits()
+            && same_bits(self.sensor_m, actual.sensor_m)
+            && self.step_start_s.to_bits() == actual.step_start_s.to_bits()
+            && step(self) == step(actual)
+    }
+
+    /// Whether `self` and `actual` are the same request bit for bit, the prediction time
+    /// included: the rule for a predictor that may read any field.
+    pub fn same_bits(&self, actual: &PredictionRequest) -> bool {
+        self.same_model_input(actual)
+            && self.prediction_time_s.to_bits() == actual.prediction_time_s.to_bits()
+    }
+
     /// The model input for predicting at `time_s` instead of the prediction time: the time
     /// feature `t_l − t` of every valid row shifted; everything else unchanged.
     pub fn at_time(&self, time_s: f64) -> Self {
@@ -140,6 +181,11 @@ impl PredictionRequest {
         request.prediction_time_s = time_s;
         request
     }
+}
+
+/// Whether two vectors are the same bit for bit.
+fn same_bits(a: DVec2, b: DVec2) -> bool {
+    a.x.to_bits() == b.x.to_bits() && a.y.to_bits() == b.y.to_bits()
 }
 
 /// A predictor's answer for one track and step.
@@ -226,6 +272,33 @@ impl From<DVec2> for Displacement {
     }
 }
 
+/// What a predictor's answer to one request depends on (see
+/// [`DisplacementPredictor::answer_dependence`]); ordered from the most to the least.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum AnswerDependence {
+    /// Possibly on the other requests of its batch, on earlier batches or on anything else: an
+    /// answer computed ahead of its frame is never reused (none is computed).
+    #[default]
+    Batch,
+    /// On the request alone, any of its fields: an answer computed ahead is reused when the
+    /// frame's request is the same bit for bit ([`PredictionRequest::same_bits`]).
+    Request,
+    /// On the model input alone ([`PredictionRequest::same_model_input`]): an answer computed
+    /// ahead for a guessed prediction time is reused when the model input is the same.
+    ModelInput,
+}
+
+impl AnswerDependence {
+    /// Whether an answer computed for `speculated` serves `actual` under this dependence.
+    pub fn serves(self, speculated: &PredictionRequest, actual: &PredictionRequest) -> bool {
+        match self {
+            AnswerDependence::Batch => false,
+            AnswerDependence::Request => speculated.same_bits(actual),
+            AnswerDependence::ModelInput => speculated.same_model_input(actual),
+        }
+    }
+}
+
 /// Predicts the displacement of many tracks over one tracker step (see the module
 /// documentation), in two steps so that an implementation may run the batch elsewhere (another
 /// thread) while the tracker predicts its physics modes.
@@ -240,6 +313,13 @@ pub trait DisplacementPredictor {
     fn predict(&mut self, requests: &[PredictionRequest], displacements: &mut [Option<Displacement>]) {
         self.submit(requests);
         self.collect(displacements);
+    }
+    /// What this predictor's answer to one request depends on, which says when the tracker
+    /// may reuse an answer computed ahead of its frame for a guessed prediction time
+    /// ([`Tracker::speculate`](crate::tracker::Tracker::speculate)). The default,
+    /// [`AnswerDependence::Batch`], never lets it.
+    fn answer_dependence(&self) -> AnswerDependence {
+        AnswerDependence::Batch
     }
     /// A one-line summary of the predictor's own counters (batches, deadline misses, errors),
     /// for a service's shutdown report; `None` when it keeps none.
@@ -265,6 +345,9 @@ impl<P: DisplacementPredictor + ?Sized> DisplacementPredictor for Box<P> {
     }
     fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
         (**self).collect(displacements)
+    }
+    fn answer_dependence(&self) -> AnswerDependence {
+        (**self).answer_dependence()
     }
     fn report(&self) -> Option<String> {
         (**self).report()

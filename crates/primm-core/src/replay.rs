@@ -45,6 +45,8 @@ pub(crate) struct TrackerSnapshot {
     pub ego_motion: crate::pose::EgoMotion,
     /// The counters.
     pub stats: TrackerStats,
+    /// The sensors' estimates (`None` before the first save).
+    pub sensors: Option<crate::sensor::SensorSet>,
 }
 
 impl TrackerSnapshot {
@@ -57,6 +59,7 @@ impl TrackerSnapshot {
             last_pose: None,
             ego_motion: crate::pose::EgoMotion::default(),
             stats: TrackerStats::default(),
+            sensors: None,
         }
     }
 }
@@ -218,7 +221,9 @@ impl ReplayRing {
         target.before.last_timestamp_s = source.before.last_timestamp_s;
         target.before.tracks_frame = source.before.tracks_frame;
         target.before.last_pose = source.before.last_pose;
+        target.before.ego_motion = source.before.ego_motion;
         target.before.stats = source.before.stats;
+        target.before.sensors = source.before.sensors;
     }
 }
 

@@ -108,13 +108,24 @@ pub struct MeasurementSensor {
     /// The detection's covariance from the sensor's own noise ([`SensorNoise`]), m²; zero for a
     /// sensor without noise keys.
     pub noise_m2: DMat2,
+    /// The sensor's slot in the tracker's [`SensorSet`](crate::sensor::SensorSet).
+    pub slot: u8,
+    /// The scale of the expected outline offset for this measurement's class under the
+    /// sensor's measurement model, dimensionless in [0, 1] (`crate::sensor`).
+    pub reflection_scale: f64,
 }
 
 impl MeasurementSensor {
     /// A measurement of a sensor that is not configured, seen from the reference point
-    /// `position_m`.
-    pub const fn unknown(position_m: DVec2) -> Self {
-        MeasurementSensor { position_m, mounted: false, noise_m2: DMat2::ZERO }
+    /// `position_m`, its detections on the outline scaled by `reflection_scale`.
+    pub const fn unknown(position_m: DVec2, reflection_scale: f64) -> Self {
+        MeasurementSensor {
+            position_m,
+            mounted: false,
+            noise_m2: DMat2::ZERO,
+            slot: crate::sensor::UNMOUNTED as u8,
+            reflection_scale,
+        }
     }
 }
 

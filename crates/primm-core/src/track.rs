@@ -93,6 +93,13 @@ pub struct Track {
     /// The learned predictor's latest `f(t)` for this track's history, reused as `f(t_{k−1})`
     /// when the track is not measured (see [`crate::predictor`], "Which displacement").
     pub remembered_displacement: Option<RememberedDisplacement>,
+    /// Where the sensor of the track's latest update was relative to the track's prior centre
+    /// then, m (an extended class's; `None` before the first update): the geometry the sensors'
+    /// reflection estimates compare the next update's with (`crate::sensor::estimates`).
+    pub sensor_relative_m: Option<DVec2>,
+    /// The slot of the sensor whose measurement started the track in the tracker's
+    /// [`SensorSet`](crate::sensor::SensorSet).
+    pub birth_sensor_slot: u8,
 }
 
 impl Track {
@@ -123,6 +130,8 @@ impl Track {
             duplicate_of: None,
             exclusive_updates: 0,
             remembered_displacement: None,
+            sensor_relative_m: None,
+            birth_sensor_slot: crate::sensor::UNMOUNTED as u8,
         };
         track.history.write(HistoryEntry::from_measurement(measurement, sensor_m, timestamp_s));
         track
@@ -134,6 +143,7 @@ impl Track {
     pub fn transform(&mut self, transform: &RigidTransform) {
         self.estimate = self.estimate.transformed(transform);
         self.remembered_displacement = None;
+        self.sensor_relative_m = self.sensor_relative_m.map(|offset| transform.apply_vector(offset));
         let mut entries = [HistoryEntry::default(); MAX_HISTORY];
         let mut len = 0;
         for entry in self.history.oldest_ordered() {

@@ -40,8 +40,12 @@ pub extern "C" fn primm_object_class_name(class_code: PrimmObjectClass) -> *cons
     })
 }
 
-/// The class code of a class name (`car`, `pedestrian`, `two_wheeler`; NUL-terminated), or -1
-/// for NULL or an unknown name.
+/// The class code of a class label (NUL-terminated), or -1 for NULL or a label that names no
+/// class. Accepts what `primm track` accepts in a measurement file: the class names (`car`,
+/// `pedestrian`, `two_wheeler`) and other data sets' names of the same objects (`truck`, `bus`,
+/// `person`, `bicycle`, `motorcycle`, ...), in any letter case, with `-` or a space for `_`,
+/// surrounding white space ignored (`ObjectClass::from_label` of primm-core, one mapping for
+/// both).
 ///
 /// # Safety
 /// `name` is NULL or a NUL-terminated string.
@@ -53,7 +57,7 @@ pub unsafe extern "C" fn primm_object_class_from_name(name: *const c_char) -> i3
         }
         // SAFETY: NUL-terminated (caller contract).
         let name = unsafe { CStr::from_ptr(name) };
-        name.to_str().ok().and_then(ObjectClass::from_name).map_or(-1, |class| i32::from(class.code()))
+        name.to_str().ok().and_then(ObjectClass::from_label).map_or(-1, |class| i32::from(class.code()))
     })
 }
 
@@ -133,7 +137,12 @@ mod tests {
         assert!(primm_object_class_name(3).is_null());
         // SAFETY: a NUL-terminated literal, and NULL.
         unsafe {
-            assert_eq!(primm_object_class_from_name(c"truck".as_ptr()), -1);
+            assert_eq!(primm_object_class_from_name(c"truck".as_ptr()), i32::from(ObjectClass::Car.code()));
+            assert_eq!(
+                primm_object_class_from_name(c" Person ".as_ptr()),
+                i32::from(ObjectClass::Pedestrian.code())
+            );
+            assert_eq!(primm_object_class_from_name(c"tram".as_ptr()), -1);
             assert_eq!(primm_object_class_from_name(core::ptr::null()), -1);
         }
     }

@@ -112,6 +112,10 @@ pub(crate) enum Failure {
     BufferTooSmall { needed: usize, capacity: usize },
     /// The tracker refused to predict to the requested time.
     Predict(primm_core::prediction::PredictError),
+    /// No sensor of the configuration has this id.
+    UnknownSensor(i32),
+    /// An unknown object class code.
+    UnknownClass(u8),
 }
 
 impl Failure {
@@ -128,7 +132,9 @@ impl Failure {
             Failure::Step(StepError::InvalidFrame(_)) => PrimmStatus::InvalidFrame,
             Failure::Step(StepError::Association(_)) => PrimmStatus::AssociationError,
             Failure::BufferTooSmall { .. } => PrimmStatus::BufferTooSmall,
-            Failure::Predict(_) => PrimmStatus::InvalidArgument,
+            Failure::Predict(_) | Failure::UnknownSensor(_) | Failure::UnknownClass(_) => {
+                PrimmStatus::InvalidArgument
+            }
         }
     }
 }
@@ -154,6 +160,11 @@ impl fmt::Display for Failure {
                 write!(f, "the buffer holds {capacity} entries, {needed} are needed")
             }
             Failure::Predict(error) => write!(f, "{error}"),
+            Failure::UnknownSensor(id) => write!(
+                f,
+                "no sensor of the configuration has id {id} (frame.sensors; -1 asks for the radars without a mount)"
+            ),
+            Failure::UnknownClass(code) => write!(f, "unknown object class code {code} (expected 0, 1 or 2)"),
         }
     }
 }

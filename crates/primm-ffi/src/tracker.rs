@@ -27,7 +27,7 @@ const CALLER_MODEL_NAME: &str = "(model bytes given to primm_tracker_create)";
 /// and the message of its last failure. Created by `primm_tracker_create`, released by
 /// `primm_tracker_destroy`. One thread at a time may use a tracker.
 pub struct PrimmTracker {
-    tracker: Tracker<Box<dyn DisplacementPredictor + Send>>,
+    pub(crate) tracker: Tracker<Box<dyn DisplacementPredictor + Send>>,
     /// [`PRIMM_MAX_TRACKS`] entries; the first `track_count` are the last step's tracks.
     tracks: Box<[PrimmTrack]>,
     track_count: usize,
@@ -164,7 +164,7 @@ impl FrameView for CallerFrame {
 ///
 /// # Safety
 /// `tracker` is NULL or a live handle from [`primm_tracker_create`], used by no other thread.
-unsafe fn with_tracker(
+pub(crate) unsafe fn with_tracker(
     tracker: *mut PrimmTracker,
     body: impl FnOnce(&mut PrimmTracker) -> Result<(), Failure>,
 ) -> PrimmStatus {

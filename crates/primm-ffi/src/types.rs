@@ -345,7 +345,7 @@ pub struct PrimmStepSummary {
     /// Measurements of the largest cluster solved in this step (0 if none was).
     pub largest_solved_cluster_measurements: usize,
     /// Newer frames tracked again because this frame was late (0 for a frame in order).
-    pub replayed_frames: usize,
+    pub frames_replayed: usize,
     /// Whether the frame was late (older than the newest frame tracked before it, within
     /// `tracker.max_frame_delay_s`) and was tracked in its place. The tracks are then those at
     /// the newest frame's time (`primm_tracker_newest_timestamp`), and their
@@ -360,29 +360,36 @@ impl PrimmStepSummary {
     /// The C form of the tracker's summary of a step whose association did `association` and
     /// whose tracks are `tracks`.
     pub(crate) fn new(summary: &StepSummary, association: &AssociationStats, tracks: &[PrimmTrack]) -> Self {
+        let count = |n: u64| usize::try_from(n).unwrap_or(usize::MAX);
+        let counts = &summary.counts;
         PrimmStepSummary {
             track_count: tracks.len(),
             updated_track_count: tracks
                 .iter()
                 .filter(|t| t.measurement_index != PRIMM_NO_MEASUREMENT_INDEX)
                 .count(),
-            measurements_accepted: summary.measurements_accepted,
-            measurements_rejected: summary.measurements_rejected,
-            tracks_initiated: summary.initiated,
-            tracks_deleted: summary.deleted,
+            measurements_accepted: count(counts.measurements_accepted),
+            measurements_rejected: count(summary.measurements_rejected()),
+            tracks_initiated: count(counts.tracks_initiated),
+            tracks_deleted: count(counts.tracks_deleted),
             solved_clusters: association.solved_clusters,
             smallest_solved_cluster_tracks: association.smallest_solved_cluster.0,
             smallest_solved_cluster_measurements: association.smallest_solved_cluster.1,
             largest_solved_cluster_tracks: association.largest_cluster.0,
             largest_solved_cluster_measurements: association.largest_cluster.1,
-            replayed_frames: summary.replayed_frames,
-            late_frame: summary.late,
-            odometry_reset: summary.odometry_reset,
+            frames_replayed: count(counts.frames_replayed),
+            late_frame: summary.late(),
+            odometry_reset: summary.odometry_reset(),
         }
     }
 }
 
-/// The tracker's counters since it was built (`TrackerStats` of primm-core).
+// cbindgen reads this struct as written, so each counter is spelled out here; the conversion
+// below is generated from the list, so a counter added there and missing here (or the
+// reverse) does not compile. Such a change changes this struct's size: raise
+// `PRIMM_ABI_VERSION` and regenerate the header.
+/// The tracker's counters since it was built: `TrackerStats` of primm-core, field for field,
+/// in the order of primm-core's list of counters (`tracker_counters!`), which documents each.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct PrimmStats {
@@ -396,16 +403,20 @@ pub struct PrimmStats {
     pub frames_rejected_interval_too_long: u64,
     /// Frames rejected because they carried too many measurements.
     pub frames_rejected_too_many_measurements: u64,
-    /// Frames rejected because their ego pose was not finite or absurdly far out.
+    /// Frames rejected because their ego pose was not finite or absurdly far out (only
+    /// when tracking in the world frame).
     pub frames_rejected_invalid_ego_pose: u64,
-    /// Frames tracked in the world frame.
+    /// Frames tracked in the world frame (they carried an ego pose and the configuration
+    /// asks for the world frame).
     pub frames_in_world_frame: u64,
-    /// Frames tracked in the vehicle frame although the configuration asks for the world frame
-    /// (they carried no ego pose).
+    /// Frames tracked in the vehicle frame although the configuration asks for the world
+    /// frame, because they carried no ego pose.
     pub frames_without_ego_pose: u64,
-    /// Times the live tracks were moved between the world and the vehicle frame.
+    /// Times the live tracks were moved between the world and the vehicle frame, because
+    /// a stream started or stopped carrying ego poses.
     pub tracking_frame_changes: u64,
-    /// Tracks started in the world frame by a measurement of a sensor without configured mount.
+    /// Tracks started in the world frame by a measurement whose sensor has no configured
+    /// mount: their line of sight starts at the vehicle's reference point.
     pub initiations_from_unknown_sensor: u64,
     /// Measurements tracked (accepted by validation).
     pub measurements_accepted: u64,
@@ -417,140 +428,113 @@ pub struct PrimmStats {
     pub measurements_rejected_out_of_range: u64,
     /// Tracks started.
     pub tracks_initiated: u64,
-    /// Tracks confirmed.
+    /// Tracks confirmed (a track started and confirmed at once included).
     pub tracks_confirmed: u64,
     /// Tracks deleted.
     pub tracks_deleted: u64,
     /// Unassigned measurements that could not start a track because the table was full.
     pub initiations_refused_table_full: u64,
-    /// Track-frames in which the PR mode had no usable learned displacement and sat out (none
-    /// given, or rejected).
+    /// Track-frames in which the PR mode had no usable learned displacement and sat out:
+    /// the predictor gave none (missed deadline, failed or hung inference) or its answer
+    /// was rejected (the three `learned_predictions_rejected_*` counters). Tracks of a
+    /// class outside `predictor.classes` are never requested and not counted.
     pub learned_predictions_missing: u64,
     /// Frames in which at least one track had no usable learned displacement.
     pub frames_with_learned_predictions_missing: u64,
     /// Learned displacements rejected for a NaN or infinite component (included in
     /// `learned_predictions_missing`).
     pub learned_predictions_rejected_non_finite: u64,
-    /// Learned displacements rejected as faster than `predictor.max_displacement_speed_mps`
-    /// (included in `learned_predictions_missing`).
+    /// Learned displacements rejected as faster than
+    /// `predictor.max_displacement_speed_mps` (included in `learned_predictions_missing`).
     pub learned_predictions_rejected_implausible: u64,
-    /// Learned displacements rejected for a covariance that is not finite, symmetric, positive
-    /// definite and of plausible size (included in `learned_predictions_missing`).
+    /// Learned displacements rejected for a covariance that is not finite, symmetric,
+    /// positive definite and of plausible size (included in
+    /// `learned_predictions_missing`).
     pub learned_predictions_rejected_invalid_covariance: u64,
     /// Kalman updates refused for numerical reasons (the track coasted instead).
     pub update_failures: u64,
     /// Calls to `primm_tracker_reset`.
     pub resets: u64,
-    /// Frames with a measurement whose sensor has no configured mount (or no sensor id): such a
-    /// radar is taken to look where its detections of the frame lie.
+    /// Frames with a measurement whose sensor has no configured mount (or no sensor id):
+    /// such a radar is taken to look where its detections of the frame lie
+    /// (`frame.unknown_sensor_*`), and a track there that it missed loses existence.
     pub frames_with_unknown_sensor: u64,
     /// Tracks merged into an older track of the same object.
     pub duplicate_tracks_merged: u64,
-    /// Late frames tracked in their place.
+    /// Late frames tracked in their place: older than the newest
+    /// tracked frame, within `tracker.max_frame_delay_s` and the recorded frames.
     pub late_frames_tracked: u64,
-    /// Newer frames tracked again after a late frame.
+    /// Newer frames tracked again after a late frame (each late frame replays the frames
+    /// it went before).
     pub frames_replayed: u64,
-    /// Frames rejected for being older than the late-frame window reaches.
+    /// Frames rejected because they were older than the newest tracked frame by more
+    /// than the late-frame window (`tracker.max_frame_delay_s`, `tracker.replay_frames`)
+    /// reaches.
     pub frames_rejected_too_late: u64,
-    /// Ego poses that jumped (odometry resets).
+    /// Ego poses that jumped further or turned faster than `tracker.max_ego_speed_mps`
+    /// and `tracker.max_ego_yaw_rate_radps` allow since the previous frame: odometry
+    /// resets, across which the tracks kept their place around the vehicle.
     pub odometry_resets: u64,
-    /// Track updates with the measurement's radial velocity applied as a measurement of the
-    /// velocity.
+    /// Track updates in which the measurement's radial velocity was applied as a
+    /// measurement of the velocity (`classes.<class>.radial_velocity_update`).
     pub radial_velocity_updates: u64,
-    /// Track updates whose radial-velocity row was gated out.
+    /// Track updates whose radial-velocity row lay beyond
+    /// `radial_velocity_update.gate_std` in every mode and was left out.
     pub radial_velocity_updates_gated: u64,
+    /// Track updates and initiations after which a velocity estimate was faster than the
+    /// class's `max_speed_mps` and was scaled back onto it (steps with an ego pose only).
+    pub speeds_bounded: u64,
     /// Updates and initiations of a class with a radial-velocity row or an extent whose
-    /// measurement's sensor has no configured mount.
+    /// measurement's sensor has no configured mount: seen from the vehicle's reference
+    /// point.
     pub updates_from_unknown_sensor: u64,
-    /// Unassigned measurements absorbed as extra detections of a confirmed extended track's
-    /// object.
+    /// Unassigned measurements absorbed as extra detections of a confirmed track's
+    /// extended object (`classes.<class>.extent.absorb_extra_detections`): they started
+    /// no track.
     pub detections_absorbed: u64,
+    /// Existing tracks updated by an assigned measurement.
+    pub tracks_updated: u64,
+    /// Tracks without a measurement while a sensor of the frame had them in view (their
+    /// existence fell); tracks out of every scanning sensor's view are not counted.
+    pub tracks_missed_in_view: u64,
 }
 
-impl From<&TrackerStats> for PrimmStats {
-    fn from(stats: &TrackerStats) -> Self {
-        // Destructured field by field: a counter added to the core breaks the build here.
-        let TrackerStats {
-            frames_tracked,
-            frames_rejected_non_finite_timestamp,
-            frames_rejected_timestamp_not_increasing,
-            frames_rejected_interval_too_long,
-            frames_rejected_too_many_measurements,
-            frames_rejected_invalid_ego_pose,
-            frames_in_world_frame,
-            frames_without_ego_pose,
-            tracking_frame_changes,
-            initiations_from_unknown_sensor,
-            measurements_accepted,
-            measurements_rejected_unknown_class,
-            measurements_rejected_non_finite,
-            measurements_rejected_out_of_range,
-            tracks_initiated,
-            tracks_confirmed,
-            tracks_deleted,
-            initiations_refused_table_full,
-            learned_predictions_missing,
-            frames_with_learned_predictions_missing,
-            learned_predictions_rejected_non_finite,
-            learned_predictions_rejected_implausible,
-            learned_predictions_rejected_invalid_covariance,
-            update_failures,
-            resets,
-            frames_with_unknown_sensor,
-            duplicate_tracks_merged,
-            late_frames_tracked,
-            frames_replayed,
-            frames_rejected_too_late,
-            odometry_resets,
-            radial_velocity_updates,
-            radial_velocity_updates_gated,
-            updates_from_unknown_sensor,
-            detections_absorbed,
-            // Not in `PrimmStats`: a field more would change the struct the caller allocates, an
-            // ABI break (PRIMM_ABI_VERSION 1 keeps its layout).
-            speeds_bounded: _,
-        } = *stats;
-        PrimmStats {
-            frames_tracked,
-            frames_rejected_non_finite_timestamp,
-            frames_rejected_timestamp_not_increasing,
-            frames_rejected_interval_too_long,
-            frames_rejected_too_many_measurements,
-            frames_rejected_invalid_ego_pose,
-            frames_in_world_frame,
-            frames_without_ego_pose,
-            tracking_frame_changes,
-            initiations_from_unknown_sensor,
-            measurements_accepted,
-            measurements_rejected_unknown_class,
-            measurements_rejected_non_finite,
-            measurements_rejected_out_of_range,
-            tracks_initiated,
-            tracks_confirmed,
-            tracks_deleted,
-            initiations_refused_table_full,
-            learned_predictions_missing,
-            frames_with_learned_predictions_missing,
-            learned_predictions_rejected_non_finite,
-            learned_predictions_rejected_implausible,
-            learned_predictions_rejected_invalid_covariance,
-            update_failures,
-            resets,
-            frames_with_unknown_sensor,
-            duplicate_tracks_merged,
-            late_frames_tracked,
-            frames_replayed,
-            frames_rejected_too_late,
-            odometry_resets,
-            radial_velocity_updates,
-            radial_velocity_updates_gated,
-            updates_from_unknown_sensor,
-            detections_absorbed,
+/// `PrimmStats` from `TrackerStats`, one field per counter of the list.
+macro_rules! primm_stats_from_tracker_stats {
+    ($( $(#[$doc:meta])* $name:ident : $kind:ident, )*) => {
+        impl From<&TrackerStats> for PrimmStats {
+            fn from(stats: &TrackerStats) -> Self {
+                PrimmStats { $( $name: stats.$name, )* }
+            }
         }
-    }
+    };
 }
+
+primm_core::tracker_counters!(primm_stats_from_tracker_stats);
 
 /// A 4×4 matrix as 16 values, row-major.
 fn row_major(matrix: &glam::DMat4) -> [f64; 16] {
     matrix.transpose().to_cols_array()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_c_counters_are_the_core_s_in_the_order_of_its_list() {
+        const COUNT: usize = TrackerStats::COUNT;
+        assert_eq!(core::mem::size_of::<PrimmStats>(), COUNT * core::mem::size_of::<u64>());
+        let values: [u64; COUNT] = core::array::from_fn(|index| 1000 + index as u64);
+        let stats = TrackerStats::from_values(values);
+        let names: [&str; COUNT] = TrackerStats::NAMES;
+        assert_eq!(stats.named_values().map(|(name, _)| name), names);
+        assert_eq!(stats.named_values().map(|(_, value)| value), values);
+        let c_stats = PrimmStats::from(&stats);
+        // SAFETY: `PrimmStats` is `repr(C)` and holds `COUNT` `u64` fields (size checked above),
+        // so it has the layout of `[u64; COUNT]`.
+        let c_values: [u64; COUNT] = unsafe { core::mem::transmute(c_stats) };
+        assert_eq!(c_values, values);
+        assert_eq!(c_stats.speeds_bounded, stats.speeds_bounded);
+    }
 }

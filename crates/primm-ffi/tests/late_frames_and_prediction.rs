@@ -79,7 +79,7 @@ fn a_late_frame_is_tracked_in_its_place_and_an_older_one_is_rejected_and_counted
     let (status, summary) = step(late, 18.0 * 0.05);
     assert_eq!(status, PrimmStatus::Ok);
     assert!(summary.late_frame);
-    assert_eq!(summary.replayed_frames, 1);
+    assert_eq!(summary.frames_replayed, 1);
     let mut newest = 0.0;
     // SAFETY: a live tracker and a writable double.
     assert_eq!(unsafe { primm_tracker_newest_timestamp(late, &mut newest) }, PrimmStatus::Ok);

@@ -570,7 +570,7 @@ fn helpers(input: &mut Input) -> Option<()> {
             let code = unsafe { primm_object_class_from_name(text.as_ptr()) };
             let expected = core::str::from_utf8(&bytes[..end])
                 .ok()
-                .and_then(ObjectClass::from_name)
+                .and_then(ObjectClass::from_label)
                 .map_or(-1, |class| i32::from(class.code()));
             assert_eq!(code, expected, "class of {text:?}");
         }

@@ -88,7 +88,7 @@ fn a_frame_rewritten_after_validation_is_tracked_as_it_was_validated() {
     let changing = ChangingFrame::new(0.15, vec![car(10.75), car(30.0), car(50.0)]);
     let summary = tracker.step_into(&changing, |_| {}).expect("the frame was valid when read");
 
-    assert_eq!(summary.measurements_accepted, 3);
+    assert_eq!(summary.counts.measurements_accepted, 3);
     assert_eq!(changing.length_reads.get(), 1, "the count is read once");
     assert_eq!(changing.timestamp_reads.get(), 1, "the timestamp is read once");
     assert!(changing.measurement_reads.iter().all(|reads| reads.get() == 1), "each measurement is read once");

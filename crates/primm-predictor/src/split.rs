@@ -23,7 +23,7 @@
 
 use crate::onnx::{ModelError, OnnxPredictor};
 use crate::threaded::ThreadedPredictor;
-use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
+use primm_core::predictor::{AnswerDependence, Displacement, DisplacementPredictor, PredictionRequest};
 use std::ops::Range;
 use std::time::Duration;
 
@@ -80,6 +80,14 @@ impl<P: DisplacementPredictor> SplitPredictor<P> {
         Ok(SplitPredictor { parts, min_requests_per_part: DEFAULT_MIN_REQUESTS_PER_PART, submitted: 0 })
     }
 
+    /// The same predictor, splitting batches of at least `min_requests_per_part` requests per
+    /// part (at least 1): smaller parts suit inference threads that are already awake, or
+    /// batches whose hand-off cost is not on the critical path.
+    pub fn with_min_requests_per_part(mut self, min_requests_per_part: usize) -> Self {
+        self.min_requests_per_part = min_requests_per_part.max(1);
+        self
+    }
+
     /// The fewest requests a part gets before a batch is split further.
     pub fn min_requests_per_part(&self) -> usize {
         self.min_requests_per_part
@@ -88,6 +96,11 @@ impl<P: DisplacementPredictor> SplitPredictor<P> {
     /// The predictors, in the order of the parts they take.
     pub fn parts(&self) -> &[P] {
         &self.parts
+    }
+
+    /// The predictors, to change their settings.
+    pub fn parts_mut(&mut self) -> &mut [P] {
+        &mut self.parts
     }
 
     /// How many predictors a batch of `requests` requests is shared among.
@@ -131,6 +144,11 @@ impl<P: DisplacementPredictor> DisplacementPredictor for SplitPredictor<P> {
                 part.collect(&mut []);
             }
         }
+    }
+
+    /// The least of the parts' (each answer comes from one part, whichever way a batch is cut).
+    fn answer_dependence(&self) -> AnswerDependence {
+        self.parts.iter().map(DisplacementPredictor::answer_dependence).min().unwrap_or_default()
     }
 
     fn report(&self) -> Option<String> {

@@ -50,9 +50,13 @@
 //! the synchronous predictor instead.
 
 use primm_core::limits::MAX_TRACKS;
-use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest};
+use primm_core::predictor::{AnswerDependence, Displacement, DisplacementPredictor, PredictionRequest};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender, TryRecvError, TrySendError};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{
+    sync_channel, Receiver, RecvError, RecvTimeoutError, SyncSender, TryRecvError, TrySendError,
+};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -87,6 +91,27 @@ struct Batch {
     displacements: Box<[Option<Displacement>]>,
     /// Whether the inference completed (a panic leaves every displacement `None`).
     completed: bool,
+    /// When the tracking thread handed the batch over, and when the inference thread began and
+    /// finished it.
+    submitted: Option<Instant>,
+    started: Option<Instant>,
+    finished: Option<Instant>,
+}
+
+/// When one batch passed each point of its round trip ([`ThreadedPredictor::last_timeline`]):
+/// for a time line of a frame across the tracking and inference threads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BatchTimeline {
+    /// The tracking thread handed the batch over (`submit`).
+    pub submitted: Instant,
+    /// The inference thread took it up (woken, or already awake).
+    pub started: Instant,
+    /// The inference thread finished it and sent it back.
+    pub finished: Instant,
+    /// The tracking thread had it back (`collect`).
+    pub collected: Instant,
+    /// Requests in the batch.
+    pub requests: usize,
 }
 
 impl Batch {
@@ -97,6 +122,9 @@ impl Batch {
             requests: vec![PredictionRequest::default(); capacity].into_boxed_slice(),
             displacements: vec![None; capacity].into_boxed_slice(),
             completed: false,
+            submitted: None,
+            started: None,
+            finished: None,
         })
     }
 }
@@ -146,6 +174,12 @@ pub struct ThreadedPredictor {
     worker: Option<JoinHandle<()>>,
     deadline: Duration,
     capacity: usize,
+    /// What the wrapped predictor's answers depend on, asked before it moved to its thread.
+    dependence: AnswerDependence,
+    /// How long each thread spins on its channel before it parks, ns ([`set_spin`]).
+    ///
+    /// [`set_spin`]: ThreadedPredictor::set_spin
+    spin: Arc<AtomicU64>,
     next_sequence: u64,
     /// The batch of the current frame: its sequence number and deadline.
     awaited: Option<(u64, Instant)>,
@@ -158,6 +192,8 @@ pub struct ThreadedPredictor {
     /// Whether the inference thread has stopped (after a panic) or is unreachable.
     thread_gone: bool,
     stats: ThreadedPredictorStats,
+    /// The round trip of the latest batch collected on time.
+    last_timeline: Option<BatchTimeline>,
 }
 
 impl std::fmt::Debug for ThreadedPredictor {
@@ -189,11 +225,14 @@ impl ThreadedPredictor {
     where
         P: DisplacementPredictor + Send + 'static,
     {
+        let dependence = predictor.answer_dependence();
+        let spin = Arc::new(AtomicU64::new(0));
         let (to_worker, work) = sync_channel::<Box<Batch>>(BUFFERS);
         let (done, from_worker) = sync_channel::<Box<Batch>>(BUFFERS);
-        let worker = std::thread::Builder::new()
-            .name(INFERENCE_THREAD_NAME.to_string())
-            .spawn(move || inference_loop(predictor, work, done))?;
+        let worker = std::thread::Builder::new().name(INFERENCE_THREAD_NAME.to_string()).spawn({
+            let spin = spin.clone();
+            move || inference_loop(predictor, work, done, &spin)
+        })?;
         let mut threaded = ThreadedPredictor {
             to_worker: Some(to_worker),
             from_worker,
@@ -201,6 +240,8 @@ impl ThreadedPredictor {
             worker: Some(worker),
             deadline,
             capacity,
+            dependence,
+            spin,
             next_sequence: 0,
             awaited: None,
             in_flight: [None; BUFFERS],
@@ -209,6 +250,7 @@ impl ThreadedPredictor {
             hung: false,
             thread_gone: false,
             stats: ThreadedPredictorStats::default(),
+            last_timeline: None,
         };
         threaded.warm_up();
         Ok(threaded)
@@ -350,6 +392,22 @@ impl ThreadedPredictor {
         }
     }
 
+    /// How long both threads spin on their channel before parking: the inference thread after
+    /// sending a batch back, waiting for the next; the tracking thread in `collect`, waiting for
+    /// its batch (never past the deadline). A batch that arrives meanwhile is taken up without a
+    /// wake-up (tens of µs each way, `benches/pr_frame_timeline.rs`), at the price of a core
+    /// kept busy for that long: for hosts with cores to spare, or back-to-back frames (`primm
+    /// track --inference-threads`). Zero (the default) parks at once. Applies from the next
+    /// batch.
+    pub fn set_spin(&mut self, spin: Duration) {
+        self.spin.store(u64::try_from(spin.as_nanos()).unwrap_or(u64::MAX), Ordering::Relaxed);
+    }
+
+    /// The round trip of the latest batch collected on time; `None` before the first.
+    pub fn last_timeline(&self) -> Option<BatchTimeline> {
+        self.last_timeline
+    }
+
     /// The counters.
     pub fn stats(&self) -> &ThreadedPredictorStats {
         &self.stats
@@ -434,6 +492,7 @@ impl DisplacementPredictor for ThreadedPredictor {
         batch.len = requests.len();
         batch.requests[..requests.len()].copy_from_slice(requests);
         batch.completed = false;
+        batch.submitted = Some(now);
         let Some(to_worker) = self.to_worker.as_ref() else { return };
         match to_worker.try_send(batch) {
             Ok(()) => {
@@ -459,10 +518,13 @@ impl DisplacementPredictor for ThreadedPredictor {
     fn collect(&mut self, displacements: &mut [Option<Displacement>]) {
         displacements.fill(None);
         let Some((sequence, deadline)) = self.awaited else { return };
+        let spin = Duration::from_nanos(self.spin.load(Ordering::Relaxed));
+        let spin_until = Instant::now() + spin;
         loop {
             let now = Instant::now();
-            let received = if now >= deadline {
-                // Past the deadline: only what has already arrived counts.
+            let received = if now >= deadline || now < spin_until {
+                // Past the deadline only what has already arrived counts; before it, while
+                // spinning, the channel is polled.
                 self.from_worker.try_recv().map_err(|error| match error {
                     TryRecvError::Empty => RecvTimeoutError::Timeout,
                     TryRecvError::Disconnected => RecvTimeoutError::Disconnected,
@@ -470,12 +532,24 @@ impl DisplacementPredictor for ThreadedPredictor {
             } else {
                 self.from_worker.recv_timeout(deadline - now)
             };
+            if now < deadline && now < spin_until && matches!(received, Err(RecvTimeoutError::Timeout)) {
+                std::hint::spin_loop();
+                continue;
+            }
             match received {
                 Ok(batch) if batch.sequence == sequence => {
                     if batch.completed {
                         let n = batch.len.min(displacements.len());
                         displacements[..n].copy_from_slice(&batch.displacements[..n]);
                         self.stats.batches_on_time += 1;
+                        if let (Some(submitted), Some(started), Some(finished)) =
+                            (batch.submitted, batch.started, batch.finished)
+                        {
+                            let collected = Instant::now();
+                            let requests = batch.len;
+                            self.last_timeline =
+                                Some(BatchTimeline { submitted, started, finished, collected, requests });
+                        }
                     }
                     self.reclaim(batch);
                     self.awaited = None;
@@ -496,6 +570,12 @@ impl DisplacementPredictor for ThreadedPredictor {
                 }
             }
         }
+    }
+
+    /// The wrapped predictor's (a missed deadline aside, which leaves an answer out whatever
+    /// it depends on).
+    fn answer_dependence(&self) -> AnswerDependence {
+        self.dependence
     }
 
     fn report(&self) -> Option<String> {
@@ -534,13 +614,17 @@ fn inference_loop<P: DisplacementPredictor>(
     mut predictor: P,
     work: Receiver<Box<Batch>>,
     done: SyncSender<Box<Batch>>,
+    spin: &AtomicU64,
 ) {
-    while let Ok(mut batch) = work.recv() {
+    let mut next = work.recv();
+    while let Ok(mut batch) = next {
+        batch.started = Some(Instant::now());
         let len = batch.len;
         let Batch { requests, displacements, .. } = &mut *batch;
         let outcome =
             catch_unwind(AssertUnwindSafe(|| predictor.predict(&requests[..len], &mut displacements[..len])));
         batch.completed = outcome.is_ok();
+        batch.finished = Some(Instant::now());
         if !batch.completed {
             batch.displacements[..len].fill(None);
             let _ = done.send(batch);
@@ -551,5 +635,22 @@ fn inference_loop<P: DisplacementPredictor>(
         if done.send(batch).is_err() {
             return;
         }
+        next = receive(&work, Duration::from_nanos(spin.load(Ordering::Relaxed)));
     }
+}
+
+/// The next batch: polled for up to `spin`, then waited for parked.
+fn receive(work: &Receiver<Box<Batch>>, spin: Duration) -> Result<Box<Batch>, RecvError> {
+    if !spin.is_zero() {
+        let until = Instant::now() + spin;
+        loop {
+            match work.try_recv() {
+                Ok(batch) => return Ok(batch),
+                Err(TryRecvError::Disconnected) => return Err(RecvError),
+                Err(TryRecvError::Empty) if Instant::now() >= until => break,
+                Err(TryRecvError::Empty) => std::hint::spin_loop(),
+            }
+        }
+    }
+    work.recv()
 }

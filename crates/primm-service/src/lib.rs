@@ -37,6 +37,7 @@
 //! ```
 
 pub mod frame_step;
+mod summary_lines;
 pub mod tracking;
 
 pub use primm_ipc::{

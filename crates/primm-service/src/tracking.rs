@@ -89,6 +89,8 @@ pub struct TrackingOptions {
     pub poll_timeout: Duration,
     /// The time the published tracks describe.
     pub publish_time: PublishTime,
+    /// After each answer, hand the predictor the next frame's requests ([`Tracker::speculate`]).
+    pub speculate: bool,
 }
 
 impl Default for TrackingOptions {
@@ -99,6 +101,7 @@ impl Default for TrackingOptions {
             latency_report_interval_frames: 100,
             poll_timeout: Duration::from_millis(50),
             publish_time: PublishTime::Frame,
+            speculate: true,
         }
     }
 }
@@ -284,7 +287,7 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         if frame.flags & FRAME_FLAG_STREAM_END != 0 {
             flags |= TRACK_FLAG_STREAM_END;
         }
-        if step.late {
+        if step.late() {
             flags |= TRACK_FLAG_LATE_FRAME;
         }
         let mut tracks_timestamp_s = self.tracker.newest_timestamp_s().unwrap_or(frame.sensor_timestamp_s);
@@ -314,6 +317,9 @@ impl<P: DisplacementPredictor> TrackingService<P> {
                 header.input_publish_time_ns,
                 header.input_scheduled_time_ns,
             );
+        }
+        if self.options.speculate {
+            self.tracker.speculate();
         }
         self.write_latency_interval();
 
@@ -391,15 +397,13 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             Ok(step) => {
                 self.counters.frames_tracked += 1;
                 self.stream.tracker_dirty = true;
-                let rejected = step.predictions_rejected_non_finite
-                    + step.predictions_rejected_implausible
-                    + step.predictions_rejected_invalid_covariance;
+                let rejected = step.learned_predictions_rejected();
                 if rejected > 0 && self.logs.learned_rejected.occur() {
                     tracing::warn!(
                         sequence = frame.sequence,
-                        non_finite = step.predictions_rejected_non_finite,
-                        implausible = step.predictions_rejected_implausible,
-                        invalid_covariance = step.predictions_rejected_invalid_covariance,
+                        non_finite = step.counts.learned_predictions_rejected_non_finite,
+                        implausible = step.counts.learned_predictions_rejected_implausible,
+                        invalid_covariance = step.counts.learned_predictions_rejected_invalid_covariance,
                         occurrences = self.logs.learned_rejected.occurrences(),
                         "learned displacements rejected; the PR mode sat out for those tracks"
                     );
@@ -636,15 +640,14 @@ impl<P: DisplacementPredictor> TrackingService<P> {
         &self.node
     }
 
-    /// A plain-text summary for the end of a run: counters and the latency table.
+    /// A plain-text summary for the end of a run: the service's counters, the tracker's
+    /// counters by their names (those not zero; the list is primm-core's `tracker_counters!`)
+    /// and the latency table.
     pub fn summary(&self) -> String {
         let c = &self.counters;
-        let s = self.tracker.stats();
         format!(
             "frames: {} received, {} tracked, {} rejected, {} lost; resets: {} (stream start {}, new publisher {}, interval too long {}); \
-             measurements: {} accepted, {} rejected; tracks: {} started, {} confirmed, {} deleted; \
-             learned predictions: {} missing ({} rejected non-finite, {} rejected implausible, {} rejected for their covariance); \
-             publish failures: {}\n{}",
+             publish failures: {}\n{}\n{}",
             c.frames_received,
             c.frames_tracked,
             c.frames_rejected,
@@ -653,18 +656,11 @@ impl<P: DisplacementPredictor> TrackingService<P> {
             c.resets_stream_start,
             c.resets_new_publisher,
             c.resets_interval_too_long,
-            s.measurements_accepted,
-            s.measurements_rejected_unknown_class + s.measurements_rejected_non_finite + s.measurements_rejected_out_of_range,
-            s.tracks_initiated,
-            s.tracks_confirmed,
-            s.tracks_deleted,
-            s.learned_predictions_missing,
-            s.learned_predictions_rejected_non_finite,
-            s.learned_predictions_rejected_implausible,
-            s.learned_predictions_rejected_invalid_covariance,
             c.publish_failures,
+            crate::summary_lines::tracker_counters_line(self.tracker.stats()),
             self.histograms.table()
         ) + &self.tracker.predictor().report().map(|line| format!("\n{line}")).unwrap_or_default()
+            + &crate::summary_lines::sensor_lines(&self.tracker)
     }
 }
 
@@ -676,7 +672,7 @@ fn track_frame_header(
     flags: u8,
     step: &StepSummary,
 ) -> TrackFrameHeader {
-    let saturating_u16 = |count: usize| u16::try_from(count).unwrap_or(u16::MAX);
+    let saturating_u16 = |count: u64| u16::try_from(count).unwrap_or(u16::MAX);
     TrackFrameHeader {
         input_sequence: frame.sequence,
         source_frame: frame.source_frame,
@@ -688,7 +684,7 @@ fn track_frame_header(
         publish_time_ns: 0,
         status,
         flags,
-        measurements_accepted: saturating_u16(step.measurements_accepted),
-        measurements_rejected: saturating_u16(step.measurements_rejected),
+        measurements_accepted: saturating_u16(step.counts.measurements_accepted),
+        measurements_rejected: saturating_u16(step.measurements_rejected()),
     }
 }

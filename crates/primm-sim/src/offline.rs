@@ -32,14 +32,19 @@ pub enum OfflineError {
     },
 }
 
-/// Tracks `sequence` from scratch with `tracker` (which is [`reset`](Tracker::reset) first) and
-/// calls `on_frame` with every recorded frame and the tracker's outputs for it.
+/// Tracks `sequence` from scratch with `tracker` (which is [`reset`](Tracker::reset) first, its
+/// sensors' estimates back at their priors: [`Tracker::forget_sensors`]) and calls `on_frame`
+/// with every recorded frame and the tracker's outputs for it. Frames come in the sequence's
+/// order, which is arrival order: for a late frame, tracked in its place, the outputs are those
+/// right after it ([`Tracker::late_frame_outputs`]), at its time and with measurement indices
+/// into its own measurements.
 pub fn track_sequence<P: DisplacementPredictor>(
     tracker: &mut Tracker<P>,
     sequence: &Sequence,
     mut on_frame: impl FnMut(&RecordedFrame, &[TrackOutput]),
 ) -> Result<(), OfflineError> {
     tracker.reset();
+    tracker.forget_sensors();
     let mut frame = Frame::default();
     for recorded in &sequence.frames {
         frame.timestamp_s = recorded.timestamp_s;
@@ -52,11 +57,13 @@ pub fn track_sequence<P: DisplacementPredictor>(
             });
         }
         frame.measurements.extend(recorded.measurements.iter().map(|m| m.measurement));
-        let outputs = tracker.step(&frame).map_err(|source| OfflineError::Step {
+        tracker.step(&frame).map_err(|source| OfflineError::Step {
             sequence: sequence.name.clone(),
             frame: recorded.index,
             source,
         })?;
+        let outputs =
+            if tracker.last_step().late() { tracker.late_frame_outputs() } else { tracker.last_outputs() };
         on_frame(recorded, outputs);
     }
     Ok(())

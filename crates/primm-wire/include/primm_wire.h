@@ -1,14 +1,17 @@
 /*
  * primm wire types: the payloads of the primm shared-memory services (iceoryx2).
  *
- * Mirrors src/wire/ of the primm crate byte for byte; a test compares the size, alignment and
- * every field offset of this header, the Rust types and examples/python/primm_wire.py.
+ * Mirrors the Rust types of the primm-wire crate (crates/primm-wire/src/) byte for byte; a test
+ * (crates/primm-wire/tests/layout.rs) compares the size, alignment and every field offset of
+ * this header, the Rust types and the Python module crates/primm-wire/python/primm_wire.py.
+ * tools/install_c_api.sh installs it beside primm.h; it needs no library.
  * Every field is a plain integer or double, there is no implicit padding, and entries past
  * `count` in an array are unused. Units are part of the field names; `_ns` times are
  * CLOCK_MONOTONIC nanoseconds, `_s` times are sensor seconds.
  *
  * iceoryx2 type names (for the C/C++ bindings' type_name): "primm::MeasurementFrame",
- * "primm::TrackFrame", "primm::LatencyReport".
+ * "primm::TrackFrame", "primm::LatencyReport". Service names and QoS: docs/service.md;
+ * examples/c/subscriber.c prints recorded track frames with this header alone.
  */
 #ifndef PRIMM_WIRE_H
 #define PRIMM_WIRE_H

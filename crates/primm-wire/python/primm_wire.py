@@ -1,6 +1,7 @@
 """primm wire types as ctypes structures.
 
-Mirrors src/wire/ of the primm crate and include/primm_wire.h byte for byte (a test compares
+Mirrors the Rust types of the primm-wire crate (crates/primm-wire/src/) and
+crates/primm-wire/include/primm_wire.h byte for byte (crates/primm-wire/tests/layout.rs compares
 sizes, alignments and every field offset). Each payload type has a static ``type_name()``
 returning the iceoryx2 type name the Rust side declares, so the iceoryx2 Python package opens
 the same services. Units are part of the field names; ``_ns`` times are CLOCK_MONOTONIC

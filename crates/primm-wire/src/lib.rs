@@ -5,8 +5,8 @@
 //!
 //! Every type is `#[repr(C)]` with fixed-size arrays plus a count, explicit padding fields and
 //! no implicit padding, so that the C header `include/primm_wire.h` and the Python `ctypes`
-//! module `examples/python/primm_wire.py` describe the same bytes; a test compares sizes,
-//! alignments and every field offset of the three declarations. Every field is a plain integer
+//! module `python/primm_wire.py` (the pip package `primm-wire`) describe the same bytes; a
+//! test compares sizes, alignments and every field offset of the three declarations. Every field is a plain integer
 //! or float (every bit pattern is a valid value), so a reader never meets an invalid value, only
 //! a wrong one, and the bytes past `count` in an array are stale but harmless.
 //!

@@ -31,7 +31,7 @@
 //!
 //! # Costs
 //!
-//! `association.cost = "paper"` is `eq:association_cost` gated at `classes.<class>.gate_m`;
+//! `association.cost = "paper"` is `eq:association_cost` gated at `classes.<class>.paper_gate_m`;
 //! `"likelihood"` is the negative log-likelihood of [`LikelihoodPrior`] gated by χ². Both
 //! bound `|Δx|` per track, which is all the x-sorted gating needs.
 //!
@@ -265,9 +265,10 @@ impl Associator {
             if let Some(index) = track_to_measurement[usize::from(track_index)] {
                 self.taken[usize::from(index)] = true;
                 if extended {
-                    let sensor = sensors[usize::from(index)].position_m;
-                    self.assigned_reflections[usize::from(track_index)] =
-                        self.row_reflections[r].find(sensor).map(|entry| entry.reflection);
+                    let sensor = &sensors[usize::from(index)];
+                    self.assigned_reflections[usize::from(track_index)] = self.row_reflections[r]
+                        .find(sensor.position_m, sensor.reflection_scale)
+                        .map(|entry| entry.reflection);
                 }
             }
         }
@@ -298,7 +299,7 @@ impl Associator {
         config: &Config,
         class: ObjectClass,
     ) {
-        let gate = config.classes.get(class).gate_m;
+        let gate = config.classes.get(class).paper_gate_m;
         let extent = extent_of(config, class);
         // An expected reflection moves the compared point by at most the extent's half diagonal.
         let window = gate + extent.map_or(0.0, |extent| extent.max_offset_m());
@@ -321,9 +322,9 @@ impl Associator {
                 };
                 let expected = match (extent, &object) {
                     (Some(extent), Some(object)) => {
-                        let sensor = sensors[index].position_m;
-                        let entry = self.row_reflections[r].get(sensor, || RowReflection {
-                            reflection: expected_reflection(extent, object, sensor),
+                        let (sensor, scale) = (sensors[index].position_m, sensors[index].reflection_scale);
+                        let entry = self.row_reflections[r].get(sensor, scale, || RowReflection {
+                            reflection: expected_reflection(extent, object, sensor, scale),
                             prepared: None,
                         });
                         centre + entry.reflection.offset_m
@@ -369,7 +370,7 @@ impl Associator {
                 &priors[usize::from(track_index)].fused,
                 noise,
                 track.last_radial_velocity_mps,
-                section.radial_velocity_residual_std_mps,
+                section.likelihood_radial_velocity_std_mps,
                 config.association.likelihood_gate_chi2,
             );
             let Some(prepared) = prepared else { continue };
@@ -534,8 +535,9 @@ fn likelihood_pair_cost(
     let own_noise = sensor.noise_m2 != glam::DMat2::ZERO;
     match extended {
         Some((extent, object)) => {
-            let entry = memo.get(sensor.position_m, || {
-                let reflection = expected_reflection(extent, object, sensor.position_m);
+            let entry = memo.get(sensor.position_m, sensor.reflection_scale, || {
+                let reflection =
+                    expected_reflection(extent, object, sensor.position_m, sensor.reflection_scale);
                 RowReflection { reflection, prepared: prepared.prepare_reflection(&reflection) }
             });
             if own_noise {

@@ -53,7 +53,7 @@ impl LikelihoodPrior {
         prior: &PositionEstimate,
         measurement_noise_m2: DMat2,
         last_radial_velocity_mps: f64,
-        radial_velocity_residual_std_mps: f64,
+        likelihood_radial_velocity_std_mps: f64,
         gate_chi2: f64,
     ) -> Option<Self> {
         let innovation_covariance = prior.covariance + measurement_noise_m2;
@@ -68,7 +68,7 @@ impl LikelihoodPrior {
             inverse_m2: innovation_covariance.inverse(),
             log_determinant: math::ln(determinant),
             last_radial_velocity_mps,
-            inverse_velocity_variance: 1.0 / math::square(radial_velocity_residual_std_mps),
+            inverse_velocity_variance: 1.0 / math::square(likelihood_radial_velocity_std_mps),
             gate_chi2,
             // Within the gate, (Δx)² ≤ χ² · S_xx.
             x_half_window_m: math::sqrt(gate_chi2 * xx),

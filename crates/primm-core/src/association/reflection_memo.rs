@@ -20,11 +20,12 @@ pub struct RowReflection {
     pub prepared: Option<PreparedReflection>,
 }
 
-/// Values of one track's reflections, keyed by sensor position, on the stack. With more sensor
+/// Values of one track's reflections, keyed by sensor position and the sensor's reflection
+/// scale (`crate::sensor`), on the stack. With more sensor
 /// positions than `N`, the rest are computed on every call (the same values).
 #[derive(Debug, Clone, Copy)]
 pub struct ReflectionMemo<T, const N: usize> {
-    entries: [(DVec2, T); N],
+    entries: [(DVec2, f64, T); N],
     len: usize,
 }
 
@@ -34,7 +35,7 @@ pub const REFLECTION_MEMO_SENSORS: usize = 4;
 
 impl<T: Copy + Default, const N: usize> Default for ReflectionMemo<T, N> {
     fn default() -> Self {
-        ReflectionMemo { entries: [(DVec2::ZERO, T::default()); N], len: 0 }
+        ReflectionMemo { entries: [(DVec2::ZERO, 0.0, T::default()); N], len: 0 }
     }
 }
 
@@ -44,23 +45,28 @@ impl<T: Copy + Default, const N: usize> ReflectionMemo<T, N> {
         Self::default()
     }
 
-    /// The value held for `sensor_m` (compared bit for bit), if any.
-    pub fn find(&self, sensor_m: DVec2) -> Option<T> {
-        let same = |position: &DVec2| {
-            position.x.to_bits() == sensor_m.x.to_bits() && position.y.to_bits() == sensor_m.y.to_bits()
+    /// The value held for `sensor_m` and `scale` (compared bit for bit), if any.
+    pub fn find(&self, sensor_m: DVec2, scale: f64) -> Option<T> {
+        let same = |position: &DVec2, held_scale: f64| {
+            position.x.to_bits() == sensor_m.x.to_bits()
+                && position.y.to_bits() == sensor_m.y.to_bits()
+                && held_scale.to_bits() == scale.to_bits()
         };
-        self.entries[..self.len].iter().find(|(position, _)| same(position)).map(|(_, value)| *value)
+        self.entries[..self.len]
+            .iter()
+            .find(|(position, held_scale, _)| same(position, *held_scale))
+            .map(|(_, _, value)| *value)
     }
 
     /// `compute()` for the reflection seen from `sensor_m`, called at most once per held
     /// position, so the answer is exactly the function's.
-    pub fn get(&mut self, sensor_m: DVec2, compute: impl FnOnce() -> T) -> T {
-        if let Some(value) = self.find(sensor_m) {
+    pub fn get(&mut self, sensor_m: DVec2, scale: f64, compute: impl FnOnce() -> T) -> T {
+        if let Some(value) = self.find(sensor_m, scale) {
             return value;
         }
         let value = compute();
         if self.len < N {
-            self.entries[self.len] = (sensor_m, value);
+            self.entries[self.len] = (sensor_m, scale, value);
             self.len += 1;
         }
         value
@@ -101,8 +107,8 @@ mod tests {
             for k in 0..sensors.len() {
                 let sensor = sensors[(k + round * 5) % sensors.len()];
                 assert_eq!(
-                    memo.get(sensor, || expected_reflection(&extent, &object, sensor)),
-                    expected_reflection(&extent, &object, sensor)
+                    memo.get(sensor, 0.5, || expected_reflection(&extent, &object, sensor, 0.5)),
+                    expected_reflection(&extent, &object, sensor, 0.5)
                 );
             }
         }

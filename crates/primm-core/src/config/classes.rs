@@ -41,13 +41,17 @@ impl ClassTable {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct ClassConfig {
-    /// Association gate on the cost of `eq:association_cost`, m.
-    pub gate_m: f64,
+    /// Gate of the `paper` association cost (`eq:association_cost`: metres of distance plus
+    /// the weighted radial-velocity difference), m. Unused by the `likelihood` cost, which is
+    /// gated by `association.likelihood_gate_chi2`.
+    pub paper_gate_m: f64,
     /// Measurement noise covariance `R` of the CV, CA and CT modes, m².
     pub measurement_noise_covariance_m2: Covariance2,
-    /// Standard deviation of the measured radial velocity, m/s.
-    pub radial_velocity_std_mps: f64,
-    /// Standard deviation of the velocity across the line of sight at initiation, m/s.
+    /// Standard deviation of a new track's velocity along the line of sight (the measured
+    /// radial velocity's error), m/s: the initial velocity covariance only.
+    pub initial_radial_speed_std_mps: f64,
+    /// Standard deviation of a new track's velocity across the line of sight (which one radar
+    /// measurement does not observe), m/s.
     pub initial_tangential_speed_std_mps: f64,
     /// Highest speed over ground an object of this class reaches, m/s (absent: no bound). In
     /// steps with an ego pose, a mode's velocity estimate above it after an update or at a
@@ -57,11 +61,12 @@ pub struct ClassConfig {
     #[cfg_attr(feature = "serde", serde(default))]
     pub max_speed_mps: Option<f64>,
     /// Standard deviation of the difference between a measurement's radial velocity and the
-    /// track's last one, as the `likelihood` association cost scores it, m/s (absent: 1 m/s).
+    /// track's last one, as the `likelihood` association cost scores it (unused by the `paper`
+    /// cost), m/s (absent: 1 m/s).
     /// Wider than the sensor's noise: the two may come from different sensors, whose lines of
     /// sight differ, and the object accelerates between them.
     #[cfg_attr(feature = "serde", serde(default = "default_radial_velocity_residual_std_mps"))]
-    pub radial_velocity_residual_std_mps: f64,
+    pub likelihood_radial_velocity_std_mps: f64,
     /// Detection probability and clutter density of this class, for the existence probability
     /// (absent: 0.9 and 1e-4 /m²).
     #[cfg_attr(feature = "serde", serde(default))]
@@ -106,9 +111,9 @@ pub struct RadialVelocityUpdateConfig {
     /// Whether the row is applied.
     pub enabled: bool,
     /// Standard deviation of a measured radial velocity as a measurement of the object's
-    /// velocity along the line of sight, m/s: the sensor's noise plus what the reflection
-    /// point adds (an extended, turning object's points move differently), so at least the
-    /// sensor's own `radial_velocity_std_mps`.
+    /// velocity along the line of sight, in the Kalman row of the CV, CA and CT updates, m/s:
+    /// the sensor's noise plus what the reflection point adds (an extended, turning object's
+    /// points move differently).
     pub std_mps: f64,
     /// Residuals beyond this many standard deviations of their innovation are not applied
     /// (counted): a radial velocity the track cannot explain, dimensionless.

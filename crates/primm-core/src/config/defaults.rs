@@ -79,12 +79,12 @@ fn tracker() -> TrackerConfig {
 /// The `classes.car` section.
 fn car() -> ClassConfig {
     ClassConfig {
-        gate_m: 8.4,
+        paper_gate_m: 8.4,
         measurement_noise_covariance_m2: diagonal(0.36, 0.36),
-        radial_velocity_std_mps: 0.5,
+        initial_radial_speed_std_mps: 0.5,
         initial_tangential_speed_std_mps: 2.0,
         max_speed_mps: Some(70.0),
-        radial_velocity_residual_std_mps: 0.5,
+        likelihood_radial_velocity_std_mps: 0.5,
         existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
         duplicate_distance_m: 3.0,
         duplicate_speed_difference_mps: 2.0,
@@ -139,12 +139,12 @@ fn car() -> ClassConfig {
 /// The `classes.pedestrian` section.
 fn pedestrian() -> ClassConfig {
     ClassConfig {
-        gate_m: 4.2,
+        paper_gate_m: 4.2,
         measurement_noise_covariance_m2: diagonal(0.05, 0.05),
-        radial_velocity_std_mps: 0.3,
+        initial_radial_speed_std_mps: 0.3,
         initial_tangential_speed_std_mps: 0.525,
         max_speed_mps: Some(12.0),
-        radial_velocity_residual_std_mps: 0.7,
+        likelihood_radial_velocity_std_mps: 0.7,
         existence: ExistenceConfig { detection_probability: 0.15, clutter_density_per_m2: 0.0004 },
         duplicate_distance_m: 1.0,
         duplicate_speed_difference_mps: 1.0,
@@ -153,7 +153,15 @@ fn pedestrian() -> ClassConfig {
             line_of_sight: RadialLineOfSight::Measured,
             ..RadialVelocityUpdateConfig::default()
         },
-        extent: ExtentConfig::default(),
+        // A point; the size applies only when switched on.
+        extent: ExtentConfig {
+            length_m: 0.6,
+            width_m: 0.6,
+            contour_std_m: 0.2,
+            offset_scale: 0.5,
+            absorb_margin_m: 0.5,
+            ..ExtentConfig::default()
+        },
         constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },
         constant_acceleration: ConstantAccelerationConfig {
             jerk_psd_m2_per_s5: 1.75,
@@ -186,12 +194,12 @@ fn pedestrian() -> ClassConfig {
 /// The `classes.two_wheeler` section.
 fn two_wheeler() -> ClassConfig {
     ClassConfig {
-        gate_m: 4.0,
+        paper_gate_m: 4.0,
         measurement_noise_covariance_m2: diagonal(0.16, 0.16),
-        radial_velocity_std_mps: 0.4,
+        initial_radial_speed_std_mps: 0.4,
         initial_tangential_speed_std_mps: 5.0,
         max_speed_mps: Some(40.0),
-        radial_velocity_residual_std_mps: 1.0,
+        likelihood_radial_velocity_std_mps: 1.0,
         existence: ExistenceConfig { detection_probability: 0.2, clutter_density_per_m2: 0.0004 },
         duplicate_distance_m: 1.5,
         duplicate_speed_difference_mps: 2.0,

@@ -56,7 +56,7 @@ pub enum ConfigError {
     /// A value is out of its valid range.
     #[error("configuration key `{key}` is invalid: {reason}")]
     Invalid {
-        /// Dotted path of the key, e.g. `classes.car.gate_m`.
+        /// Dotted path of the key, e.g. `classes.car.paper_gate_m`.
         key: String,
         /// What is wrong with it.
         reason: String,

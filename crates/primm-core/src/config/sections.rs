@@ -58,12 +58,12 @@ fn default_likelihood_gate_chi2() -> f64 {
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum AssociationCost {
     /// `eq:association_cost`: Euclidean distance to the fused prior plus the capped, weighted
-    /// radial-velocity difference, gated at `classes.<class>.gate_m`.
+    /// radial-velocity difference, gated at `classes.<class>.paper_gate_m`.
     #[default]
     Paper,
     /// Negative log-likelihood: the squared Mahalanobis distance of the position (innovation
     /// covariance `S = P⁻ + R`) and of the radial-velocity difference (variance
-    /// `classes.<class>.radial_velocity_residual_std_mps²`), plus `ln det S`, gated at
+    /// `classes.<class>.likelihood_radial_velocity_std_mps²`), plus `ln det S`, gated at
     /// `association.likelihood_gate_chi2` on the distance.
     Likelihood,
 }

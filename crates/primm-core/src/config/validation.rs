@@ -201,12 +201,12 @@ pub(super) fn validate_tracker_and_predictor(
 /// The section `classes.<class>`.
 pub(super) fn validate_class(class: ObjectClass, section: &ClassConfig) -> Result<(), ConfigError> {
     let key = |name: &str| format!("classes.{}.{}", class.name(), name);
-    positive(&key("gate_m"), section.gate_m)?;
+    positive(&key("paper_gate_m"), section.paper_gate_m)?;
     covariance(&key("measurement_noise_covariance_m2"), &section.measurement_noise_covariance_m2)?;
-    positive(&key("radial_velocity_std_mps"), section.radial_velocity_std_mps)?;
+    positive(&key("initial_radial_speed_std_mps"), section.initial_radial_speed_std_mps)?;
     positive(&key("initial_tangential_speed_std_mps"), section.initial_tangential_speed_std_mps)?;
     section.max_speed_mps.map_or(Ok(()), |speed| positive(&key("max_speed_mps"), speed))?;
-    positive(&key("radial_velocity_residual_std_mps"), section.radial_velocity_residual_std_mps)?;
+    positive(&key("likelihood_radial_velocity_std_mps"), section.likelihood_radial_velocity_std_mps)?;
     positive(&key("duplicate_distance_m"), section.duplicate_distance_m)?;
     positive(&key("duplicate_speed_difference_mps"), section.duplicate_speed_difference_mps)?;
     positive(&key("radial_velocity_update.std_mps"), section.radial_velocity_update.std_mps)?;

@@ -99,7 +99,7 @@ impl ModeModels {
     /// Models from a class's configuration section.
     pub fn from_config(class: &ClassConfig) -> Self {
         let initial_velocity = InitialVelocity {
-            radial_std_mps: class.radial_velocity_std_mps,
+            radial_std_mps: class.initial_radial_speed_std_mps,
             tangential_std_mps: class.initial_tangential_speed_std_mps,
         };
         let r = crate::config::to_matrix(&class.measurement_noise_covariance_m2);
@@ -133,10 +133,16 @@ impl ModeModels {
     }
 
     /// Where the reflection of a track of this class is expected (a point class: no offset, no
-    /// spread), for its fused prior `object` and a sensor at `sensor_position_m`.
-    pub fn expected_reflection(&self, object: &ObjectPrior, sensor_position_m: DVec2) -> ExpectedReflection {
+    /// spread), for its fused prior `object` and a sensor at `sensor_position_m` whose
+    /// measurement model scales the outline offset by `scale`.
+    pub fn expected_reflection(
+        &self,
+        object: &ObjectPrior,
+        sensor_position_m: DVec2,
+        scale: f64,
+    ) -> ExpectedReflection {
         match &self.extent {
-            Some(extent) => crate::extent::expected_reflection(extent, object, sensor_position_m),
+            Some(extent) => crate::extent::expected_reflection(extent, object, sensor_position_m, scale),
             None => ExpectedReflection::POINT,
         }
     }

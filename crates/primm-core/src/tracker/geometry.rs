@@ -2,14 +2,15 @@
 //! `crate::tracking_frame`), odometry resets, and the sensors' positions and fields of view in
 //! the tracking frame.
 
-use super::{ScanningSensor, Tracker, MAX_DETECTION_PROBABILITY};
+use super::{ScanningSensor, Tracker};
 use crate::coordinates::CoordinateFrame;
 use crate::existence::FieldOfView;
 use crate::measurement::FrameView;
-use crate::measurement::{Measurement, ObjectClass};
+use crate::measurement::ObjectClass;
 use crate::pose::{EgoPose, RigidVelocity};
 use crate::predictor::DisplacementPredictor;
-use crate::sensor_noise::{MeasurementSensor, SensorNoise};
+use crate::sensor::UNMOUNTED;
+use crate::sensor_noise::MeasurementSensor;
 use glam::DVec2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
@@ -30,10 +31,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if self.step_pose.is_some() { CoordinateFrame::World } else { CoordinateFrame::Vehicle };
         self.last_step.tracking_frame = step_frame;
         if world && pose.is_none() {
-            self.stats.frames_without_ego_pose += 1;
+            self.last_step.counts.frames_without_ego_pose += 1;
         }
         if step_frame == CoordinateFrame::World {
-            self.stats.frames_in_world_frame += 1;
+            self.last_step.counts.frames_in_world_frame += 1;
         }
         let motion_since_last = self.ego_motion_since_last_pose(t);
         if step_frame != self.tracks_frame && !self.table.is_empty() {
@@ -65,7 +66,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                         add_ego(track);
                     }
                 }
-                self.last_step.tracking_frame_changed = true;
+                self.last_step.counts.tracking_frame_changes = 1;
             }
         }
         self.tracks_frame = step_frame;
@@ -88,7 +89,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         else {
             return None;
         };
-        if !(t > last_s) || self.last_step.odometry_reset {
+        if !(t > last_s) || self.last_step.odometry_reset() {
             return None;
         }
         let velocity_mps = (pose.position() - last.position()) / (t - last_s);
@@ -117,7 +118,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if !jumped {
             return;
         }
-        self.last_step.odometry_reset = true;
+        self.last_step.counts.odometry_resets = 1;
         let (to_vehicle, to_world) = (last.world_to_vehicle(), pose.vehicle_to_world());
         for track in self.table.tracks_mut() {
             track.transform(&to_vehicle);
@@ -134,23 +135,18 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.unknown_sensor_view = None;
         for index in 0..self.validated.len() {
             let Some(measurement) = self.validated.accepted(index) else { continue };
-            let mount = measurement.sensor_id.and_then(|id| self.config.frame.sensor(id));
-            let Some(mount) = mount else {
-                self.last_step.unknown_sensor = true;
+            let slot = self.sensors.slot(measurement.sensor_id);
+            let Some(field_of_view) = self.sensors.get(slot).field_of_view(self.step_pose) else {
+                self.last_step.counts.frames_with_unknown_sensor = 1;
                 continue;
             };
-            if self.scanning_sensors.iter().any(|sensor| sensor.id == mount.id) {
+            if self.scanning_sensors.iter().any(|sensor| sensor.slot == slot) {
                 continue;
             }
             // There are at most MAX_SENSORS configured mounts, so this never overflows.
-            let _ = self.scanning_sensors.try_push(ScanningSensor {
-                id: mount.id,
-                field_of_view: FieldOfView::of(mount, self.step_pose),
-                detection_probability_factor: mount.detection_probability_factor,
-                clutter_density_factor: mount.clutter_density_factor,
-            });
+            let _ = self.scanning_sensors.try_push(ScanningSensor { slot, field_of_view });
         }
-        if self.last_step.unknown_sensor {
+        if self.last_step.unknown_sensor() {
             self.unknown_sensor_view = self.unknown_sensor_view();
         }
     }
@@ -161,8 +157,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let frame = &self.config.frame;
         let unknown = (0..self.validated.len()).filter_map(|index| {
             let measurement = self.validated.accepted(index)?;
-            let mounted = measurement.sensor_id.and_then(|id| frame.sensor(id)).is_some();
-            (!mounted).then(|| measurement.position())
+            (self.sensors.slot(measurement.sensor_id) == UNMOUNTED).then(|| measurement.position())
         });
         let origin_m = self.step_pose.map_or(DVec2::ZERO, |pose| pose.position());
         FieldOfView::spanning(
@@ -173,59 +168,30 @@ impl<P: DisplacementPredictor> Tracker<P> {
         )
     }
 
-    /// Where the radar of every accepted measurement is, in the tracking frame: its mount,
-    /// mapped into the world in a world-frame step; without a configured mount the vehicle's
-    /// reference point (flagged, and counted where a row or an extent uses it). With it, the
-    /// detection's covariance from the radar's own noise (`crate::sensor_noise`).
+    /// Where the radar of every accepted measurement is, in the tracking frame, as its
+    /// [`Sensor`](crate::sensor::Sensor) says: its mount (the vehicle's reference point without
+    /// one), the detection's covariance from the radar's own noise, and the scale of its
+    /// measurement model for the measurement's class.
     pub(super) fn locate_measurement_sensors(&mut self) {
         for index in 0..self.validated.len() {
             let Some(measurement) = self.validated.accepted(index) else { continue };
-            let mount = measurement.sensor_id.and_then(|id| self.config.frame.sensor(id));
-            let in_vehicle = mount.map_or(DVec2::ZERO, |mount| mount.position());
-            let position_m = match self.step_pose {
-                Some(pose) => pose.point_to_world(in_vehicle),
-                None => in_vehicle,
+            let slot = self.sensors.slot(measurement.sensor_id);
+            let sensor = self.sensors.get(slot);
+            let position_m = sensor.position_m(self.step_pose);
+            let noise_m2 = sensor.noise(self.step_pose).covariance_m2(measurement.position() - position_m);
+            let extent = &self.config.classes.get(measurement.class).extent;
+            self.measurement_sensors[index] = MeasurementSensor {
+                position_m,
+                mounted: sensor.mount.is_some(),
+                noise_m2,
+                slot: slot as u8,
+                reflection_scale: sensor.reflection_scale(measurement.class, extent),
             };
-            // The radar's own noise enters world-frame steps only. In the vehicle frame a
-            // turning ego sweeps far objects across the line of sight at ω·r, which no motion
-            // model predicts; trusting far detections less there makes their tracks lag
-            // (ARCHITECTURE.md, "The radar's own noise").
-            let noise_m2 = match (mount, self.step_pose) {
-                (Some(mount), Some(pose)) => {
-                    SensorNoise::of(mount, Some(pose)).covariance_m2(measurement.position() - position_m)
-                }
-                _ => glam::DMat2::ZERO,
-            };
-            self.measurement_sensors[index] =
-                MeasurementSensor { position_m, mounted: mount.is_some(), noise_m2 };
         }
     }
 
-    /// Where the radar that measured `measurement` is, in the tracking frame: the world
-    /// position of its mount in a world-frame step (the vehicle's reference point, counted, for
-    /// a sensor without a configured mount), the vehicle frame's origin otherwise.
-    pub(super) fn sensor_position(&mut self, measurement: &Measurement) -> DVec2 {
-        let Some(pose) = self.step_pose else { return DVec2::ZERO };
-        match measurement.sensor_id.and_then(|id| self.config.frame.sensor(id)) {
-            Some(mount) => pose.point_to_world(mount.position()),
-            None => {
-                self.last_step.initiations_from_unknown_sensor += 1;
-                pose.position()
-            }
-        }
-    }
-
-    /// The detection probability and clutter density of `class` for the sensor `sensor_id`
-    /// (the class's own for a sensor without a configured mount).
-    pub(super) fn detection_and_clutter(&self, class: ObjectClass, sensor_id: Option<u16>) -> (f64, f64) {
-        let existence = &self.config.classes.get(class).existence;
-        let (detection, clutter) = match sensor_id.and_then(|id| self.config.frame.sensor(id)) {
-            Some(mount) => (mount.detection_probability_factor, mount.clutter_density_factor),
-            None => (1.0, 1.0),
-        };
-        (
-            (existence.detection_probability * detection).min(MAX_DETECTION_PROBABILITY),
-            existence.clutter_density_per_m2 * clutter,
-        )
+    /// The detection probability and clutter density of `class` for the sensor in `slot`.
+    pub(super) fn detection_and_clutter(&self, class: ObjectClass, slot: usize) -> (f64, f64) {
+        self.sensors.get(slot).detection_and_clutter(class)
     }
 }

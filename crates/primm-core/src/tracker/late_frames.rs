@@ -26,7 +26,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             Placement::TooLate => {
                 self.last_step = StepSummary::default();
                 self.count_live_tracks();
-                self.stats.frames_rejected_too_late += 1;
+                self.last_step.counts.frames_rejected_too_late = 1;
+                self.stats.add(&self.last_step.counts);
                 Err(StepError::InvalidFrame(FrameError::TooLate {
                     timestamp_s: self.recorded.timestamp_s(),
                     newest_s: self.last_timestamp_s.unwrap_or(f64::NAN),
@@ -69,6 +70,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.last_timestamp_s = newest_s;
         if let Err(error) = check {
             self.count_live_tracks();
+            self.stats.add(&self.last_step.counts);
             return Err(error);
         }
         self.restore_state(newer);
@@ -77,10 +79,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let result = self.track_recorded(observer);
         let mut summary = self.last_step;
         let mut next = position;
+        self.late_outputs.clear();
         if result.is_ok() {
+            self.keep_late_outputs();
             core::mem::swap(&mut self.recorded, &mut self.ring.slot_mut(late).frame);
             self.ring.insert(late, position);
-            self.stats.late_frames_tracked += 1;
+            summary.counts.late_frames_tracked = 1;
             next += 1;
         }
         while next < self.ring.len() {
@@ -90,7 +94,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let replayed = self.track_recorded(observer);
             core::mem::swap(&mut self.recorded, &mut self.ring.slot_mut(slot).frame);
             if replayed.is_ok() {
-                summary.replayed_frames += 1;
+                summary.counts.frames_replayed += 1;
                 next += 1;
             } else {
                 // Cannot happen for a frame tracked before (its interval only shrank); it is
@@ -99,11 +103,20 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         self.ring.trim(self.recorded_newest_s());
-        self.stats.frames_replayed += summary.replayed_frames as u64;
-        summary.late = true;
+        self.stats.late_frames_tracked += summary.counts.late_frames_tracked;
+        self.stats.frames_replayed += summary.counts.frames_replayed;
         self.last_step = summary;
         self.count_live_tracks();
         result
+    }
+
+    /// The report of the late frame just tracked, into `late_outputs` (whose room was reserved
+    /// when the tracker was built).
+    fn keep_late_outputs(&mut self) {
+        let outputs = &mut self.late_outputs;
+        let to_vehicle = self.step_pose.map(|pose| pose.world_to_vehicle());
+        let t = self.last_timestamp_s.unwrap_or(0.0);
+        super::report(&self.table, &self.rows[..], &self.imms, to_vehicle, t, |output| outputs.push(*output));
     }
 
     /// The newest tracked frame's time, s (0 before the first).
@@ -120,6 +133,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         before.last_pose = self.last_pose;
         before.ego_motion = self.ego_motion;
         before.stats = self.stats;
+        before.sensors = Some(*self.sensors);
     }
 
     /// Puts the tracker back into the state saved in ring slot `slot`.
@@ -131,6 +145,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.last_pose = before.last_pose;
         self.ego_motion = before.ego_motion;
         self.stats.restore_tracked_counts(&before.stats);
+        if let Some(sensors) = &before.sensors {
+            *self.sensors = *sensors;
+        }
     }
 
     /// Tracks the recorded frame; counts what it did into [`last_step`](Self::last_step) and
@@ -139,7 +156,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.last_step = StepSummary::default();
         let result = self.run_stages(observer);
         self.count_live_tracks();
-        self.stats.add_step(&self.last_step);
+        self.stats.add(&self.last_step.counts);
         result
     }
 

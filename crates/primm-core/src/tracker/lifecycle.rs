@@ -23,12 +23,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
             let Some(measurement) = self.validated.accepted(index) else { continue };
             if self.absorbed_by_a_track(&measurement, tracks_before) {
-                self.last_step.detections_absorbed += 1;
+                self.last_step.counts.detections_absorbed += 1;
                 continue;
             }
-            let sensor_position_m = self.sensor_position(&measurement);
             // Where the history's line of sight starts: the radial-velocity row's radar position.
             let sensor = self.measurement_sensors[index];
+            if !sensor.mounted && self.step_pose.is_some() {
+                self.last_step.counts.initiations_from_unknown_sensor += 1;
+            }
             let line_of_sight_origin = sensor.position_m;
             let models = &self.models[measurement.class.index()];
             // An extended object starts at the centre behind its reflection (no heading yet:
@@ -37,18 +39,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
             if models.extent.is_some() {
                 let standing =
                     crate::extent::ObjectPrior { centre_m: measurement.position(), ..Default::default() };
-                reflection = models.expected_reflection(&standing, sensor.position_m);
+                reflection =
+                    models.expected_reflection(&standing, sensor.position_m, sensor.reflection_scale);
                 (centre.x_m, centre.y_m) =
                     (measurement.x_m - reflection.offset_m.x, measurement.y_m - reflection.offset_m.y);
                 if !sensor.mounted {
-                    self.last_step.updates_from_unknown_sensor += 1;
+                    self.last_step.counts.updates_from_unknown_sensor += 1;
                 }
             }
             let imms = super::step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms);
             let mut estimate = imms[measurement.class.index()].initiate_seen_from(
                 &self.models[measurement.class.index()],
                 &centre,
-                sensor_position_m,
+                sensor.position_m,
             );
             // The radar's own noise spreads the start as it spreads every update.
             estimate.add_position_covariance(&crate::gaussian::to_nalgebra(
@@ -56,19 +59,20 @@ impl<P: DisplacementPredictor> Tracker<P> {
             ));
             let max_speed_mps = self.config.classes.get(measurement.class).max_speed_mps;
             if super::update::bound_speed(max_speed_mps, self.step_pose.is_some(), &mut estimate) {
-                self.last_step.speeds_bounded += 1;
+                self.last_step.counts.speeds_bounded += 1;
             }
             let tracker = &self.config.tracker;
             match self.table.insert(|id| {
                 Track::new(id, &measurement, line_of_sight_origin, t, estimate, initial_existence)
             }) {
                 Ok(track) => {
-                    self.last_step.initiated += 1;
+                    track.birth_sensor_slot = sensor.slot;
+                    self.last_step.counts.tracks_initiated += 1;
                     // A confirmation threshold of one hit (or an initial existence at the
                     // threshold) confirms at once.
                     if confirms(track, tracker) {
                         track.status = TrackStatus::Confirmed;
-                        self.last_step.newly_confirmed += 1;
+                        self.last_step.counts.tracks_confirmed += 1;
                     }
                     self.rows[self.table.len() - 1] = RowRecord {
                         prior_position_m: None,
@@ -77,7 +81,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     };
                     self.fates[index] = MeasurementFate::Assigned;
                 }
-                Err(_) => self.last_step.initiations_refused_table_full += 1,
+                Err(_) => self.last_step.counts.initiations_refused_table_full += 1,
             }
         }
     }
@@ -108,6 +112,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// `tentative_max_misses` misses and confirmed ones after `confirmed_max_misses`.
     pub(super) fn delete(&mut self, t: f64) {
         let lifecycle = &self.config.tracker;
+        let mut false_tracks =
+            [(crate::measurement::ObjectClass::Car, 0u8, 0u32); crate::track_table::MAX_TRACKS];
+        let mut false_count = 0;
         let deleted = retain_with_rows(&mut self.table, &mut self.rows[..], |_, track| {
             let (max_misses, max_coast_s) = if track.status.is_confirmed() {
                 (lifecycle.confirmed_max_misses, lifecycle.max_coast_s)
@@ -120,9 +127,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     track.existence_probability >= lifecycle.deletion_existence_probability
                 }
             };
-            alive && t - track.last_update_s <= max_coast_s
+            let kept = alive && t - track.last_update_s <= max_coast_s;
+            if !kept && super::sensors::was_false(track) {
+                false_tracks[false_count] = (track.class, track.birth_sensor_slot, track.hits);
+                false_count += 1;
+            }
+            kept
         });
-        self.last_step.deleted = deleted;
+        for &(class, slot, hits) in &false_tracks[..false_count] {
+            self.learn_false_track(class, slot, hits);
+        }
+        self.last_step.counts.tracks_deleted = deleted as u64;
     }
 
     /// Merges each track that has shadowed an older track of its class for
@@ -169,7 +184,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
         let merged = &self.merged;
         let removed = retain_with_rows(&mut self.table, &mut self.rows[..], |index, _| !merged[index]);
-        self.last_step.duplicates_merged = removed;
+        self.last_step.counts.duplicate_tracks_merged = removed as u64;
     }
 
     /// The nearest older track (more frames, or as many and a smaller id) of `index`'s class that

@@ -24,6 +24,7 @@ use crate::pose::{EgoMotion, EgoPose};
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::recorded_frame::RecordedFrame;
 use crate::replay::ReplayRing;
+use crate::sensor::SensorSet;
 use crate::sensor_noise::MeasurementSensor;
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
 use crate::track::{Track, TrackOutput};
@@ -36,16 +37,20 @@ use alloc::vec;
 use arrayvec::ArrayVec;
 use glam::{DMat2, DVec2};
 
+mod counters;
 mod geometry;
 mod late_frames;
 mod lifecycle;
 mod output;
 mod predict;
+mod sensors;
+mod speculation;
 mod stats;
 mod update;
 mod validate;
 
 use output::report;
+pub use speculation::{IntervalGuess, SpeculationStats};
 pub use stats::{StepSummary, TrackerStats};
 
 /// Why a step failed. The tracker's tracks are exactly as before the frame (after an
@@ -80,17 +85,13 @@ struct RowRecord {
 const EMPTY_ROW: RowRecord =
     RowRecord { prior_position_m: None, available: ModeSet::EMPTY, measurement_index: None };
 
-/// A sensor that scanned in the current frame, in the tracking frame.
+/// A sensor that scanned in the current frame: its slot in the [`SensorSet`] and its field of
+/// view in the tracking frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct ScanningSensor {
-    id: u16,
+    slot: usize,
     field_of_view: FieldOfView,
-    detection_probability_factor: f64,
-    clutter_density_factor: f64,
 }
-
-/// The detection probabilities are kept below 1, so that a miss never makes existence 0.
-const MAX_DETECTION_PROBABILITY: f64 = 0.999;
 
 /// The PR-IMM multi-object tracker with a learned-displacement predictor `P`.
 #[derive(Debug)]
@@ -117,10 +118,14 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     last_pose: Option<EgoPose>,
     /// When `last_pose` was taken and the ego's velocity over ground that the poses give.
     ego_motion: EgoMotion,
+    /// Every sensor: its mount, measurement model and what its data said so far.
+    sensors: Box<SensorSet>,
     // Per-frame workspaces, allocated once.
     requests: Box<ArrayVec<PredictionRequest, MAX_TRACKS>>,
     /// The table row of each request's track (`predictor.classes` may leave tracks out).
     requested_rows: Box<ArrayVec<u16, MAX_TRACKS>>,
+    /// Learned predictions computed between frames (`speculation`).
+    speculation: speculation::Speculation,
     /// The predictor's answers, aligned with `requests`.
     answers: Box<[Option<Displacement>; MAX_TRACKS]>,
     /// Each track's checked displacement, aligned with the table (`None`: the PR mode sits out).
@@ -142,6 +147,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// mount; the vehicle's reference point when it has none), whether it had a mount, and the
     /// detection's covariance from the radar's own noise (`crate::sensor_noise`).
     measurement_sensors: Box<[MeasurementSensor; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// Whether each track was confirmed (or coasting) before the current frame's update.
+    was_confirmed: Box<[bool; MAX_TRACKS]>,
     /// Each track's update outcome of the current frame.
     update_outcomes: Box<[track_loops::UpdateOutcome; MAX_TRACKS]>,
     rows: Box<[RowRecord; MAX_TRACKS]>,
@@ -164,6 +171,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     /// The recent frames and the state before each, for late frames.
     ring: ReplayRing,
     outputs: Box<ArrayVec<TrackOutput, MAX_TRACKS>>,
+    /// The outputs of the latest late frame right after it was tracked in its place, before
+    /// the newer frames were tracked again (room reserved only when late frames are on).
+    late_outputs: alloc::vec::Vec<TrackOutput>,
 }
 
 impl Tracker<NoPredictor> {
@@ -182,6 +192,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             imms: track_loops::class_imms(&config),
             compensated_imms: track_loops::class_compensated_imms(&config),
             models: ObjectClass::ALL.map(|class| ModeModels::from_config(config.classes.get(class))),
+            sensors: Box::new(sensor_set(&config)),
             config,
             predictor,
             table: TrackTable::new(),
@@ -195,17 +206,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
             ego_motion: EgoMotion::default(),
             requests: Box::new(ArrayVec::new()),
             requested_rows: Box::new(ArrayVec::new()),
+            speculation: speculation::Speculation::new(),
             answers: Box::new([None; MAX_TRACKS]),
             displacements: Box::new([None; MAX_TRACKS]),
             priors: vec![ImmPrior::default(); MAX_TRACKS].into_boxed_slice(),
             dt_s: 0.0,
             track_to_measurement: Box::new([None; MAX_TRACKS]),
             assigned_measurements: Box::new([None; MAX_TRACKS]),
-            assigned_sensors: Box::new([MeasurementSensor::unknown(DVec2::ZERO); MAX_TRACKS]),
+            assigned_sensors: Box::new([MeasurementSensor::unknown(DVec2::ZERO, 0.0); MAX_TRACKS]),
             assigned_reflections: Box::new([ExpectedReflection::POINT; MAX_TRACKS]),
             measurement_sensors: Box::new(
-                [MeasurementSensor::unknown(DVec2::ZERO); MAX_MEASUREMENTS_PER_FRAME],
+                [MeasurementSensor::unknown(DVec2::ZERO, 0.0); MAX_MEASUREMENTS_PER_FRAME],
             ),
+            was_confirmed: Box::new([false; MAX_TRACKS]),
             update_outcomes: Box::new([Ok(None); MAX_TRACKS]),
             rows: Box::new([EMPTY_ROW; MAX_TRACKS]),
             fates: Box::new([MeasurementFate::Rejected; MAX_MEASUREMENTS_PER_FRAME]),
@@ -216,6 +229,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             merged: Box::new([false; MAX_TRACKS]),
             recorded: Box::new(RecordedFrame::new()),
             validated: Box::new(ValidatedFrame::new()),
+            late_outputs: alloc::vec::Vec::with_capacity(if ring.is_enabled() { MAX_TRACKS } else { 0 }),
             ring,
             outputs: Box::new(ArrayVec::new()),
         })
@@ -283,12 +297,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
         observer.stage_finished(Stage::Associate);
         self.update(t);
         self.coast();
+        self.learn_sensors();
         self.initiate(t);
         self.delete(t);
         self.merge_duplicates();
         observer.stage_finished(Stage::Update);
         self.last_timestamp_s = Some(t);
-        self.stats.frames_tracked += 1;
+        self.last_step.counts.frames_tracked += 1;
         Ok(())
     }
 
@@ -306,6 +321,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.stats.resets += 1;
     }
 
+    /// Puts every sensor's estimates back at their priors (the configured values), e.g. before
+    /// tracking a recording of another vehicle. [`reset`](Self::reset) keeps them: a gap in the
+    /// stream does not change the radars.
+    pub fn forget_sensors(&mut self) {
+        *self.sensors = sensor_set(&self.config);
+        self.ring.clear();
+    }
+
     /// What the associator did in the last association: allowed pairs, clusters paired
     /// directly, clusters handed to the optimal solver and the largest and smallest of those.
     pub fn association_stats(&self) -> &AssociationStats {
@@ -316,6 +339,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// [`step_into`](Self::step_into), which hands them to its sink instead).
     pub fn last_outputs(&self) -> &[TrackOutput] {
         &self.outputs
+    }
+
+    /// When the last step tracked a late frame in its place ([`StepSummary::late`]): the
+    /// outputs of every live track right after that frame, at its time and with
+    /// `measurement_index` into its measurements, as in-order arrival gives them after it
+    /// (before the newer frames were tracked again). Empty after any other step, and when the
+    /// late frame itself was refused.
+    pub fn late_frame_outputs(&self) -> &[TrackOutput] {
+        if self.last_step.late() {
+            &self.late_outputs
+        } else {
+            &[]
+        }
     }
 
     /// The newest tracked frame's time, s: the time of the latest outputs (after a late frame
@@ -338,6 +374,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// The live tracks.
     pub fn tracks(&self) -> &[Track] {
         self.table.tracks()
+    }
+
+    /// Every sensor with what its data said so far (`crate::sensor`).
+    pub fn sensors(&self) -> &SensorSet {
+        &self.sensors
     }
 
     /// The configuration.
@@ -373,6 +414,15 @@ fn retain_with_rows(
         read += 1;
         kept
     })
+}
+
+/// The sensors of `config` at their priors.
+fn sensor_set(config: &Config) -> SensorSet {
+    let classes = ObjectClass::ALL.map(|class| {
+        let section = config.classes.get(class);
+        (&section.extent, &section.existence)
+    });
+    SensorSet::new(&config.frame, &classes)
 }
 
 /// Whether a tentative `track` has earned confirmation under the configured lifecycle.

@@ -8,11 +8,13 @@ use crate::displacement_check::{check_answer, DisplacementRejection};
 use crate::existence;
 use crate::mode::Mode;
 use crate::predictor::{Displacement, DisplacementPredictor, PredictionRequest, RememberedDisplacement};
+use crate::track::Track;
 use crate::track_loops;
 
 impl<P: DisplacementPredictor> Tracker<P> {
     /// Hands the history (`eq:pr_input`) of every track of a class in `predictor.classes` to
-    /// the learned predictor.
+    /// the learned predictor, less the requests that a batch computed ahead answers
+    /// (`super::speculation`).
     pub(super) fn request_learned_predictions(&mut self, t: f64) {
         self.requests.clear();
         self.requested_rows.clear();
@@ -20,25 +22,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
         if !modes.contains(Mode::Learned) {
             return;
         }
+        let step_start = self.last_timestamp_s.unwrap_or(t);
+        self.speculation.record_interval(t - step_start);
         for (row, track) in self.table.tracks().iter().enumerate() {
             if !self.config.predictor.predicts(track.class, modes) {
                 continue;
             }
-            let (older, newer) = track.history.as_slices();
-            let mut window = [Default::default(); crate::predictor::MAX_HISTORY];
-            let len = older.len() + newer.len();
-            window[..older.len()].copy_from_slice(older);
-            window[older.len()..len].copy_from_slice(newer);
-            let step_start = self.last_timestamp_s.unwrap_or(t);
-            self.requests.push(
-                PredictionRequest::from_history(&window[..len], t)
-                    .with_step_start(step_start)
-                    .with_remembered_step_start(track.remembered_displacement.as_ref()),
-            );
+            self.requests.push(learned_request(track, t, step_start));
             // The table holds at most MAX_TRACKS (512) rows, so the row fits in u16.
             self.requested_rows.push(row as u16);
         }
-        self.predictor.submit(&self.requests);
+        self.speculation.submit(&mut self.predictor, &self.requests);
     }
 
     /// Mixing and the CV, CA and CT predictions, while the predictor works.
@@ -84,7 +78,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// counted and dropped) and handed to its track's row.
     fn collect_displacements(&mut self) {
         let answers = &mut self.answers[..self.requests.len()];
-        self.predictor.collect(answers);
+        self.speculation.gather(&mut self.predictor, answers);
         for (answer, request) in answers.iter_mut().zip(self.requests.iter()) {
             let Some(displacement) = answer.as_mut() else { continue };
             if let Err(reason) = accept_displacement(request, displacement, &self.config.predictor) {
@@ -92,7 +86,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 *answer = None;
             }
         }
-        self.last_step.predictions_missing = answers.iter().filter(|answer| answer.is_none()).count();
+        let missing = answers.iter().filter(|answer| answer.is_none()).count() as u64;
+        self.last_step.counts.learned_predictions_missing = missing;
+        self.last_step.counts.frames_with_learned_predictions_missing = u64::from(missing > 0);
         let tracks = self.table.tracks_mut();
         for ((answer, request), &row) in
             answers.iter().zip(self.requests.iter()).zip(self.requested_rows.iter())
@@ -103,6 +99,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 answer.as_ref().and_then(|answer| RememberedDisplacement::of(request, answer));
         }
     }
+}
+
+/// The learned-prediction request of `track` for `prediction_time_s`, its step starting at
+/// `step_start_s` (the previous frame's time), with the displacement it remembers.
+pub(super) fn learned_request(track: &Track, prediction_time_s: f64, step_start_s: f64) -> PredictionRequest {
+    let (older, newer) = track.history.as_slices();
+    let mut window = [Default::default(); crate::predictor::MAX_HISTORY];
+    let len = older.len() + newer.len();
+    window[..older.len()].copy_from_slice(older);
+    window[older.len()..len].copy_from_slice(newer);
+    PredictionRequest::from_history(&window[..len], prediction_time_s)
+        .with_step_start(step_start_s)
+        .with_remembered_step_start(track.remembered_displacement.as_ref())
 }
 
 /// Checks one learned displacement against its request and sets its process noise `Q_PR`

@@ -9,9 +9,10 @@ use crate::imm::ImmState;
 use crate::measurement::FrameView;
 use crate::measurement::ObjectClass;
 use crate::predictor::DisplacementPredictor;
+use crate::sensor::UNMOUNTED;
+use crate::sensor_noise::MeasurementSensor;
 use crate::track::TrackStatus;
 use crate::track_loops;
-use glam::DVec2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
     /// Per-class gated optimal assignment (`eq:association_cost`).
@@ -29,15 +30,15 @@ impl<P: DisplacementPredictor> Tracker<P> {
         Ok(())
     }
 
-    /// The expected reflection of track `i`'s object for a sensor at `sensor_m` (a point class:
-    /// none).
-    pub(super) fn expected_reflection(&self, i: usize, sensor_m: DVec2) -> ExpectedReflection {
+    /// The expected reflection of track `i`'s object for a measurement of `sensor` (a point
+    /// class: none).
+    pub(super) fn expected_reflection(&self, i: usize, sensor: &MeasurementSensor) -> ExpectedReflection {
         let class = self.table.tracks()[i].class;
         let models = &self.models[class.index()];
         match models.extent {
             Some(_) => {
                 let prior = &self.priors[i];
-                models.expected_reflection(&prior.object_prior(), sensor_m)
+                models.expected_reflection(&prior.object_prior(), sensor.position_m, sensor.reflection_scale)
             }
             None => ExpectedReflection::POINT,
         }
@@ -63,11 +64,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let reflection = self
                 .associator
                 .assigned_reflection(i)
-                .unwrap_or_else(|| self.expected_reflection(i, sensor.position_m));
+                .unwrap_or_else(|| self.expected_reflection(i, &sensor));
             self.assigned_reflections[i] = reflection;
             let models = &self.models[measurement.class.index()];
             if !sensor.mounted && (models.radial_velocity_update.enabled || models.extent.is_some()) {
-                self.last_step.updates_from_unknown_sensor += 1;
+                self.last_step.counts.updates_from_unknown_sensor += 1;
             }
         }
     }
@@ -78,13 +79,16 @@ impl<P: DisplacementPredictor> Tracker<P> {
     fn bound_speed(&mut self, i: usize, class: ObjectClass) {
         let max_speed_mps = self.config.classes.get(class).max_speed_mps;
         if bound_speed(max_speed_mps, self.step_pose.is_some(), &mut self.table.tracks_mut()[i].estimate) {
-            self.last_step.speeds_bounded += 1;
+            self.last_step.counts.speeds_bounded += 1;
         }
     }
 
     /// Kalman and mode-probability update of every assigned track.
     pub(super) fn update(&mut self, t: f64) {
         let count = self.table.len();
+        for (was_confirmed, track) in self.was_confirmed.iter_mut().zip(self.table.tracks()) {
+            *was_confirmed = track.status.is_confirmed();
+        }
         self.read_assignment();
         track_loops::update(
             super::step_imms(self.step_pose.is_some(), &self.imms, &self.compensated_imms),
@@ -107,21 +111,31 @@ impl<P: DisplacementPredictor> Tracker<P> {
             };
             if let Ok(radial_velocity) = self.update_outcomes[i] {
                 match radial_velocity {
-                    Some(RadialVelocityOutcome::Applied) => self.last_step.radial_velocity_rows_applied += 1,
-                    Some(RadialVelocityOutcome::Gated) => self.last_step.radial_velocity_rows_gated += 1,
+                    Some(RadialVelocityOutcome::Applied) => {
+                        self.last_step.counts.radial_velocity_updates += 1
+                    }
+                    Some(RadialVelocityOutcome::Gated) => {
+                        self.last_step.counts.radial_velocity_updates_gated += 1
+                    }
                     Some(RadialVelocityOutcome::NoLineOfSight) | None => {}
                 }
                 let class = self.table.tracks()[i].class;
                 self.bound_speed(i, class);
-                let (detection, clutter) = self.detection_and_clutter(class, measurement.sensor_id);
+                let sensor = self.assigned_sensors[i];
+                let (detection, clutter) = self.detection_and_clutter(class, usize::from(sensor.slot));
                 let reflection = self.assigned_reflections[i];
                 let prior = &self.priors[i].fused;
-                let likelihood = existence::gaussian_density_per_m2(
-                    measurement.position() - reflection.offset_m - prior.mean,
-                    prior.covariance
-                        + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2)
-                        + reflection.covariance_m2
-                        + self.assigned_sensors[i].noise_m2,
+                let innovation_m = measurement.position() - reflection.offset_m - prior.mean;
+                let innovation_covariance_m2 = prior.covariance
+                    + covariance(&self.config.classes.get(class).measurement_noise_covariance_m2)
+                    + reflection.covariance_m2
+                    + sensor.noise_m2;
+                let likelihood = existence::gaussian_density_per_m2(innovation_m, innovation_covariance_m2);
+                self.learn_reflection(
+                    i,
+                    &sensor,
+                    innovation_m,
+                    0.5 * (innovation_covariance_m2.x_axis.x + innovation_covariance_m2.y_axis.y),
                 );
                 let tracker = &self.config.tracker;
                 let track = &mut self.table.tracks_mut()[i];
@@ -134,14 +148,14 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 track.record_hit(&measurement, self.assigned_sensors[i].position_m, t);
                 if track.status == TrackStatus::Tentative && confirms(track, tracker) {
                     track.status = TrackStatus::Confirmed;
-                    self.last_step.newly_confirmed += 1;
+                    self.last_step.counts.tracks_confirmed += 1;
                 }
-                self.last_step.assigned += 1;
+                self.last_step.counts.tracks_updated += 1;
                 self.fates[usize::from(index)] = MeasurementFate::Assigned;
             } else {
                 // Numerically unusable: the track coasts and the measurement is free to start a
                 // track of its own.
-                self.last_step.update_failures += 1;
+                self.last_step.counts.update_failures += 1;
                 self.track_to_measurement[i] = None;
             }
         }
@@ -159,7 +173,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 let mut missed = false;
                 let prior_m = self.priors[i].fused.mean;
                 for sensor in self.scanning_sensors.iter().filter(|s| s.field_of_view.contains(prior_m)) {
-                    let (detection, clutter) = self.detection_and_clutter(track.class, Some(sensor.id));
+                    let (detection, clutter) = self.detection_and_clutter(track.class, sensor.slot);
                     existence_probability = existence::updated_existence(
                         existence_probability,
                         Evidence::MissedInView,
@@ -169,7 +183,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     missed = true;
                 }
                 if self.unknown_sensor_view.is_some_and(|view| view.contains(prior_m)) {
-                    let (detection, clutter) = self.detection_and_clutter(track.class, None);
+                    let (detection, clutter) = self.detection_and_clutter(track.class, UNMOUNTED);
                     existence_probability = existence::updated_existence(
                         existence_probability,
                         Evidence::MissedInView,
@@ -178,7 +192,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     );
                     missed = true;
                 }
-                self.last_step.missed_in_view += usize::from(missed);
+                self.last_step.counts.tracks_missed_in_view += u64::from(missed);
                 let track = &mut self.table.tracks_mut()[i];
                 track.estimate = self.imms[track.class.index()].coast(&self.priors[i]);
                 track.record_miss();

@@ -14,7 +14,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// [`ValidatedFrame`]: crate::validated_frame::ValidatedFrame
     pub(super) fn validate(&mut self) -> Result<f64, StepError> {
         self.validated.read_header(&*self.recorded);
-        let dt_s = self.check_frame().inspect_err(|error| self.stats.count_frame_rejection(error))?;
+        let dt_s =
+            self.check_frame().inspect_err(|error| self.last_step.counts.count_frame_rejection(error))?;
         for index in 0..self.validated.len() {
             let verdict = validate_measurement(&*self.recorded, index);
             self.validated.set(index, verdict.ok());
@@ -22,12 +23,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
             match verdict {
                 Ok(_) => {
                     self.fates[index] = MeasurementFate::Unassigned;
-                    self.last_step.measurements_accepted += 1;
+                    self.last_step.counts.measurements_accepted += 1;
                 }
                 Err(reason) => {
                     self.fates[index] = MeasurementFate::Rejected;
-                    self.stats.count_measurement_rejection(reason);
-                    self.last_step.measurements_rejected += 1;
+                    self.last_step.counts.count_measurement_rejection(reason);
                 }
             }
         }

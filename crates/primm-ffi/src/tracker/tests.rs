@@ -155,12 +155,12 @@ fn tracks_copied_out_are_the_core_trackers_outputs_field_for_field() {
 
 #[test]
 fn an_invalid_toml_value_gives_invalid_config_with_a_message_naming_the_key() {
-    let text = primm_config::DEFAULT_CONFIG_TOML.replace("gate_m = 8.4", "gate_m = -1.0");
+    let text = primm_config::DEFAULT_CONFIG_TOML.replace("paper_gate_m = 8.4", "paper_gate_m = -1.0");
     let text = CString::new(text).unwrap();
     let options = PrimmTrackerOptions { config_toml: text.as_ptr(), ..imm_options() };
     let (status, message) = create(&options).unwrap_err();
     assert_eq!(status, PrimmStatus::InvalidConfig);
-    assert!(message.contains("classes.car.gate_m"), "{message}");
+    assert!(message.contains("classes.car.paper_gate_m"), "{message}");
 
     let text = CString::new("[tracker]\nconfirmation_hitz = 3\n").unwrap();
     let options = PrimmTrackerOptions { config_toml: text.as_ptr(), ..imm_options() };
@@ -648,4 +648,34 @@ fn an_invalid_pose_is_rejected_with_a_message_and_leaves_the_tracker_as_it_was()
     assert_eq!(status, PrimmStatus::NullArgument);
     destroy(faulty);
     destroy(clean);
+}
+
+#[test]
+fn a_speed_held_at_its_class_s_bound_is_counted_in_the_c_counters() {
+    // A car at 20 m/s whose detections run ahead faster every frame (as in the integration test
+    // of the speed bound), with an ego pose: the track is held at the car's highest speed.
+    let tracker = create(&imm_options()).unwrap();
+    let pose = PrimmEgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 };
+    let (mut x_m, mut speed_mps) = (10.0, 20.0);
+    for k in 0..70 {
+        if k >= 30 {
+            speed_mps += 6.0;
+        }
+        x_m += speed_mps * 0.05;
+        let mut frame = Frame::new(k as f64 * 0.05);
+        frame.measurements.push(primm_core::measurement::Measurement {
+            x_m,
+            y_m: -3.0,
+            radial_velocity_mps: speed_mps * x_m / f64::hypot(x_m, 3.0),
+            rcs_dbsm: 10.0,
+            class: ObjectClass::Car,
+            sensor_id: Some(2),
+            ground_truth_id: Some(1),
+        });
+        assert_eq!(step_frame(tracker, &frame, Some(&pose)).0, PrimmStatus::Ok);
+    }
+    let stats = stats(tracker);
+    assert!(stats.speeds_bounded > 0, "{stats:?}");
+    assert_eq!(stats.frames_tracked, 70);
+    destroy(tracker);
 }

@@ -128,6 +128,9 @@ static void errors() {
     }
     const std::string before = snapshot(tracker);
     const PrimmStats stats_before = tracker.stats();
+    /* Every accepted measurement updated or started one track; no speed needed bounding. */
+    CHECK(stats_before.tracks_updated + stats_before.tracks_initiated == stats_before.measurements_accepted);
+    CHECK(stats_before.speeds_bounded == 0);
     try {
         tracker.step(0.05, two_objects(9));
         CHECK(false);
@@ -167,12 +170,13 @@ static void errors() {
     CHECK(small[0].id == 777);
 
     try {
-        primm::object_class_from_name("bus");
+        primm::object_class_from_name("tram");
         CHECK(false);
     } catch (const primm::Error &error) {
         CHECK(error.status() == PRIMM_STATUS_INVALID_ARGUMENT);
     }
     CHECK(primm::object_class_from_name("pedestrian") == PRIMM_OBJECT_CLASS_PEDESTRIAN);
+    CHECK(primm::object_class_from_name("bus") == PRIMM_OBJECT_CLASS_CAR);
 }
 
 static void spans_and_steps() {

@@ -23,7 +23,9 @@ use super::model::PrModel;
 use glam::DVec2;
 use primm_config::InferenceEngine;
 use primm_core::limits::MAX_TRACKS;
-use primm_core::predictor::{Displacement, DisplacementPredictor, PredictionRequest, FEATURES, MAX_HISTORY};
+use primm_core::predictor::{
+    AnswerDependence, Displacement, DisplacementPredictor, PredictionRequest, FEATURES, MAX_HISTORY,
+};
 use std::path::Path;
 
 /// Where a request's step starts, for turning `f(t_k)` into the step's displacement.
@@ -267,6 +269,17 @@ impl DisplacementPredictor for OnnxPredictor {
         displacements.fill(None);
         for (out, result) in displacements.iter_mut().zip(&self.results) {
             *out = *result;
+        }
+    }
+
+    /// On the native engine, the model input alone: it computes one sample at a time, reading
+    /// the request only through its features (rotated by the anchor and sensor positions), its
+    /// step start and remembered `f(t_{k−1})`, and the `f32` step length. On tract, whose plans
+    /// for different batch sizes may round differently, anything in the batch.
+    fn answer_dependence(&self) -> AnswerDependence {
+        match self.model.engine() {
+            InferenceEngine::Native => AnswerDependence::ModelInput,
+            InferenceEngine::Tract => AnswerDependence::Batch,
         }
     }
 

@@ -16,6 +16,8 @@
 //! * mean IMM mode probabilities ([`modes`]),
 //! * the ego vehicle's motion (straight or turning) of each frame, for Tables II and IV split
 //!   by it ([`ego_motion`]),
+//! * the true reflection offset, detection probability and clutter density of each simulated
+//!   sensor and class, the reference of the tracker's estimates of them ([`sensor_truth`]),
 //! * velocity RMSE of the tracks and speed and heading errors of confirmed tracks, where the
 //!   data carry true velocities ([`velocity`]),
 //!
@@ -38,6 +40,7 @@ pub mod record;
 pub mod report;
 pub mod rmse;
 pub mod scenario;
+pub mod sensor_truth;
 pub mod velocity;
 
 pub use confirmed::{
@@ -59,4 +62,7 @@ pub use record::{counts_as_confirmed, AssociationRecord, EvalError, Method};
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;
 pub use scenario::{classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules};
+pub use sensor_truth::{
+    format_sensor_truth, sensor_truth_of_split, SensorClassTruth, SensorTruthAccumulator, UnknownSensor,
+};
 pub use velocity::{SpeedHeadingAccumulator, VelocityRmseAccumulator, HEADING_MIN_TRUE_SPEED_MPS};

@@ -644,23 +644,10 @@ pub fn read_dataset_dir(dir: &Path) -> Result<Vec<Sequence>, CsvError> {
 
 /// The class of a `class` cell: `car`, `pedestrian` or `two_wheeler`, or a name other datasets
 /// and stacks give the same kind of object (docs/scenario.md), in any letter case, with `-` or a
-/// space for `_`. A truck or a bus is tracked as a car, a cyclist as a two-wheeler.
+/// space for `_`. A truck or a bus is tracked as a car, a cyclist as a two-wheeler. The mapping
+/// is primm-core's [`ObjectClass::from_label`], which the C API shares.
 pub fn class_from_label(text: &str) -> Option<ObjectClass> {
-    let label: String = text
-        .trim()
-        .chars()
-        .map(|c| if c == '-' || c == ' ' { '_' } else { c.to_ascii_lowercase() })
-        .collect();
-    match label.as_str() {
-        "car" | "vehicle" | "passenger_car" | "van" | "truck" | "bus" | "large_vehicle" | "trailer" => {
-            Some(ObjectClass::Car)
-        }
-        "pedestrian" | "person" | "pedestrian_group" => Some(ObjectClass::Pedestrian),
-        "two_wheeler" | "bicycle" | "bike" | "cyclist" | "motorcycle" | "motorbike" | "scooter" => {
-            Some(ObjectClass::TwoWheeler)
-        }
-        _ => None,
-    }
+    ObjectClass::from_label(text)
 }
 
 #[cfg(test)]

@@ -19,9 +19,10 @@
 //! frame, so every scorer reads both kinds of file.
 //!
 //! A frame that arrived late (older than the newest tracked frame, which the tracker tracks in
-//! its place before tracking the newer frames again) has no rows: its measurements show in the
-//! rows of the frames that follow it in the file. Rows already written for the newer frames
-//! stay as they were written.
+//! its place before tracking the newer frames again) has the rows of the tracks as they were
+//! right after it (`Tracker::late_frame_outputs`), with its own frame index and time, after the
+//! rows of the newer frames that came before it. Rows already written for the newer frames stay
+//! as they were written.
 
 use super::recording::Sequence;
 use primm_core::config::CoordinateFrame;

@@ -42,6 +42,8 @@ mod kinematics;
 mod path;
 mod radar;
 mod road;
+#[cfg(test)]
+mod sensor_presets_tests;
 mod split;
 mod world;
 
@@ -51,10 +53,10 @@ use rand_chacha::ChaCha12Rng;
 use serde::{Deserialize, Serialize};
 
 pub use config::{
-    CarConfig, ClutterConfig, ConfigError, DriverConfig, EgoConfig, ExtendedObjectConfig, Interval,
-    MotionLimits, PedestrianConfig, Preset, RadarConfig, RadarMount, ReflectionConfig, RoadConfig,
-    ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig, TrafficConfig, WalkerConfig,
-    MAX_DETECTIONS_PER_OBJECT,
+    CarConfig, ClutterConfig, ConfigError, DriverConfig, EgoConfig, EgoPlacement, ExtendedObjectConfig,
+    Interval, MotionLimits, OutputConfig, PedestrianConfig, Preset, RadarConfig, RadarMount, RadarReport,
+    ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig,
+    TrafficConfig, WalkerConfig, MAX_DETECTIONS_PER_OBJECT,
 };
 pub use events::{
     count_events, EventCounts, CLOSE_PROXIMITY_DISTANCE_M, CROSSING_DISTANCE_M,
@@ -126,6 +128,9 @@ pub struct EgoState {
 pub struct TruthFrame {
     /// Frame time, seconds (same as the recorded frame's).
     pub timestamp_s: f64,
+    /// The sensor that scanned, also where the recorded frame leaves it out
+    /// (`output.sensor_id = false`).
+    pub sensor_id: u16,
     /// The ego vehicle.
     pub ego: EgoState,
     /// All objects that exist at this time.
@@ -239,14 +244,17 @@ impl ScenarioGenerator {
                 &mut clutter_rng,
             );
             let ego_pose = world.ego_pose();
+            let sensor_id = cfg.radar.sensors[scan.sensor].layout.id;
             let mut frame = RecordedFrame::new(index as u64, scan.t);
-            frame.sensor_id = Some(cfg.radar.sensors[scan.sensor].layout.id);
+            frame.sensor_id = Some(sensor_id);
             frame.ego_pose = Some(ego_pose);
             frame.measurements = scanned.measurements;
+            apply_output(&cfg.output, &mut frame);
             sequence.frames.push(frame);
             let ego = world.ego();
             truth.push(TruthFrame {
                 timestamp_s: scan.t,
+                sensor_id,
                 ego: EgoState {
                     pose: ego_pose,
                     speed_mps: ego.kin.speed,
@@ -272,5 +280,19 @@ impl ScenarioGenerator {
             });
         }
         GeneratedSequence { split: None, seed, sequence, truth }
+    }
+}
+
+/// Leaves out of a recorded frame what `output` does not write: the ego pose, the sensor id of
+/// the frame and of each of its measurements.
+fn apply_output(output: &OutputConfig, frame: &mut RecordedFrame) {
+    if !output.ego_pose {
+        frame.ego_pose = None;
+    }
+    if !output.sensor_id {
+        frame.sensor_id = None;
+        for measurement in &mut frame.measurements {
+            measurement.measurement.sensor_id = None;
+        }
     }
 }

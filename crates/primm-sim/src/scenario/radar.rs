@@ -15,6 +15,9 @@
 //! (near the point nearest to the sensor, or on a visible corner), reported on its own, and a
 //! vehicle sometimes yields several detections in one scan. Pedestrians keep the averaged
 //! point model.
+//!
+//! An object-list radar (`radar.report = "centre"`) detects objects the same way, but reports
+//! each at its true centre with the noise of one point.
 
 use glam::DVec2;
 use rand::seq::SliceRandom;
@@ -22,7 +25,9 @@ use rand::Rng;
 use rand_chacha::ChaCha12Rng;
 use rand_distr::{Distribution, Normal, Poisson};
 
-use super::config::{ExtendedObjectConfig, RadarConfig, RadarMount, ReflectionConfig, ScenarioConfig};
+use super::config::{
+    ExtendedObjectConfig, RadarConfig, RadarMount, RadarReport, ReflectionConfig, ScenarioConfig,
+};
 use super::kinematics::wrap_angle;
 use super::world::{Agent, World};
 use crate::io::{EgoPose, RecordedMeasurement};
@@ -206,13 +211,17 @@ pub(crate) fn scan(
             continue;
         }
         let n = f64::from(echo.count);
-        let position = ego.world_to_car(echo.sum_position / n);
+        let (measured, vr, rcs) = match radar.report {
+            RadarReport::Echo => (echo.sum_position / n, echo.sum_vr / n, echo.sum_rcs / n),
+            RadarReport::Centre => measure_centre(&sensor, object, refl, rng),
+        };
+        let position = ego.world_to_car(measured);
         out.push(RecordedMeasurement {
             measurement: Measurement {
                 x_m: position.x,
                 y_m: position.y,
-                radial_velocity_mps: echo.sum_vr / n + scan_bias,
-                rcs_dbsm: echo.sum_rcs / n,
+                radial_velocity_mps: vr + scan_bias,
+                rcs_dbsm: rcs,
                 class: object.class,
                 sensor_id: Some(mount.layout.id),
                 ground_truth_id: Some(object.id),
@@ -534,6 +543,22 @@ fn detected(
         return None;
     }
     Some((point_rel, point_range, azimuth))
+}
+
+/// What an object-list radar (`radar.report = "centre"`) reports of a detected object: its true
+/// centre, measured like one reflection point there ([`measure_point`]: range, azimuth and
+/// Doppler noise, the mount's misalignment, micro-Doppler and RCS).
+fn measure_centre(
+    sensor: &ScanSensor<'_>,
+    object: &Agent,
+    refl: &ReflectionConfig,
+    rng: &mut ChaCha12Rng,
+) -> (DVec2, f64, f64) {
+    let centre = object.kin.position;
+    let rel = centre - sensor.origin;
+    let range = rel.length().max(1e-6);
+    let azimuth = wrap_angle(rel.to_angle() - sensor.boresight);
+    measure_point(sensor, object, refl, centre, rel, range, azimuth, rng)
 }
 
 /// The measured position, radial velocity and RCS of a detected reflection point.

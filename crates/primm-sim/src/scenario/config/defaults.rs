@@ -3,8 +3,8 @@
 use super::behaviour::{DriverConfig, MotionLimits, WalkerConfig};
 use super::mount::RadarMount;
 use super::types::{
-    CarConfig, ClutterConfig, EgoConfig, ExtendedObjectConfig, PedestrianConfig, RadarConfig,
-    ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig, TrafficConfig,
+    CarConfig, ClutterConfig, EgoConfig, EgoPlacement, ExtendedObjectConfig, OutputConfig, PedestrianConfig,
+    RadarConfig, RadarReport, ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig, TrafficConfig,
 };
 use super::ScenarioConfig;
 
@@ -23,6 +23,7 @@ impl Default for ScenarioConfig {
             pedestrian_reflection: ReflectionConfig::pedestrian(),
             clutter: ClutterConfig::default(),
             extended_objects: ExtendedObjectConfig::default(),
+            output: OutputConfig::default(),
         }
     }
 }
@@ -92,6 +93,7 @@ impl Default for EgoConfig {
             start_distance_to_junction_m: [20.0, 80.0],
             turn_left_probability: None,
             turn_right_probability: None,
+            placement: EgoPlacement::Driving,
         }
     }
 }
@@ -157,7 +159,15 @@ impl Default for RadarConfig {
             miss_probability: 0.03,
             occluded_point_probability: 0.05,
             fade_start_fraction: 0.7,
+            report: RadarReport::Echo,
         }
+    }
+}
+
+impl Default for OutputConfig {
+    /// Frames carry the ego pose and the sensor id.
+    fn default() -> Self {
+        Self { ego_pose: true, sensor_id: true }
     }
 }
 

@@ -24,8 +24,9 @@ pub use behaviour::{DriverConfig, MotionLimits, WalkerConfig};
 pub use mount::RadarMount;
 pub use presets::Preset;
 pub use types::{
-    CarConfig, ClutterConfig, EgoConfig, ExtendedObjectConfig, PedestrianConfig, RadarConfig,
-    ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig, TrafficConfig, MAX_DETECTIONS_PER_OBJECT,
+    CarConfig, ClutterConfig, EgoConfig, EgoPlacement, ExtendedObjectConfig, OutputConfig, PedestrianConfig,
+    RadarConfig, RadarReport, ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig, TrafficConfig,
+    MAX_DETECTIONS_PER_OBJECT,
 };
 
 /// A closed interval `[min, max]` from which a value is drawn uniformly.
@@ -87,6 +88,8 @@ pub struct ScenarioConfig {
     /// Extended-object reflections of cars and two-wheelers: separate detections on the
     /// visible contour of the box instead of one averaged measurement (off by default).
     pub extended_objects: ExtendedObjectConfig,
+    /// What the written frames carry besides the measurements (ego pose, sensor ids).
+    pub output: OutputConfig,
 }
 
 impl ScenarioConfig {

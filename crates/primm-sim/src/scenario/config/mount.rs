@@ -83,6 +83,7 @@ impl TryFrom<RadarMountFields> for RadarMount {
             range_std_m: 0.0,
             azimuth_std_rad: 0.0,
             azimuth_std_max_factor: 1.0,
+            reflection: primm_core::sensor::ReflectionModel::Outline,
         };
         Ok(RadarMount {
             layout,
@@ -111,9 +112,9 @@ impl From<RadarMount> for RadarMountFields {
 }
 
 /// The layout of a sensor whose boresight and half field of view are given in degrees,
-/// converted as a scenario file's `yaw_deg` and `half_fov_deg` are.
-#[cfg(test)]
-fn layout_in_degrees(
+/// converted as a scenario file's `yaw_deg` and `half_fov_deg` are, with the tracker's noise
+/// and measurement-model keys neutral, as a scenario file's mounts have them.
+pub(super) fn layout_in_degrees(
     id: u16,
     x_m: f64,
     y_m: f64,
@@ -133,6 +134,7 @@ fn layout_in_degrees(
         range_std_m: 0.0,
         azimuth_std_rad: 0.0,
         azimuth_std_max_factor: 1.0,
+        reflection: primm_core::sensor::ReflectionModel::Outline,
     }
 }
 
@@ -156,6 +158,7 @@ impl RadarMount {
                     range_std_m: 0.0,
                     azimuth_std_rad: 0.0,
                     azimuth_std_max_factor: 1.0,
+                    reflection: primm_core::sensor::ReflectionModel::Outline,
                     ..layout
                 },
                 azimuth_bias_deg,

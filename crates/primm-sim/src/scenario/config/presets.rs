@@ -2,8 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::types::{CarConfig, ClutterConfig, ExtendedObjectConfig, PedestrianConfig};
+use super::mount::RadarMount;
+use super::types::{
+    CarConfig, ClutterConfig, EgoPlacement, ExtendedObjectConfig, OutputConfig, PedestrianConfig, RadarReport,
+};
 use super::ScenarioConfig;
+use primm_core::pose::SensorMount;
 
 /// Named configurations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -33,11 +37,20 @@ pub enum Preset {
     ExtendedClutter,
     /// The [`Preset::ClutterTurning`] scene with the extended vehicles of [`Preset::Extended`].
     ExtendedClutterTurning,
+    /// The default scene seen by object-list radars ([`RadarReport::Centre`]): every detected
+    /// object, car or pedestrian, is reported at its true centre plus one point's range,
+    /// azimuth and Doppler noise.
+    Centroid,
+    /// One static roadside radar beside a junction ([`EgoPlacement::Roadside`]) in dense
+    /// traffic, 25 to 45 objects in view, scanning every 50 to 80 ms, with a little clutter;
+    /// its frames carry no ego pose and no sensor id ([`OutputConfig`]). Cars are measured
+    /// with the averaged echo of the default, which lies on the faces towards the sensor.
+    DenseStatic,
 }
 
 impl Preset {
     /// All presets.
-    pub const ALL: [Preset; 9] = [
+    pub const ALL: [Preset; 11] = [
         Preset::Default,
         Preset::Robustness,
         Preset::Turning,
@@ -47,10 +60,13 @@ impl Preset {
         Preset::ExtendedTurning,
         Preset::ExtendedClutter,
         Preset::ExtendedClutterTurning,
+        Preset::Centroid,
+        Preset::DenseStatic,
     ];
 
     /// The preset's name (`default`, `robustness`, `turning`, `clutter`, `clutter_turning`,
-    /// `extended`, `extended_turning`, `extended_clutter`, `extended_clutter_turning`).
+    /// `extended`, `extended_turning`, `extended_clutter`, `extended_clutter_turning`, `centroid`,
+    /// `dense_static`).
     pub fn name(self) -> &'static str {
         match self {
             Preset::Default => "default",
@@ -62,6 +78,8 @@ impl Preset {
             Preset::ExtendedTurning => "extended_turning",
             Preset::ExtendedClutter => "extended_clutter",
             Preset::ExtendedClutterTurning => "extended_clutter_turning",
+            Preset::Centroid => "centroid",
+            Preset::DenseStatic => "dense_static",
         }
     }
 
@@ -82,6 +100,8 @@ impl Preset {
             Preset::ExtendedTurning => ScenarioConfig::extended(Preset::Turning),
             Preset::ExtendedClutter => ScenarioConfig::extended(Preset::Clutter),
             Preset::ExtendedClutterTurning => ScenarioConfig::extended(Preset::ClutterTurning),
+            Preset::Centroid => ScenarioConfig::centroid(),
+            Preset::DenseStatic => ScenarioConfig::dense_static(),
         }
     }
 }
@@ -143,6 +163,44 @@ impl ScenarioConfig {
         config
     }
 
+    /// The object-list radar preset: see [`Preset::Centroid`].
+    pub fn centroid() -> Self {
+        let mut config = Self::default();
+        config.splits.seed_base = 0x4345_4e54_5244;
+        config.radar.report = RadarReport::Centre;
+        config
+    }
+
+    /// The static-sensor preset: see [`Preset::DenseStatic`].
+    pub fn dense_static() -> Self {
+        let mut config = Self::default();
+        config.splits.seed_base = 0x4453_5441_5449;
+        config.sequence.duration_s = 10.0;
+        config.sequence.warmup_s = 20.0;
+        config.road.block_length_m = 90.0;
+        config.ego.placement = EgoPlacement::Roadside;
+        config.radar.sensors = vec![RadarMount {
+            layout: static_sensor_layout(),
+            azimuth_bias_deg: 0.0,
+            azimuth_noise_scale: 1.0,
+        }];
+        // One scan every 65 ± 15 ms.
+        config.radar.scan_period_s = 0.065;
+        config.radar.phase_jitter_s = 0.0;
+        config.radar.scan_jitter_s = 0.0075;
+        config.traffic.car_count = DENSE_CAR_COUNT;
+        config.traffic.pedestrian_count = DENSE_PEDESTRIAN_COUNT;
+        config.traffic.population_radius_m = 85.0;
+        config.traffic.despawn_radius_m = 100.0;
+        config.clutter = ClutterConfig {
+            mean_false_detections_per_scan: 0.3,
+            ghost_probability: 0.01,
+            ..ClutterConfig::urban()
+        };
+        config.output = OutputConfig { ego_pose: false, sensor_id: false };
+        config
+    }
+
     /// The robustness preset: see [`Preset::Robustness`].
     pub fn robustness() -> Self {
         let mut config = Self::default();
@@ -158,6 +216,17 @@ impl ScenarioConfig {
         robust_sensors(&mut config);
         config
     }
+}
+
+/// Cars kept around the sensor of [`Preset::DenseStatic`].
+const DENSE_CAR_COUNT: u32 = 80;
+/// Pedestrians kept around the sensor of [`Preset::DenseStatic`].
+const DENSE_PEDESTRIAN_COUNT: u32 = 110;
+
+/// The one sensor of [`Preset::DenseStatic`]: at the platform's reference point, looking along
+/// its x axis, ±60° and 100 m.
+fn static_sensor_layout() -> SensorMount {
+    super::mount::layout_in_degrees(0, 0.0, 0.0, 0.0, 60.0, 100.0)
 }
 
 /// The faster and more aggressive cars of [`Preset::Robustness`].
@@ -254,7 +323,7 @@ mod tests {
     }
 
     #[test]
-    fn only_the_clutter_and_robustness_presets_add_false_detections() {
+    fn only_the_clutter_robustness_and_dense_static_presets_add_false_detections() {
         for preset in Preset::ALL {
             let clutter = preset.config().clutter;
             let expected = matches!(
@@ -264,6 +333,7 @@ mod tests {
                     | Preset::Robustness
                     | Preset::ExtendedClutter
                     | Preset::ExtendedClutterTurning
+                    | Preset::DenseStatic
             );
             assert_eq!(clutter.is_enabled(), expected, "{preset}");
         }
@@ -293,5 +363,31 @@ mod tests {
             assert_eq!(config, base.config(), "{extended} against {base}");
         }
         assert!((ExtendedObjectConfig::vehicles().mean_detection_count() - 1.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_centroid_preset_is_the_default_scene_reported_at_the_centres() {
+        let mut config = Preset::Centroid.config();
+        assert_eq!(config.radar.report, RadarReport::Centre);
+        config.radar.report = RadarReport::Echo;
+        config.splits.seed_base = ScenarioConfig::default().splits.seed_base;
+        assert_eq!(config, ScenarioConfig::default());
+        for preset in Preset::ALL {
+            let centre = preset.config().radar.report == RadarReport::Centre;
+            assert_eq!(centre, preset == Preset::Centroid, "{preset}");
+        }
+    }
+
+    #[test]
+    fn only_the_dense_static_preset_stands_still_and_leaves_out_poses_and_sensor_ids() {
+        for preset in Preset::ALL {
+            let config = preset.config();
+            let dense = preset == Preset::DenseStatic;
+            assert_eq!(config.ego.placement == EgoPlacement::Roadside, dense, "{preset}");
+            assert_eq!(config.output == OutputConfig::default(), !dense, "{preset}");
+            assert_eq!(config.radar.sensors.len() == 1, dense, "{preset}");
+        }
+        let output = Preset::DenseStatic.config().output;
+        assert!(!output.ego_pose && !output.sensor_id);
     }
 }

@@ -123,6 +123,24 @@ pub struct EgoConfig {
     /// Probability that the ego vehicle turns right at a junction; absent: the cars'
     /// `car.turn_right_probability`.
     pub turn_right_probability: Option<f64>,
+    /// Where the ego vehicle is: `"driving"` (the default: it drives the road grid) or
+    /// `"roadside"` (a static sensor platform that never moves).
+    pub placement: EgoPlacement,
+}
+
+/// Where the ego vehicle (the platform that carries the radars) is.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EgoPlacement {
+    /// It drives the road grid like a car, with the speeds and turn probabilities of `ego.*`.
+    #[default]
+    Driving,
+    /// It stands still for the whole sequence beside a junction, outside the road and the
+    /// sidewalk at the outer corner of a block (a corner chosen per sequence), its x axis
+    /// pointing diagonally across the junction: a roadside sensor that sees two of the
+    /// junction's arms. It takes no part in traffic; `ego.desired_speed_mps` and the turn
+    /// probabilities are not used.
+    Roadside,
 }
 
 /// Cars: sizes, physical limits and driving behaviour.
@@ -243,6 +261,35 @@ pub struct RadarConfig {
     /// Fraction of a class's detection range beyond which point detection probability fades
     /// linearly to zero.
     pub fade_start_fraction: f64,
+    /// What a sensor reports per detected object: `"echo"` (the default: the average of its
+    /// detected reflection points, or the reflection centres of the extended-object model) or
+    /// `"centre"` (an object-list radar: the object's true centre with one point's range,
+    /// azimuth and Doppler noise).
+    pub report: RadarReport,
+}
+
+/// What a radar reports for an object it detects.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RadarReport {
+    /// The averaged echo of its visible outline (or, for vehicles measured as extended
+    /// objects, each reflection centre).
+    #[default]
+    Echo,
+    /// Its true centre, measured with the noise of one reflection point: the object list of a
+    /// radar that clusters and tracks internally. Whether the object is detected at all
+    /// (field of view, range, occlusion, fading, misses) is decided as for `"echo"`.
+    Centre,
+}
+
+/// What the generator writes of each frame besides the measurements.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OutputConfig {
+    /// Whether frames carry the ego pose (`ego_x`, `ego_y`, `ego_yaw`).
+    pub ego_pose: bool,
+    /// Whether frames and measurements carry the id of the sensor that scanned.
+    pub sensor_id: bool,
 }
 
 /// Reflection model of one object class.

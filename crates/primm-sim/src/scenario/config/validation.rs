@@ -5,7 +5,7 @@ use primm_core::readable_number::readable;
 
 use super::behaviour::{DriverConfig, MotionLimits, WalkerConfig};
 use super::mount::RadarMount;
-use super::types::MAX_DETECTIONS_PER_OBJECT;
+use super::types::{RadarReport, MAX_DETECTIONS_PER_OBJECT};
 use super::{ConfigError, Interval, ScenarioConfig};
 
 impl ScenarioConfig {
@@ -349,6 +349,12 @@ impl ScenarioConfig {
         }
         probability("extended_objects.corner_probability", e.corner_probability)?;
         non_negative("extended_objects.contour_spread_m", e.contour_spread_m)?;
+        if e.enabled && self.radar.report == RadarReport::Centre {
+            return Err(ConfigError::new(
+                "extended_objects.enabled",
+                "reports reflection centres on the outline; it needs radar.report = \"echo\"",
+            ));
+        }
         Ok(())
     }
 }

@@ -61,6 +61,8 @@ fn coin(rng: &mut ChaCha12Rng) -> bool {
 enum Brain {
     Car(CarBrain),
     Pedestrian(PedBrain),
+    /// Never moves: the roadside ego platform (`ego.placement = "roadside"`).
+    Stationary,
 }
 
 /// One simulated road user.
@@ -168,6 +170,7 @@ impl<'c> World<'c> {
         match &self.agents[i].brain {
             Brain::Car(brain) => self.car_control(i, brain),
             Brain::Pedestrian(brain) => self.ped_control(i, brain),
+            Brain::Stationary => (0.0, 0.0),
         }
     }
 
@@ -183,6 +186,7 @@ impl<'c> World<'c> {
             Brain::Pedestrian(brain) => {
                 pedestrian::update_pedestrian(&mut env, dt, brain, &mut agent.path, agent.s, agent.kin.speed);
             }
+            Brain::Stationary => {}
         }
     }
 }

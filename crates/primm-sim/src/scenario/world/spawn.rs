@@ -4,6 +4,7 @@
 use glam::DVec2;
 use rand::Rng;
 
+use super::super::config::EgoPlacement;
 use super::super::kinematics::{wrap_angle, Kinematics};
 use super::super::path::{Leg, Path};
 use super::super::road::{right_of, Axis};
@@ -19,6 +20,8 @@ const EGO_START_SPEED_FRACTION: [f64; 2] = [0.7, 1.0];
 /// The ego vehicle starts at least this far from the junction areas at both ends of its
 /// block, metres.
 const EGO_START_CLEARANCE_M: f64 = 5.0;
+/// The roadside ego platform stands this far beyond the outer edge of the sidewalk, metres.
+const ROADSIDE_SETBACK_M: f64 = 1.0;
 /// Largest number of spawn attempts per class and population check.
 const SPAWN_TRIES: u32 = 60;
 /// Cars never appear within this distance of a junction area, metres…
@@ -38,8 +41,13 @@ const GROUP_MAX_BEHIND_M: f64 = 0.6;
 const GROUP_MAX_AHEAD_M: f64 = 0.3;
 
 impl World<'_> {
-    /// Places the ego vehicle on a random lane of the road grid, with its route planned.
+    /// Places the ego vehicle: on a random lane of the road grid with its route planned, or,
+    /// with `ego.placement = "roadside"`, beside a junction ([`World::spawn_roadside_ego`]).
     pub(super) fn spawn_ego(&mut self) {
+        if self.cfg.ego.placement == EgoPlacement::Roadside {
+            self.spawn_roadside_ego();
+            return;
+        }
         let cfg = self.cfg;
         let b = self.grid.block_m;
         let dir = [DVec2::X, DVec2::Y, DVec2::NEG_X, DVec2::NEG_Y][self.rng.random_range(0..4)];
@@ -83,6 +91,31 @@ impl World<'_> {
         }
         agent.kin.speed = feasible_start_speed(cfg, &agent.path, agent.kin.speed);
         self.agents.push(agent);
+    }
+
+    /// The roadside ego platform: at rest for good, `ROADSIDE_SETBACK_M` beyond the outer edge
+    /// of the sidewalk at a random corner of junction (0, 0), facing the junction centre, so
+    /// that its reference point (the rear axle) lies on that corner's diagonal.
+    fn spawn_roadside_ego(&mut self) {
+        let cfg = self.cfg;
+        let corner =
+            [DVec2::new(1.0, 1.0), DVec2::new(-1.0, 1.0), DVec2::new(-1.0, -1.0), DVec2::new(1.0, -1.0)]
+                [self.rng.random_range(0..4)];
+        let reference =
+            corner * (self.grid.sidewalk_m + self.grid.sidewalk_half_width_m + ROADSIDE_SETBACK_M);
+        let heading = -corner.normalize();
+        let pos = reference + heading * cfg.ego.rear_axle_to_centre_m;
+        self.agents.push(Agent {
+            id: EGO_ID,
+            class: ObjectClass::Car,
+            is_ego: true,
+            length: cfg.ego.length_m,
+            width: cfg.ego.width_m,
+            kin: Kinematics::new(pos, heading.to_angle(), 0.0),
+            path: Path::default(),
+            s: 0.0,
+            brain: Brain::Stationary,
+        });
     }
 
     /// Whether any sensor could see `point` (fields of view widened by the spawn margins).

@@ -1,0 +1,274 @@
+//! A radar as the tracker knows it: one type that every stage asks about a sensor.
+//!
+//! A [`Sensor`] holds the sensor's configured mount (`[[frame.sensors]]`, its file form: pose,
+//! field of view, polar noise, measurement model and existence factors) and what the tracker has
+//! learned of it from its data ([`SensorEstimates`]). Radars without a configured mount (no
+//! sensor id, or one not listed) share one more sensor, the *unmounted* one: it is seen from
+//! the vehicle's reference point, its field of view is built from its detections of each frame
+//! (`FieldOfView::spanning`), and it has no noise of its own; its measurement model is
+//! `frame.unmounted_reflection`.
+//!
+//! The measurement model of a sensor ([`ReflectionModel`]) says where on an extended object its
+//! detections lie: on the outline (the extent's expected reflection, scaled by the class's
+//! `extent.offset_scale`; the default), at the centre (an object-list radar, or clustered
+//! detections), or where its data says (`auto`: the running estimate of
+//! [`estimates::ReflectionEstimate`]).
+
+pub mod estimates;
+
+use crate::coordinates::CoordinatesConfig;
+use crate::existence::{ExistenceConfig, FieldOfView};
+use crate::extent::ExtentConfig;
+use crate::limits::MAX_SENSORS;
+use crate::measurement::ObjectClass;
+use crate::pose::{EgoPose, SensorMount};
+use crate::sensor_noise::SensorNoise;
+use estimates::{ClutterEstimate, DetectionEstimate, ReflectionEstimate};
+use glam::DVec2;
+
+/// Where a sensor's detections of an extended object lie (`[[frame.sensors]] reflection`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum ReflectionModel {
+    /// On the outline: the extent's expected reflection, scaled by the class's
+    /// `extent.offset_scale` (a detection-level radar reporting its strongest reflection, or
+    /// averaging the reflections of the faces it sees). The default.
+    #[default]
+    Outline,
+    /// At the object's centre, with the class's measurement noise (an object-list radar, or a
+    /// stack that clusters detections before tracking).
+    Centre,
+    /// Where the sensor's data says: the scale starts at the class's `extent.offset_scale` and
+    /// follows the running estimate ([`estimates::ReflectionEstimate`]).
+    Auto,
+}
+
+impl ReflectionModel {
+    /// The short name used in configuration and output.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReflectionModel::Outline => "outline",
+            ReflectionModel::Centre => "centre",
+            ReflectionModel::Auto => "auto",
+        }
+    }
+}
+
+/// What the tracker has learned of a sensor for one class.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClassEstimates {
+    /// Where its detections lie between the centre (0) and the outline (1).
+    pub reflection: ReflectionEstimate,
+    /// Its detection probability.
+    pub detection: DetectionEstimate,
+    /// Its clutter density.
+    pub clutter: ClutterEstimate,
+}
+
+/// What the tracker has learned of a sensor, per class ([`ObjectClass::index`]).
+pub type SensorEstimates = [ClassEstimates; ObjectClass::COUNT];
+
+/// A sensor: its configured mount (none for the unmounted sensor) and its estimates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sensor {
+    /// The configured mount; `None` for the radars without one.
+    pub mount: Option<SensorMount>,
+    /// The measurement model of extended objects.
+    pub reflection: ReflectionModel,
+    /// What its data said so far.
+    pub estimates: SensorEstimates,
+}
+
+impl Sensor {
+    /// A sensor of `mount` (or the unmounted one with `reflection`) at its priors: each class's
+    /// configured offset scale, detection probability and clutter density (with the mount's
+    /// factors).
+    fn new(
+        mount: Option<SensorMount>,
+        reflection: ReflectionModel,
+        classes: &[(&ExtentConfig, &ExistenceConfig); ObjectClass::COUNT],
+    ) -> Self {
+        let (detection_factor, clutter_factor) = mount
+            .map_or((1.0, 1.0), |mount| (mount.detection_probability_factor, mount.clutter_density_factor));
+        let estimates = core::array::from_fn(|index| {
+            let (extent, existence) = classes[index];
+            ClassEstimates {
+                reflection: ReflectionEstimate::new(extent.offset_scale),
+                detection: DetectionEstimate::new(
+                    (existence.detection_probability * detection_factor).min(MAX_DETECTION_PROBABILITY),
+                ),
+                clutter: ClutterEstimate::new(existence.clutter_density_per_m2 * clutter_factor),
+            }
+        });
+        Sensor { mount, reflection, estimates }
+    }
+
+    /// The sensor id of its mount (`None`: the unmounted sensor).
+    pub fn id(&self) -> Option<u16> {
+        self.mount.map(|mount| mount.id)
+    }
+
+    /// Where the sensor is in the tracking frame: its mount, mapped into the world with the
+    /// step's `pose` in a world-frame step; the vehicle's reference point for the unmounted
+    /// sensor.
+    pub fn position_m(&self, pose: Option<EgoPose>) -> DVec2 {
+        let in_vehicle = self.mount.map_or(DVec2::ZERO, |mount| mount.position());
+        match pose {
+            Some(pose) => pose.point_to_world(in_vehicle),
+            None => in_vehicle,
+        }
+    }
+
+    /// Its configured field of view in the tracking frame (`None` for the unmounted sensor,
+    /// whose view its detections give).
+    pub fn field_of_view(&self, pose: Option<EgoPose>) -> Option<FieldOfView> {
+        self.mount.map(|mount| FieldOfView::of(&mount, pose))
+    }
+
+    /// Its polar noise in the tracking frame. The noise enters world-frame steps only (in the
+    /// vehicle frame a turning ego sweeps far objects across the line of sight at ω·r, which no
+    /// motion model predicts; trusting far detections less there makes their tracks lag:
+    /// ARCHITECTURE.md, "The radar's own noise").
+    pub fn noise(&self, pose: Option<EgoPose>) -> SensorNoise {
+        match (self.mount, pose) {
+            (Some(mount), Some(pose)) => SensorNoise::of(&mount, Some(pose)),
+            _ => SensorNoise::NONE,
+        }
+    }
+
+    /// The scale of the outline offset for its detections of `class`: the class's
+    /// `extent.offset_scale` (outline), 0 (centre), or the running estimate (auto).
+    pub fn reflection_scale(&self, class: ObjectClass, extent: &ExtentConfig) -> f64 {
+        match self.reflection {
+            ReflectionModel::Outline => extent.offset_scale,
+            ReflectionModel::Centre => 0.0,
+            ReflectionModel::Auto => self.estimates[class.index()].reflection.value,
+        }
+    }
+
+    /// The detection probability and clutter density of `class` the existence model uses: the
+    /// configured ones (with the mount's factors).
+    pub fn detection_and_clutter(&self, class: ObjectClass) -> (f64, f64) {
+        let estimates = &self.estimates[class.index()];
+        (estimates.detection.prior, estimates.clutter.prior_per_m2)
+    }
+}
+
+/// The detection probabilities are kept below 1, so that a miss never makes existence 0.
+pub const MAX_DETECTION_PROBABILITY: f64 = 0.999;
+
+/// The index of the unmounted sensor in a [`SensorSet`].
+pub const UNMOUNTED: usize = MAX_SENSORS;
+
+/// Every sensor of a configuration, the unmounted one last (at [`UNMOUNTED`]); fixed capacity,
+/// `Copy`, so that the replay snapshots hold it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorSet {
+    sensors: [Sensor; MAX_SENSORS + 1],
+    mounted: usize,
+}
+
+impl SensorSet {
+    /// The sensors of `frame` at their priors for `classes`' extents and existence settings.
+    pub fn new(
+        frame: &CoordinatesConfig,
+        classes: &[(&ExtentConfig, &ExistenceConfig); ObjectClass::COUNT],
+    ) -> Self {
+        let unmounted = Sensor::new(None, frame.unmounted_reflection, classes);
+        let mut sensors = [unmounted; MAX_SENSORS + 1];
+        for (slot, mount) in frame.sensors.iter().enumerate() {
+            sensors[slot] = Sensor::new(Some(*mount), mount.reflection, classes);
+        }
+        SensorSet { sensors, mounted: frame.sensors.len() }
+    }
+
+    /// The slot of the sensor that measured with `sensor_id`: its mount's, or [`UNMOUNTED`].
+    pub fn slot(&self, sensor_id: Option<u16>) -> usize {
+        sensor_id
+            .and_then(|id| self.sensors[..self.mounted].iter().position(|sensor| sensor.id() == Some(id)))
+            .unwrap_or(UNMOUNTED)
+    }
+
+    /// The sensor in `slot`.
+    pub fn get(&self, slot: usize) -> &Sensor {
+        &self.sensors[slot.min(UNMOUNTED)]
+    }
+
+    /// The sensor in `slot`, to update its estimates.
+    pub fn get_mut(&mut self, slot: usize) -> &mut Sensor {
+        &mut self.sensors[slot.min(UNMOUNTED)]
+    }
+
+    /// The sensor that measured with `sensor_id`.
+    pub fn of(&self, sensor_id: Option<u16>) -> &Sensor {
+        self.get(self.slot(sensor_id))
+    }
+
+    /// The mounted sensors, in configuration order, then the unmounted one.
+    pub fn iter(&self) -> impl Iterator<Item = &Sensor> {
+        self.sensors[..self.mounted].iter().chain(core::iter::once(&self.sensors[UNMOUNTED]))
+    }
+}
+
+/// The estimates of every sensor that took a sample, one line per sensor and class, as the
+/// service's summary and `primm track` print them ([`SensorSet::report`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SensorReport<'a> {
+    sensors: &'a SensorSet,
+    config: &'a crate::config::Config,
+}
+
+impl SensorSet {
+    /// The estimates of every sensor and class that took a sample, for display.
+    pub fn report<'a>(&'a self, config: &'a crate::config::Config) -> SensorReport<'a> {
+        SensorReport { sensors: self, config }
+    }
+}
+
+impl core::fmt::Display for SensorReport<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let mut first = true;
+        for sensor in self.sensors.iter() {
+            for class in ObjectClass::ALL {
+                let estimates = &sensor.estimates[class.index()];
+                if estimates.reflection.samples == 0
+                    && estimates.detection.samples == 0
+                    && estimates.clutter.scans == 0
+                {
+                    continue;
+                }
+                if !first {
+                    f.write_str("\n")?;
+                }
+                first = false;
+                match sensor.id() {
+                    Some(id) => write!(f, "sensor {id}")?,
+                    None => f.write_str("sensor without mount")?,
+                }
+                let extent = &self.config.classes.get(class).extent;
+                write!(f, " {}: ", class.name())?;
+                if extent.enabled {
+                    write!(
+                        f,
+                        "reflection {} (used {:.3}, estimate {:.3}, {} samples), ",
+                        sensor.reflection.name(),
+                        sensor.reflection_scale(class, extent),
+                        estimates.reflection.value,
+                        estimates.reflection.samples,
+                    )?;
+                }
+                write!(
+                    f,
+                    "detection probability {:.3} ({} opportunities), clutter {:.2e} /m² ({} scans), held at bounds {}",
+                    estimates.detection.value(),
+                    estimates.detection.samples,
+                    estimates.clutter.value_per_m2(),
+                    estimates.clutter.scans,
+                    estimates.reflection.bounded + estimates.detection.bounded + estimates.clutter.bounded,
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
