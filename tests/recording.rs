@@ -356,3 +356,65 @@ fn an_address_in_use_stops_serve_with_the_address_named() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success() && stderr.contains(&address), "{stderr}");
 }
+
+/// Largest file `primm record` may write in the test below, bytes: a few compressed chunks.
+const FILE_SIZE_LIMIT: u64 = 256 * 1024;
+
+#[test]
+fn a_recording_that_runs_out_of_room_stops_with_a_message_and_stays_readable() {
+    let dir = tempdir("full");
+    let output = dir.join("full.mcap");
+    let log = dir.join("recorder.log");
+    let prefix = unique_prefix("record-full");
+    let names = ServiceNames::new(&prefix);
+    let serve = spawn_serve(&prefix, &["--method", "imm"]);
+    let mut command = Command::new(env!("CARGO_BIN_EXE_primm"));
+    command
+        .args(["record", "--service-prefix", &prefix, "--until-end", "--output"])
+        .arg(&output)
+        .env("RUST_LOG", "warn")
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(&log).unwrap());
+    // The file may not grow past the limit: a write past it fails (EFBIG) as one on a full disk
+    // fails (ENOSPC), and SIGXFSZ, ignored here, stays ignored across exec.
+    unsafe {
+        use std::os::unix::process::CommandExt;
+        command.pre_exec(|| {
+            let limit = libc::rlimit { rlim_cur: FILE_SIZE_LIMIT, rlim_max: FILE_SIZE_LIMIT };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            Ok(())
+        });
+    }
+    let recorder = ChildGuard(command.spawn().unwrap());
+    wait_for_subscribers(&names, 1);
+    // The tracker answers every frame although the recorder stops on the way.
+    primm(&[
+        "publish",
+        "--service-prefix",
+        &prefix,
+        "--scenario",
+        "--duration-s",
+        "20",
+        "--as-fast-as-possible",
+        "--max-in-flight",
+        "8",
+    ]);
+    let (status, _) = recorder.wait(Duration::from_secs(60));
+    let message = std::fs::read_to_string(&log).unwrap();
+    assert!(!status.success(), "the recorder went on past the limit: {message}");
+    assert!(
+        message.contains("full.mcap") && message.contains("cannot write") && message.contains("mcap recover"),
+        "{message}"
+    );
+    let bytes = std::fs::read(&output).unwrap();
+    assert!(bytes.len() as u64 <= FILE_SIZE_LIMIT);
+    let readable = mcap::MessageStream::new(&bytes).unwrap().take_while(Result::is_ok).count();
+    assert!(readable > 100, "{readable} messages readable");
+    serve.signal(libc::SIGINT);
+    let (status, _) = serve.wait(Duration::from_secs(10));
+    assert!(status.success());
+    let _ = std::fs::remove_dir_all(&dir);
+}

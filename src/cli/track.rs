@@ -157,6 +157,17 @@ fn track_predictor(
     Ok(Box::new(split))
 }
 
+/// `--mcap`'s recording of `frames` frames, drawing the tracker's configured radars.
+fn offline_recording<P: DisplacementPredictor>(
+    path: Option<&Path>,
+    tracker: &Tracker<P>,
+    frames: usize,
+) -> Result<Option<OfflineRecording>, TrackError> {
+    let Some(path) = path else { return Ok(None) };
+    let radars = tracker.config().frame.sensors.iter().map(RadarPose::from).collect();
+    Ok(Some(OfflineRecording::create(path, radars, frames)?))
+}
+
 /// Runs `primm track`.
 pub fn run(args: &Args) -> Result<(), TrackError> {
     let settings = args.tracker.load_settings()?;
@@ -176,13 +187,7 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         None => None,
     };
     let frames = sequence.to_frames()?;
-    let mut recording = match &args.mcap {
-        Some(path) => {
-            let radars = tracker.config().frame.sensors.iter().map(RadarPose::from).collect();
-            Some(OfflineRecording::create(path, radars, frames.len())?)
-        }
-        None => None,
-    };
+    let mut recording = offline_recording(args.mcap.as_deref(), &tracker, frames.len())?;
     let mut step_ns: Vec<u64> = Vec::with_capacity(frames.len());
     tracker.reset();
     // Frames in file order, which is arrival order: a late frame (within

@@ -66,7 +66,7 @@ impl OfflineRecording {
             step: Some(tracker.last_step()),
             status: FrameStatus::Tracked,
             tracks_timestamp_s: tracker.newest_timestamp_s().unwrap_or(recorded.timestamp_s),
-            late: tracker.last_step().late,
+            late: tracker.last_step().late(),
         };
         self.write(recorded, &answer)
     }
@@ -134,7 +134,7 @@ impl OfflineRecording {
         for output in answer.outputs {
             writer.push(output);
         }
-        let saturating = |count: usize| u16::try_from(count).unwrap_or(u16::MAX);
+        let saturating = |count: u64| u16::try_from(count).unwrap_or(u16::MAX);
         let mut flags = 0;
         if first {
             flags |= TRACK_FLAG_TRACKER_RESET;
@@ -156,8 +156,8 @@ impl OfflineRecording {
             publish_time_ns: 0,
             status: answer.status,
             flags,
-            measurements_accepted: answer.step.map_or(0, |step| saturating(step.measurements_accepted)),
-            measurements_rejected: answer.step.map_or(0, |step| saturating(step.measurements_rejected)),
+            measurements_accepted: answer.step.map_or(0, |step| saturating(step.counts.measurements_accepted)),
+            measurements_rejected: answer.step.map_or(0, |step| saturating(step.measurements_rejected())),
         });
         // SAFETY: as for the measurements: zeroed plain data, header and tracks written.
         let tracks = unsafe { self.tracks.assume_init_ref() };

@@ -1,4 +1,4 @@
-//! A small client of the Foxglove WebSocket protocol (`foxglove.websocket.v1`): it connects,
+//! A small client of the Foxglove WebSocket protocol (`foxglove.sdk.v1`): it connects,
 //! takes the channel advertisement, subscribes to every channel and reads the messages. It is
 //! what the tests and `primm bench-service --foxglove-client` connect to the live view with; the
 //! message types are the Foxglove SDK's own.
@@ -13,8 +13,9 @@ use tungstenite::client::IntoClientRequest;
 use tungstenite::http::HeaderValue;
 use tungstenite::WebSocket;
 
-/// The subprotocol of the Foxglove WebSocket protocol.
-pub const SUBPROTOCOL: &str = "foxglove.websocket.v1";
+/// The subprotocol the Foxglove SDK's server speaks: the Foxglove WebSocket protocol v1, named
+/// `foxglove.sdk.v1` (the SDK refuses the older name `foxglove.websocket.v1`).
+pub const SUBPROTOCOL: &str = "foxglove.sdk.v1";
 
 /// How long one read waits before [`LiveClient::next_message`] returns `None`.
 const READ_TIMEOUT: Duration = Duration::from_millis(200);
