@@ -156,7 +156,9 @@ impl OfflineRecording {
             publish_time_ns: 0,
             status: answer.status,
             flags,
-            measurements_accepted: answer.step.map_or(0, |step| saturating(step.counts.measurements_accepted)),
+            measurements_accepted: answer
+                .step
+                .map_or(0, |step| saturating(step.counts.measurements_accepted)),
             measurements_rejected: answer.step.map_or(0, |step| saturating(step.measurements_rejected())),
         });
         // SAFETY: as for the measurements: zeroed plain data, header and tracks written.

@@ -28,13 +28,22 @@ pub enum McapFileError {
     },
     /// Writing failed (the disk may be full); the chunks written before stay readable with
     /// `mcap recover`.
-    #[error("cannot write {}: {source} (the part written so far can be read back with `mcap recover`)", path.display())]
+    #[error("cannot write {}: {} (the part written so far can be read back with `mcap recover`)", path.display(), os_reason(source))]
     Write {
         /// The file.
         path: PathBuf,
         /// The MCAP writer's error.
         source: mcap::McapError,
     },
+}
+
+/// What went wrong in a write, with the OS's words where the operating system refused it ("No
+/// space left on device"), which the MCAP error alone leaves out.
+fn os_reason(error: &mcap::McapError) -> String {
+    match error {
+        mcap::McapError::Io(io) => io.to_string(),
+        other => other.to_string(),
+    }
 }
 
 /// An MCAP file being written.
