@@ -118,6 +118,22 @@ fn count_gap(last: &mut Option<u64>, next: u64, missed: &mut u64) {
     *last = Some(next);
 }
 
+/// Encodes every measurement frame received so far.
+fn drain_measurements(
+    ports: &StreamPorts,
+    encoder: &mut FrameEncoder,
+    sink: &mut dyn MessageSink,
+    summary: &mut RecordSummary,
+    last_measurement: &mut Option<u64>,
+) -> Result<(), RecordError> {
+    while let Some(sample) = ports.measurements.receive().map_err(RecordError::Receive)? {
+        summary.measurement_frames += 1;
+        count_gap(last_measurement, sample.sequence, &mut summary.measurement_frames_missed);
+        encoder.on_measurements(&sample, sink)?;
+    }
+    Ok(())
+}
+
 /// Records until `stop()` says so or a limit is reached; returns what was received.
 pub fn record(
     ports: &StreamPorts,
@@ -134,13 +150,14 @@ pub fn record(
             Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
             Err(error) => return Err(RecordError::Wait(error)),
         }
-        while let Some(sample) = ports.measurements.receive().map_err(RecordError::Receive)? {
-            summary.measurement_frames += 1;
-            count_gap(&mut last_measurement, sample.sequence, &mut summary.measurement_frames_missed);
-            encoder.on_measurements(&sample, sink)?;
-        }
+        drain_measurements(ports, encoder, sink, &mut summary, &mut last_measurement)?;
         let mut done = false;
         while let Some(sample) = ports.tracks.receive().map_err(RecordError::Receive)? {
+            // The answer to a frame that came after the last look: take that frame first, so
+            // that the detections are drawn with what the tracker made of them.
+            if last_measurement.is_none_or(|last| sample.input_sequence > last) {
+                drain_measurements(ports, encoder, sink, &mut summary, &mut last_measurement)?;
+            }
             summary.track_frames += 1;
             count_gap(&mut last_track, sample.input_sequence, &mut summary.track_frames_missed);
             encoder.on_tracks(&sample, sink)?;
