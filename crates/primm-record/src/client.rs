@@ -165,6 +165,16 @@ impl LiveClient {
         }
     }
 
+    /// Closes the connection with the WebSocket closing handshake (bounded by the read
+    /// time-out), so that the server sees a client leave rather than a reset connection.
+    pub fn close(mut self) {
+        if self.socket.close(None).is_ok() {
+            // Read until the server's close frame (or an error, or the time-out) ends the
+            // handshake.
+            while self.socket.read().is_ok() {}
+        }
+    }
+
     /// The next message of a subscribed channel, or `None` when none came within a read
     /// time-out (200 ms).
     pub fn next_message(&mut self) -> Result<Option<ReceivedMessage>, LiveClientError> {

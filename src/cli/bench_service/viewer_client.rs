@@ -44,6 +44,7 @@ impl ViewerClient {
                         received += 1;
                     }
                 }
+                client.close();
                 Ok(received)
             })
         };
