@@ -137,7 +137,10 @@ pub fn read_payload<T: WirePayload>(bytes: &[u8], frame: &mut T) -> Result<(), R
         return Err(RawPayloadError::TooShort { type_name, length, header });
     }
     let rest = length - header;
-    let (present, whole) = if entry == 0 { (0, rest == 0) } else { (rest / entry, rest % entry == 0) };
+    let (present, whole) = match rest.checked_div(entry) {
+        Some(present) => (present, rest.is_multiple_of(entry)),
+        None => (0, rest == 0),
+    };
     if !whole || present > capacity {
         return Err(RawPayloadError::BadLength { type_name, length, header, entry, capacity });
     }

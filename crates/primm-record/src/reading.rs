@@ -81,10 +81,9 @@ pub fn read_topic(path: &Path, topic: Topic) -> Result<Vec<RecordedMessage>, Rea
     let damaged =
         |messages: usize, source| ReadRecordingError::Damaged { path: path.to_owned(), messages, source };
     let mut messages = Vec::new();
-    let mut read = 0;
-    for message in mcap::MessageStream::new(&bytes).map_err(|source| damaged(0, source))? {
+    let stream = mcap::MessageStream::new(&bytes).map_err(|source| damaged(0, source))?;
+    for (read, message) in stream.enumerate() {
         let message = message.map_err(|source| damaged(read, source))?;
-        read += 1;
         if message.channel.topic != topic.name() {
             continue;
         }
