@@ -306,3 +306,20 @@ def test_a_websocket_client_gets_the_track_scenes_of_a_running_demo():
         assert largest >= 3
         return
     pytest.fail("no free loopback port stayed free")
+
+
+def test_the_layout_names_topics_and_fields_a_recording_has(demo_recording):
+    path, _ = demo_recording
+    layout = json.loads((ROOT / "tools" / "foxglove" / "primm.json").read_text())
+    panels = layout["configById"]
+    assert set(panels) == {"3D!primm", "Plot!latency", "RawMessages!latency"}
+    assert set(panels["3D!primm"]["topics"]) <= set(EVERY_TOPIC)
+    assert panels["RawMessages!latency"]["topicPath"] in EVERY_TOPIC
+    topics = read_topics(path)
+    last = {topic: json.loads(messages[-1][2].data) for topic, messages in topics.items() if topic in JSON_TOPICS}
+    for plotted in panels["Plot!latency"]["paths"]:
+        topic, _, fields = plotted["value"].partition(".")
+        value = last[topic]
+        for field in fields.split("."):
+            value = value[field]
+        assert isinstance(value, (int, float)), plotted["value"]
