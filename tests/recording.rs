@@ -421,3 +421,39 @@ fn a_recording_that_runs_out_of_room_stops_with_a_message_and_stays_readable() {
     assert!(status.success(), "primm serve: {status}\n{output}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_recording_stopped_by_its_duration_or_by_ctrl_c_is_a_finished_file() {
+    let dir = tempdir("stop");
+    let timed = dir.join("timed.mcap");
+    let prefix = unique_prefix("record-stop");
+    let started = Instant::now();
+    primm(&["record", "--service-prefix", &prefix, "--duration-s", "1", "--output", timed.to_str().unwrap()]);
+    assert!(started.elapsed() >= Duration::from_secs(1));
+    let interrupted = dir.join("interrupted.mcap");
+    let mut recorder = Command::new(env!("CARGO_BIN_EXE_primm"))
+        .args(["record", "--service-prefix", &prefix, "--output"])
+        .arg(&interrupted)
+        .env("RUST_LOG", "warn")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // It says where it records once it has subscribed (and its signal handlers are in place).
+    // (Kept open until it exits, so that nothing it prints meets a closed pipe.)
+    let mut stderr = std::io::BufReader::new(recorder.stderr.take().unwrap());
+    let mut first_line = String::new();
+    std::io::BufRead::read_line(&mut stderr, &mut first_line).unwrap();
+    assert!(first_line.starts_with("recording"), "{first_line}");
+    let recorder = ChildGuard(recorder);
+    recorder.signal(libc::SIGINT);
+    let (status, stdout) = recorder.wait(Duration::from_secs(10));
+    assert!(status.success() && stdout.contains("0 track frames"), "{status}: {stdout}");
+    drop(stderr);
+    for path in [&timed, &interrupted] {
+        let bytes = std::fs::read(path).unwrap();
+        let summary = mcap::Summary::read(&bytes).unwrap().expect("a summary");
+        assert_eq!(summary.stats.expect("statistics").message_count, 0);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
