@@ -314,7 +314,9 @@ fn the_live_view_streams_the_tracks_to_a_client_on_loopback() {
     let frames = crate::common::scene_frames(&crate::common::lanes(4), 400, 0.05, 0.2, 3);
     let deadline = Instant::now() + Duration::from_secs(30);
     let mut largest_scene = 0;
+    let mut next = 0;
     for (k, frame) in frames.iter().enumerate() {
+        next = k + 1;
         client.send(frame, k as u64, 0);
         let _ = client.next_answer(Duration::from_secs(5), |_| ());
         while let Some(message) = viewer.next_message().unwrap() {
@@ -332,6 +334,14 @@ fn the_live_view_streams_the_tracks_to_a_client_on_loopback() {
         }
     }
     assert_eq!(largest_scene, 4, "the client saw no scene of the four tracks");
+    // A viewer that vanishes (its connection dropped unread, no closing handshake) changes
+    // nothing for the tracker: it answers every further frame.
+    drop(viewer);
+    for (k, frame) in frames.iter().enumerate().skip(next).take(40) {
+        client.send(frame, k as u64, 0);
+        let answered = client.next_answer(Duration::from_secs(5), |answer| answer.input_sequence);
+        assert_eq!(answered, Some(k as u64), "frame {k} after the viewer left");
+    }
     serve.signal(libc::SIGINT);
     let (status, _) = serve.wait(Duration::from_secs(10));
     let output: Vec<String> = lines.try_iter().collect();
