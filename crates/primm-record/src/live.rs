@@ -165,6 +165,24 @@ impl Drop for LiveView {
     }
 }
 
+/// The nice value of the live view's thread: on a host without a core to spare, the scheduler
+/// gives the tracking thread (nice 0 or real-time) the CPU first, and the view loses its own
+/// frames instead (safe overflow).
+const VIEW_NICE: libc::c_int = 10;
+
+/// Lowers the calling thread's scheduling priority to [`VIEW_NICE`] (Linux sets nice values per
+/// thread); a refusal is logged and the view runs at the priority it has.
+fn yield_to_tracking() {
+    // SAFETY: plain system calls on the calling thread, no pointers.
+    let result = unsafe {
+        let thread = libc::gettid() as libc::id_t;
+        libc::setpriority(libc::PRIO_PROCESS, thread, VIEW_NICE)
+    };
+    if result != 0 {
+        tracing::warn!(error = %std::io::Error::last_os_error(), "the live view keeps its priority");
+    }
+}
+
 /// The body of the live view's thread.
 fn view_thread(
     mut server: LiveServer,
@@ -173,6 +191,7 @@ fn view_thread(
     stop: &AtomicBool,
     ready: std::sync::mpsc::SyncSender<Result<(), String>>,
 ) {
+    yield_to_tracking();
     let ports = match StreamPorts::open(names, None, "primm-foxglove-view") {
         Ok(ports) => ports,
         Err(error) => {
