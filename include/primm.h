@@ -34,7 +34,7 @@
 
 // Most measurements one frame may carry; a larger frame is rejected with
 // `PRIMM_STATUS_INVALID_FRAME`.
-#define PRIMM_MAX_MEASUREMENTS_PER_FRAME 256
+#define PRIMM_MAX_MEASUREMENTS_PER_FRAME 1024
 
 // Number of IMM modes; mode probabilities are ordered PR, CV, CA, CT.
 #define PRIMM_MODE_COUNT 4
@@ -50,7 +50,7 @@
 
 // The ABI version of this header (see the crate documentation of primm-ffi for the policy):
 // compare it with `primm_abi_version()`, the ABI version of the linked library.
-#define PRIMM_ABI_VERSION 2
+#define PRIMM_ABI_VERSION 3
 
 // Result of a C API call.
 typedef enum PrimmStatus {
@@ -110,6 +110,14 @@ typedef struct PrimmSensorEstimates {
   uint64_t clutter_scans;
   // Times any of the three would have left its bounds and was held at them.
   uint64_t bounded;
+  // The sensor's share of confirmed-track scans with several detections on the track's
+  // object (the same for every class).
+  double points_share;
+  // Track scans the share has taken.
+  uint64_t points_samples;
+  // 1 when the sensor's detections are grouped as a point cloud now (`detections` is
+  // "points", or "auto" and its data showed one), else 0.
+  uint8_t groups_points;
 } PrimmSensorEstimates;
 
 // A method code, one of the `PRIMM_METHOD_*` constants: which IMM modes the tracker runs.
@@ -309,6 +317,12 @@ typedef struct PrimmStats {
   // Tracks started in the world frame by a measurement whose sensor has no configured
   // mount: their line of sight starts at the vehicle's reference point.
   uint64_t initiations_from_unknown_sensor;
+  // Unassigned measurements that started no track as the mirror image of a confirmed
+  // track in a wall along its heading (multipath ghosts).
+  uint64_t initiations_refused_as_ghost;
+  // Tentative tracks ended because their measurement was the mirror image of a confirmed
+  // track (multipath ghosts).
+  uint64_t tentative_tracks_ended_as_ghost;
   // Measurements tracked (accepted by validation).
   uint64_t measurements_accepted;
   // Measurements rejected for an unknown class code.
@@ -383,6 +397,8 @@ typedef struct PrimmStats {
   // extended object (`classes.<class>.extent.absorb_extra_detections`): they started
   // no track.
   uint64_t detections_absorbed;
+  // Detections of point-cloud radars that joined another detection's group.
+  uint64_t detections_grouped;
   // Existing tracks updated by an assigned measurement.
   uint64_t tracks_updated;
   // Tracks without a measurement while a sensor of the frame had them in view (their

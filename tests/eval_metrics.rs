@@ -48,6 +48,7 @@ fn load_sequences() -> BTreeMap<String, Vec<AssociationRecord>> {
             measured: DVec2::ZERO,
             true_position: None,
             true_velocity: None,
+            origin: None,
             track_id,
             prior: None,
             velocity: None,

@@ -57,6 +57,7 @@ fn scene(
                 measured: truth,
                 true_position: Some(truth),
                 true_velocity: None,
+                origin: None,
                 track_id: Some(track),
                 prior: (k > 0).then_some(estimate),
                 velocity: None,

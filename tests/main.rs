@@ -41,6 +41,8 @@ mod layered_config;
 mod learned_covariance;
 mod logging;
 mod motion_models;
+mod multipath_ghosts;
+mod point_clouds;
 mod predictor_allocation;
 mod predictor_classes;
 mod predictor_native;

@@ -272,8 +272,10 @@ fn the_object_list_sensor_file_is_the_shipped_configuration_with_every_radar_at_
     let object_list = primm_config::from_file(&path).unwrap();
     let mut expected = Config::default();
     expected.frame.unmounted_reflection = ReflectionModel::Centre;
+    expected.frame.unmounted_detections = primm_core::grouping::DetectionModel::Objects;
     for mount in expected.frame.sensors.iter_mut() {
         mount.reflection = ReflectionModel::Centre;
+        mount.detections = primm_core::grouping::DetectionModel::Objects;
     }
     assert_eq!(object_list, expected);
 }

@@ -93,6 +93,7 @@ fn scene(rng: &mut ChaCha8Rng, config: &Config) -> Scene {
         azimuth_std_rad: 0.03,
         azimuth_std_max_factor: 2.0,
         reflection: primm_core::sensor::ReflectionModel::Outline,
+        detections: Default::default(),
         ..CoordinatesConfig::default().sensors[0]
     };
     let noise = SensorNoise::of(&mount, None);

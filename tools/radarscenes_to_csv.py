@@ -16,9 +16,17 @@ columns; ``t`` is seconds since the sequence's first scan; ``gt_id`` numbers the
 sequence in order of first appearance; true_x and true_y stay empty (RadarScenes has no
 object boxes); the ego pose comes from the odometry entry linked to the scan.
 
+With ``--detections`` nothing is averaged: every detection with one of the kept labels becomes
+a row of its own (x_cc, y_cc, vr_compensated, rcs, in the file's order within the scan), its
+class from its own label and its ``gt_id`` from its track id (``-1`` for a labelled detection
+without one). This is what a radar gives a tracker in a car, several detections per object and
+scan; the averaged mode needs the annotation's track ids, which no tracker has. Detections of
+other labels (the static world among them) are left out in both modes.
+
 Usage:
     radarscenes_to_csv.py RADARSCENES_DIR --output OUT
     radarscenes_to_csv.py RADARSCENES_DIR/data/sequence_42 --output OUT
+    radarscenes_to_csv.py RADARSCENES_DIR --output OUT --detections
 """
 
 from __future__ import annotations
@@ -48,7 +56,7 @@ LABEL_TO_CLASS = {
 }
 
 # Largest number of measurements primm accepts in one frame.
-MAX_MEASUREMENTS_PER_FRAME = 256
+MAX_MEASUREMENTS_PER_FRAME = 1024
 
 HEADER = [
     "frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y",
@@ -92,8 +100,58 @@ def _text(value) -> str:
     return str(value)
 
 
-def convert_sequence(sequence_dir: Path) -> tuple[int, list[list[str]]]:
-    """Converts one sequence directory; returns its number and the CSV rows (no header)."""
+def averaged_measurements(detections, frame: str, t: str, sensor: str, ego: list[str],
+                          track_numbers: dict[str, int]) -> list[list[str]]:
+    """One row per track id of a scan: its detections averaged (the paper's measurements)."""
+    groups: dict[str, list[int]] = {}
+    for index, detection in enumerate(detections):
+        track = _text(detection["track_id"])
+        if track:
+            groups.setdefault(track, []).append(index)
+    measurements = []
+    for track, indices in groups.items():
+        points = detections[indices]
+        # A track's points carry one label; should they disagree, the majority decides.
+        labels, counts = np.unique(points["label_id"], return_counts=True)
+        label = int(labels[np.argmax(counts)])
+        object_class = LABEL_TO_CLASS.get(label)
+        if object_class is None:
+            continue
+        if track not in track_numbers:
+            track_numbers[track] = len(track_numbers)
+        measurements.append([
+            frame, t, str(track_numbers[track]), object_class,
+            fmt(np.mean(points["x_cc"], dtype=np.float64)),
+            fmt(np.mean(points["y_cc"], dtype=np.float64)),
+            fmt(np.mean(points["vr_compensated"], dtype=np.float64)),
+            fmt(np.mean(points["rcs"], dtype=np.float64)),
+            "", "", sensor, *ego,
+        ])
+    return measurements
+
+
+def detection_rows(detections, frame: str, t: str, sensor: str, ego: list[str],
+                   track_numbers: dict[str, int]) -> list[list[str]]:
+    """One row per detection of a scan with a kept label, class and gt_id its own."""
+    rows = []
+    for detection in detections:
+        object_class = LABEL_TO_CLASS.get(int(detection["label_id"]))
+        if object_class is None:
+            continue
+        track = _text(detection["track_id"])
+        if track and track not in track_numbers:
+            track_numbers[track] = len(track_numbers)
+        rows.append([
+            frame, t, str(track_numbers[track]) if track else "-1", object_class,
+            fmt(detection["x_cc"]), fmt(detection["y_cc"]), fmt(detection["vr_compensated"]),
+            fmt(detection["rcs"]), "", "", sensor, *ego,
+        ])
+    return rows
+
+
+def convert_sequence(sequence_dir: Path, detections_only: bool = False) -> tuple[int, list[list[str]]]:
+    """Converts one sequence directory; returns its number and the CSV rows (no header). With
+    `detections_only`, one row per detection instead of one per track and scan."""
     scenes_path = sequence_dir / "scenes.json"
     h5_path = sequence_dir / "radar_data.h5"
     if not scenes_path.is_file() or not h5_path.is_file():
@@ -121,34 +179,12 @@ def convert_sequence(sequence_dir: Path) -> tuple[int, list[list[str]]]:
             ego = [fmt(pose["x_seq"]), fmt(pose["y_seq"]), fmt(pose["yaw_seq"])]
         start, end = (int(i) for i in scene["radar_indices"])
         detections = radar[start:end]
-
-        groups: dict[str, list[int]] = {}
-        for index, detection in enumerate(detections):
-            track = _text(detection["track_id"])
-            if track:
-                groups.setdefault(track, []).append(index)
-        measurements = []
-        for track, indices in groups.items():
-            points = detections[indices]
-            # A track's points carry one label; should they disagree, the majority decides.
-            labels, counts = np.unique(points["label_id"], return_counts=True)
-            label = int(labels[np.argmax(counts)])
-            object_class = LABEL_TO_CLASS.get(label)
-            if object_class is None:
-                continue
-            if track not in track_numbers:
-                track_numbers[track] = len(track_numbers)
-            measurements.append([
-                str(frame), t, str(track_numbers[track]), object_class,
-                fmt(np.mean(points["x_cc"], dtype=np.float64)),
-                fmt(np.mean(points["y_cc"], dtype=np.float64)),
-                fmt(np.mean(points["vr_compensated"], dtype=np.float64)),
-                fmt(np.mean(points["rcs"], dtype=np.float64)),
-                "", "", sensor, *ego,
-            ])
+        build = detection_rows if detections_only else averaged_measurements
+        measurements = build(detections, str(frame), t, sensor, ego, track_numbers)
         if len(measurements) > MAX_MEASUREMENTS_PER_FRAME:
+            what = "detections" if detections_only else "objects"
             raise ConversionError(
-                f"{sequence_dir}: scan at {timestamp} has {len(measurements)} objects, "
+                f"{sequence_dir}: scan at {timestamp} has {len(measurements)} {what}, "
                 f"more than {MAX_MEASUREMENTS_PER_FRAME}"
             )
         if not measurements:
@@ -179,15 +215,17 @@ def write_rows(path: Path, rows: list[list[str]]) -> None:
         writer.writerows(rows)
 
 
-def convert(root: Path, output: Path, only: set[int] | None = None) -> list[Path]:
-    """Converts every sequence found under `root`; returns the files written."""
+def convert(root: Path, output: Path, only: set[int] | None = None,
+            detections_only: bool = False) -> list[Path]:
+    """Converts every sequence found under `root`; returns the files written. With
+    `detections_only`, one row per detection (see the module's description)."""
     written = []
     for sequence_dir in find_sequences(root):
         if only is not None:
             with open(sequence_dir / "scenes.json", "r", encoding="utf-8") as handle:
                 if sequence_number_of(sequence_dir, json.load(handle)) not in only:
                     continue
-        number, rows = convert_sequence(sequence_dir)
+        number, rows = convert_sequence(sequence_dir, detections_only)
         path = output / split_of(number) / f"sequence_{number}.csv"
         write_rows(path, rows)
         written.append(path)
@@ -209,9 +247,15 @@ def main(argv: list[str] | None = None) -> int:
         "--sequences", type=int, nargs="+", metavar="N",
         help="convert only these sequence numbers",
     )
+    parser.add_argument(
+        "--detections", action="store_true",
+        help="write every detection as a row of its own instead of averaging each track's "
+        "detections per scan (gt_id from the track id, class from the detection's label)",
+    )
     args = parser.parse_args(argv)
     try:
-        written = convert(args.input, args.output, set(args.sequences) if args.sequences else None)
+        only = set(args.sequences) if args.sequences else None
+        written = convert(args.input, args.output, only, args.detections)
     except (ConversionError, OSError, KeyError, ValueError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 1

@@ -57,6 +57,7 @@ pub fn lane_scene(objects: usize, frames: usize, interval_s: f64, noise_m: f64, 
                         },
                         true_position: None,
                         true_velocity: None,
+                        origin: None,
                     }
                 })
                 .collect();

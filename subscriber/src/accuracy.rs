@@ -130,6 +130,7 @@ impl AccuracyMonitor {
                 measured: measurement.measured,
                 true_position: measurement.true_position,
                 true_velocity: None,
+                origin: None,
                 track_id: track.map(|t| t.id),
                 prior: track.and_then(|t| t.prior_m()).map(DVec2::from),
                 velocity: None,

@@ -156,6 +156,41 @@ def test_averaging_class_mapping_drops_and_empty_scans(dataset: Path, tmp_path: 
     assert times == sorted(times)
 
 
+def test_detections_are_written_one_row_each_with_their_own_label_and_track(dataset: Path, tmp_path: Path) -> None:
+    out = tmp_path / "detections"
+    conv.convert(dataset, out, only={42}, detections_only=True)
+    rows = read_csv(out / "validation" / "sequence_42.csv")
+    averaged = read_csv(conv.convert(dataset, tmp_path / "averaged", only={42})[0])
+    # Scan 0: both detections of car-a, one of ped-b, in the file's order; static and
+    # bicycle dropped as in the averaged mode.
+    frame0 = [r for r in rows if r["frame"] == "0"]
+    assert [(r["class"], float(r["x"]), float(r["vr"]), float(r["rcs"])) for r in frame0] == [
+        ("car", 10.0, -3.0, 5.0), ("car", 12.0, -1.0, 9.0), ("pedestrian", 5.0, 0.5, -8.0),
+    ]
+    assert frame0[0]["gt_id"] == frame0[1]["gt_id"] == "0" and frame0[2]["gt_id"] == "1"
+    assert all(r["sensor_id"] == "1" and r["t"] == "0.0" and r["true_x"] == "" for r in frame0)
+    # The mean of a track's detections is the averaged mode's measurement.
+    car = next(r for r in averaged if r["frame"] == "0" and r["class"] == "car")
+    assert float(car["x"]) == pytest.approx(np.mean([float(r["x"]) for r in frame0[:2]]))
+    # Scan 1: the pedestrian group's two detections stay two rows of one track.
+    group = [r for r in rows if r["frame"] == "1" and r["class"] == "pedestrian"]
+    assert len(group) == 2 and group[0]["gt_id"] == group[1]["gt_id"]
+    # Same track numbering, empty scans and frames as the averaged mode.
+    assert {r["gt_id"] for r in rows} == {r["gt_id"] for r in averaged if r["gt_id"]} | {""}
+    assert [r["frame"] for r in rows if r["class"] == ""] == ["2"]
+    assert len(rows) == 8 and len(averaged) == 6
+    # A labelled detection without a track id is kept without a ground-truth id.
+    root = tmp_path / "untracked"
+    write_sequence(root, 9, [(T0, 1, [detection(T0, 1, 4.0, 1.0, 0.5, -7.0, "", 7, 0)])])
+    untracked = read_csv(conv.convert(root, tmp_path / "untracked_out", detections_only=True)[0])
+    assert [(r["gt_id"], r["class"]) for r in untracked] == [("-1", "pedestrian")]
+    # From the command line.
+    script = TOOLS / "radarscenes_to_csv.py"
+    done = subprocess.run([sys.executable, str(script), str(dataset), "-o", str(tmp_path / "cli"),
+                           "--sequences", "42", "--detections"], capture_output=True, text=True, check=True)
+    assert read_csv(Path(done.stdout.split()[0])) == rows
+
+
 def test_split_lists_match_the_paper() -> None:
     assert len(conv.VALIDATION_SEQUENCES) == 6
     assert len(conv.EVALUATION_SEQUENCES) == 22

@@ -86,6 +86,14 @@ pub struct CoordinatesConfig {
     /// `"outline"`, `"centre"` or `"auto"` (absent: outline; `crate::sensor`).
     #[cfg_attr(feature = "serde", serde(default))]
     pub unmounted_reflection: crate::sensor::ReflectionModel,
+    /// What one detection of a radar without a configured mount is: `"points"`, `"objects"` or
+    /// `"auto"` (absent: auto; `crate::grouping`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub unmounted_detections: crate::grouping::DetectionModel,
+    /// How the detections of point-cloud radars are grouped (absent: the defaults of
+    /// [`GroupingConfig`](crate::grouping::GroupingConfig)).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub grouping: crate::grouping::GroupingConfig,
     /// How fast the sensors' running estimates move (absent: the defaults of
     /// [`EstimationConfig`](crate::sensor::estimates::EstimationConfig)).
     #[cfg_attr(feature = "serde", serde(default))]
@@ -126,6 +134,7 @@ impl Default for CoordinatesConfig {
             azimuth_std_rad: 0.0105,
             azimuth_std_max_factor: 1.0,
             reflection: crate::sensor::ReflectionModel::Outline,
+            detections: Default::default(),
         };
         let mut sensors = ArrayVec::new();
         sensors.push(mount(1, 3.66, -0.87, -85.0));
@@ -138,6 +147,8 @@ impl Default for CoordinatesConfig {
             unknown_sensor_margin_rad: DEFAULT_UNKNOWN_SENSOR_MARGIN_RAD,
             unknown_sensor_margin_m: DEFAULT_UNKNOWN_SENSOR_MARGIN_M,
             unmounted_reflection: crate::sensor::ReflectionModel::Outline,
+            unmounted_detections: crate::grouping::DetectionModel::Auto,
+            grouping: crate::grouping::GroupingConfig::default(),
             estimation: crate::sensor::estimates::EstimationConfig::default(),
         }
     }
@@ -158,6 +169,9 @@ impl CoordinatesConfig {
             return Some(("frame.unknown_sensor_margin_m", "must be a finite number >= 0"));
         }
         if let Some(problem) = self.estimation.problem() {
+            return Some(problem);
+        }
+        if let Some(problem) = self.grouping.problem() {
             return Some(problem);
         }
         for (index, mount) in self.sensors.iter().enumerate() {

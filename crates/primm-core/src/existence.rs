@@ -238,6 +238,7 @@ mod tests {
             azimuth_std_rad: 0.0,
             azimuth_std_max_factor: 1.0,
             reflection: crate::sensor::ReflectionModel::Outline,
+            detections: Default::default(),
         }
     }
 

@@ -60,6 +60,7 @@ pub mod duplicates;
 pub mod existence;
 pub mod extent;
 pub mod gaussian;
+pub mod grouping;
 pub mod imm;
 pub mod invariants;
 pub mod limits;

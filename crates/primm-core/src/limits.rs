@@ -10,7 +10,7 @@
 pub const MAX_TRACKS: usize = 512;
 
 /// Largest number of measurements one frame may carry.
-pub const MAX_MEASUREMENTS_PER_FRAME: usize = 256;
+pub const MAX_MEASUREMENTS_PER_FRAME: usize = 1024;
 
 /// Longest measurement history the learned predictor reads (`L` in `eq:pr_input`); also the
 /// capacity of each track's history buffer.

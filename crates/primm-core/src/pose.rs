@@ -180,6 +180,11 @@ pub struct SensorMount {
     /// `"auto"` (absent: outline, the class's `extent.offset_scale`; `crate::sensor`).
     #[cfg_attr(feature = "serde", serde(default))]
     pub reflection: crate::sensor::ReflectionModel,
+    /// What one of the sensor's detections is: `"points"` (a point cloud, grouped into objects
+    /// before association), `"objects"` or `"auto"` (absent: auto, decided from the data;
+    /// `crate::grouping`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub detections: crate::grouping::DetectionModel,
 }
 
 /// The default of [`SensorMount::half_fov_rad`]: all around.

@@ -46,6 +46,12 @@ impl ValidatedFrame {
         }
     }
 
+    /// Sets the number of measurements, after the grouping of a point cloud replaced them
+    /// (`crate::grouping`; at most [`MAX_MEASUREMENTS_PER_FRAME`]).
+    pub(crate) fn set_len(&mut self, count: usize) {
+        self.count = count.min(MAX_MEASUREMENTS_PER_FRAME);
+    }
+
     /// Records measurement `index` as validation left it: `None` when it was rejected.
     pub(crate) fn set(&mut self, index: usize, measurement: Option<Measurement>) {
         self.measurements[index] = measurement;

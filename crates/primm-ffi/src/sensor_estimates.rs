@@ -1,6 +1,7 @@
 //! What the tracker has learned of each sensor from its data (primm-core's `sensor` module):
 //! per sensor and class, where its detections lie on an object, its detection probability and
-//! its clutter density, with how many samples each rests on.
+//! its clutter density, with how many samples each rests on; per sensor, whether its data
+//! look like a point cloud.
 
 use crate::status::Failure;
 use crate::tracker::{with_tracker, PrimmTracker};
@@ -34,6 +35,14 @@ pub struct PrimmSensorEstimates {
     pub clutter_scans: u64,
     /// Times any of the three would have left its bounds and was held at them.
     pub bounded: u64,
+    /// The sensor's share of confirmed-track scans with several detections on the track's
+    /// object (the same for every class).
+    pub points_share: f64,
+    /// Track scans the share has taken.
+    pub points_samples: u64,
+    /// 1 when the sensor's detections are grouped as a point cloud now (`detections` is
+    /// "points", or "auto" and its data showed one), else 0.
+    pub groups_points: u8,
 }
 
 impl PrimmSensorEstimates {
@@ -63,6 +72,9 @@ impl PrimmSensorEstimates {
             clutter_density_per_m2: estimates.clutter.value_per_m2(),
             clutter_scans: estimates.clutter.scans,
             bounded: estimates.reflection.bounded + estimates.detection.bounded + estimates.clutter.bounded,
+            points_share: sensor.points.share(),
+            points_samples: sensor.points.samples,
+            groups_points: u8::from(sensor.groups_detections()),
         })
     }
 }

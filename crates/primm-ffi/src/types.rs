@@ -16,7 +16,7 @@ use primm_core::tracker::{StepSummary, TrackerStats};
 pub const PRIMM_MAX_TRACKS: usize = 512;
 /// Most measurements one frame may carry; a larger frame is rejected with
 /// `PRIMM_STATUS_INVALID_FRAME`.
-pub const PRIMM_MAX_MEASUREMENTS_PER_FRAME: usize = 256;
+pub const PRIMM_MAX_MEASUREMENTS_PER_FRAME: usize = 1024;
 /// Number of IMM modes; mode probabilities are ordered PR, CV, CA, CT.
 pub const PRIMM_MODE_COUNT: usize = 4;
 
@@ -418,6 +418,12 @@ pub struct PrimmStats {
     /// Tracks started in the world frame by a measurement whose sensor has no configured
     /// mount: their line of sight starts at the vehicle's reference point.
     pub initiations_from_unknown_sensor: u64,
+    /// Unassigned measurements that started no track as the mirror image of a confirmed
+    /// track in a wall along its heading (multipath ghosts).
+    pub initiations_refused_as_ghost: u64,
+    /// Tentative tracks ended because their measurement was the mirror image of a confirmed
+    /// track (multipath ghosts).
+    pub tentative_tracks_ended_as_ghost: u64,
     /// Measurements tracked (accepted by validation).
     pub measurements_accepted: u64,
     /// Measurements rejected for an unknown class code.
@@ -492,6 +498,8 @@ pub struct PrimmStats {
     /// extended object (`classes.<class>.extent.absorb_extra_detections`): they started
     /// no track.
     pub detections_absorbed: u64,
+    /// Detections of point-cloud radars that joined another detection's group.
+    pub detections_grouped: u64,
     /// Existing tracks updated by an assigned measurement.
     pub tracks_updated: u64,
     /// Tracks without a measurement while a sensor of the frame had them in view (their

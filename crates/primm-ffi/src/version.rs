@@ -6,7 +6,7 @@ use core::ffi::{c_char, CStr};
 
 /// The ABI version of this header (see the crate documentation of primm-ffi for the policy):
 /// compare it with `primm_abi_version()`, the ABI version of the linked library.
-pub const PRIMM_ABI_VERSION: u32 = 2;
+pub const PRIMM_ABI_VERSION: u32 = 3;
 
 /// The release version of the library, e.g. `0.1.0`.
 const VERSION: &CStr = match CStr::from_bytes_with_nul(concat!(env!("CARGO_PKG_VERSION"), "\0").as_bytes()) {

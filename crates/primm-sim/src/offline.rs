@@ -122,6 +122,7 @@ mod tests {
                 },
                 true_position: None,
                 true_velocity: None,
+                origin: None,
             });
             sequence.frames.push(frame);
         }

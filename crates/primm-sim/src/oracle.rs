@@ -290,11 +290,13 @@ mod tests {
                         measurement: measurement(centre.x + 0.5, centre.y, Some(1)),
                         true_position: Some(centre),
                         true_velocity: None,
+                        origin: None,
                     },
                     RecordedMeasurement {
                         measurement: measurement(40.0, 40.0, None),
                         true_position: None,
                         true_velocity: None,
+                        origin: None,
                     },
                 ],
             });

@@ -18,8 +18,8 @@
 
 #include <stdint.h>
 
-#define PRIMM_WIRE_VERSION 4 /* layout version; primm_track_frame.wire_version carries the writer's */
-#define PRIMM_MEASUREMENT_CAPACITY 256
+#define PRIMM_WIRE_VERSION 5 /* layout version; primm_track_frame.wire_version carries the writer's */
+#define PRIMM_MEASUREMENT_CAPACITY 1024
 #define PRIMM_TRACK_CAPACITY 512
 #define PRIMM_STAGE_CAPACITY 12
 #define PRIMM_STAGE_NAME_LEN 24

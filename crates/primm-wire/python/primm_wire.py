@@ -10,8 +10,8 @@ nanoseconds (``time.monotonic_ns()``), ``_s`` times are sensor seconds.
 
 import ctypes
 
-WIRE_VERSION = 4  # layout version; TrackFrame.wire_version carries the writer's
-MEASUREMENT_CAPACITY = 256
+WIRE_VERSION = 5  # layout version; TrackFrame.wire_version carries the writer's
+MEASUREMENT_CAPACITY = 1024
 TRACK_CAPACITY = 512
 STAGE_CAPACITY = 12
 STAGE_NAME_LEN = 24

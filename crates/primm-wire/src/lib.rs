@@ -61,9 +61,10 @@
 /// position–velocity covariances (in place of the 2×2 position covariance) and `age_s` of
 /// [`WireTrack`], [`TrackFrame::tracks_timestamp_s`], the flags for late frames and predicted
 /// tracks, [`FrameStatus::RejectedTooLate`], and the publisher's schedule
-/// (`MeasurementFrame::scheduled_time_ns`, `TrackFrame::input_scheduled_time_ns`). (iceoryx2
+/// (`MeasurementFrame::scheduled_time_ns`, `TrackFrame::input_scheduled_time_ns`); version 5 the capacity of a [`MeasurementFrame`],
+/// 1,024 measurements (from 256), to hold a radar's point cloud. (iceoryx2
 /// also refuses to connect a publisher and a subscriber whose payload sizes differ.)
-pub const WIRE_VERSION: u16 = 4;
+pub const WIRE_VERSION: u16 = 5;
 
 mod latency_report;
 mod measurement_frame;

@@ -216,7 +216,7 @@ fn the_rust_types_have_no_implicit_padding() {
         println!("{}: {} fields, {} bytes, no gaps", layout.name, layout.fields.len(), layout.size);
     }
     assert_eq!(size_of::<WireMeasurement>(), 64);
-    assert_eq!(size_of::<MeasurementFrame>(), 16_456);
+    assert_eq!(size_of::<MeasurementFrame>(), 65_608);
     assert_eq!(size_of::<WireTrack>(), 424);
     assert_eq!(size_of::<TrackFrame>(), 217_168);
     assert_eq!(size_of::<LatencyReport>(), 1032);

@@ -15,16 +15,19 @@
 //! [`estimates::ReflectionEstimate`]).
 
 pub mod estimates;
+pub mod points;
 
 use crate::coordinates::CoordinatesConfig;
 use crate::existence::{ExistenceConfig, FieldOfView};
 use crate::extent::ExtentConfig;
+use crate::grouping::DetectionModel;
 use crate::limits::MAX_SENSORS;
 use crate::measurement::ObjectClass;
 use crate::pose::{EgoPose, SensorMount};
 use crate::sensor_noise::SensorNoise;
 use estimates::{ClutterEstimate, DetectionEstimate, ReflectionEstimate};
 use glam::DVec2;
+use points::PointsEstimate;
 
 /// Where a sensor's detections of an extended object lie (`[[frame.sensors]] reflection`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -76,8 +79,12 @@ pub struct Sensor {
     pub mount: Option<SensorMount>,
     /// The measurement model of extended objects.
     pub reflection: ReflectionModel,
+    /// What one of its detections is: a point of a point cloud or an object.
+    pub detections: DetectionModel,
     /// What its data said so far.
     pub estimates: SensorEstimates,
+    /// Whether its data look like a point cloud (`detections = "auto"`).
+    pub points: PointsEstimate,
 }
 
 impl Sensor {
@@ -86,7 +93,7 @@ impl Sensor {
     /// factors).
     fn new(
         mount: Option<SensorMount>,
-        reflection: ReflectionModel,
+        (reflection, detections): (ReflectionModel, DetectionModel),
         classes: &[(&ExtentConfig, &ExistenceConfig); ObjectClass::COUNT],
     ) -> Self {
         let (detection_factor, clutter_factor) = mount
@@ -101,7 +108,7 @@ impl Sensor {
                 clutter: ClutterEstimate::new(existence.clutter_density_per_m2 * clutter_factor),
             }
         });
-        Sensor { mount, reflection, estimates }
+        Sensor { mount, reflection, detections, estimates, points: PointsEstimate::new() }
     }
 
     /// The sensor id of its mount (`None`: the unmounted sensor).
@@ -147,6 +154,16 @@ impl Sensor {
         }
     }
 
+    /// Whether its detections are grouped into objects before association: `points`, or
+    /// `auto` once its data showed a point cloud.
+    pub fn groups_detections(&self) -> bool {
+        match self.detections {
+            DetectionModel::Points => true,
+            DetectionModel::Objects => false,
+            DetectionModel::Auto => self.points.points,
+        }
+    }
+
     /// The detection probability and clutter density of `class` the existence model uses: the
     /// configured ones (with the mount's factors).
     pub fn detection_and_clutter(&self, class: ObjectClass) -> (f64, f64) {
@@ -175,10 +192,10 @@ impl SensorSet {
         frame: &CoordinatesConfig,
         classes: &[(&ExtentConfig, &ExistenceConfig); ObjectClass::COUNT],
     ) -> Self {
-        let unmounted = Sensor::new(None, frame.unmounted_reflection, classes);
+        let unmounted = Sensor::new(None, (frame.unmounted_reflection, frame.unmounted_detections), classes);
         let mut sensors = [unmounted; MAX_SENSORS + 1];
         for (slot, mount) in frame.sensors.iter().enumerate() {
-            sensors[slot] = Sensor::new(Some(*mount), mount.reflection, classes);
+            sensors[slot] = Sensor::new(Some(*mount), (mount.reflection, mount.detections), classes);
         }
         SensorSet { sensors, mounted: frame.sensors.len() }
     }
@@ -266,6 +283,24 @@ impl core::fmt::Display for SensorReport<'_> {
                     estimates.clutter.value_per_m2(),
                     estimates.clutter.scans,
                     estimates.reflection.bounded + estimates.detection.bounded + estimates.clutter.bounded,
+                )?;
+            }
+            if sensor.points.samples > 0 {
+                if !first {
+                    f.write_str("\n")?;
+                }
+                first = false;
+                match sensor.id() {
+                    Some(id) => write!(f, "sensor {id}")?,
+                    None => f.write_str("sensor without mount")?,
+                }
+                write!(
+                    f,
+                    " detections: {} ({}; several per track in {:.3} of {} track scans)",
+                    sensor.detections.name(),
+                    if sensor.groups_detections() { "grouped as points" } else { "objects" },
+                    sensor.points.share(),
+                    sensor.points.samples,
                 )?;
             }
         }

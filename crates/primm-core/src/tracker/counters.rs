@@ -59,6 +59,13 @@ macro_rules! tracker_counters {
             /// Tracks started in the world frame by a measurement whose sensor has no configured
             /// mount: their line of sight starts at the vehicle's reference point.
             initiations_from_unknown_sensor: tracked,
+            /// Unassigned measurements that started no track because they lie where a wall
+            /// along a confirmed track's heading would mirror it, moving as its image
+            /// (multipath ghosts; ARCHITECTURE.md, "Point clouds").
+            initiations_refused_as_ghost: tracked,
+            /// Tentative tracks ended because their measurement of the step was the mirror image
+            /// of a confirmed track (multipath ghosts, as `initiations_refused_as_ghost`).
+            tentative_tracks_ended_as_ghost: tracked,
             /// Measurements tracked (accepted by validation).
             measurements_accepted: tracked,
             /// Measurements rejected for an unknown class code.
@@ -133,6 +140,10 @@ macro_rules! tracker_counters {
             /// extended object (`classes.<class>.extent.absorb_extra_detections`): they started
             /// no track.
             detections_absorbed: tracked,
+            /// Detections of point-cloud radars that joined another detection's group
+            /// (`crate::grouping`): the accepted detections of grouped frames less the
+            /// measurements their groups became.
+            detections_grouped: tracked,
             /// Existing tracks updated by an assigned measurement.
             tracks_updated: tracked,
             /// Tracks without a measurement while a sensor of the frame had them in view (their

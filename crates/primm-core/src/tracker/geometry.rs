@@ -185,7 +185,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 mounted: sensor.mount.is_some(),
                 noise_m2,
                 slot: slot as u8,
-                reflection_scale: sensor.reflection_scale(measurement.class, extent),
+                // A group moved to its object's centre is a measurement of the centre.
+                reflection_scale: if self.grouped_frame && self.group_is_centre[index] {
+                    0.0
+                } else {
+                    sensor.reflection_scale(measurement.class, extent)
+                },
             };
         }
     }

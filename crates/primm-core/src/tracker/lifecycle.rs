@@ -28,6 +28,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
             // Where the history's line of sight starts: the radial-velocity row's radar position.
             let sensor = self.measurement_sensors[index];
+            if self.mirrors_a_track(&measurement, sensor.position_m, tracks_before) {
+                self.last_step.counts.initiations_refused_as_ghost += 1;
+                continue;
+            }
             if !sensor.mounted && self.step_pose.is_some() {
                 self.last_step.counts.initiations_from_unknown_sensor += 1;
             }
@@ -115,7 +119,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let mut false_tracks =
             [(crate::measurement::ObjectClass::Car, 0u8, 0u32); crate::track_table::MAX_TRACKS];
         let mut false_count = 0;
-        let deleted = retain_with_rows(&mut self.table, &mut self.rows[..], |_, track| {
+        let ending = &self.ending;
+        let deleted = retain_with_rows(&mut self.table, &mut self.rows[..], |index, track| {
             let (max_misses, max_coast_s) = if track.status.is_confirmed() {
                 (lifecycle.confirmed_max_misses, lifecycle.max_coast_s)
             } else {
@@ -127,7 +132,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     track.existence_probability >= lifecycle.deletion_existence_probability
                 }
             };
-            let kept = alive && t - track.last_update_s <= max_coast_s;
+            let kept = alive && t - track.last_update_s <= max_coast_s && !ending[index];
             if !kept && super::sensors::was_false(track) {
                 false_tracks[false_count] = (track.class, track.birth_sensor_slot, track.hits);
                 false_count += 1;
@@ -184,7 +189,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
         let merged = &self.merged;
         let removed = retain_with_rows(&mut self.table, &mut self.rows[..], |index, _| !merged[index]);
-        self.last_step.counts.duplicate_tracks_merged = removed as u64;
+        self.last_step.counts.duplicate_tracks_merged += removed as u64;
     }
 
     /// The nearest older track (more frames, or as many and a smaller id) of `index`'s class that

@@ -39,6 +39,8 @@ use glam::{DMat2, DVec2};
 
 mod counters;
 mod geometry;
+mod ghosts;
+mod grouping;
 mod late_frames;
 mod lifecycle;
 mod output;
@@ -164,6 +166,22 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     duplicate_views: Box<[DuplicateView; MAX_TRACKS]>,
     /// Tracks merged into an older one in the current frame, aligned with the table.
     merged: Box<[bool; MAX_TRACKS]>,
+    /// The grouping of the current frame's point-cloud detections (`crate::grouping`).
+    frame_groups: Box<crate::grouping::frame_groups::FrameGroups>,
+    /// Whether the current frame's measurements are groups.
+    grouped_frame: bool,
+    /// The frame index of each group's representative detection (when `grouped_frame`).
+    group_first_index: Box<[u16; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// Whether each group's measurement is a measurement of its object's centre (when
+    /// `grouped_frame`).
+    group_is_centre: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// Per track: whether an older track of its class nearby took a detection on its object in
+    /// the current grouped frame (`grouping`).
+    shadowed: Box<[bool; MAX_TRACKS]>,
+    /// Per track: whether the deletion ends it as a shadowed duplicate.
+    ending: Box<[bool; MAX_TRACKS]>,
+    /// Per track: its detections of one radar in the current frame (`learn_points`).
+    owned_counts: Box<[u16; MAX_TRACKS]>,
     /// The current frame as read once from the caller; validation reads only this copy.
     recorded: Box<RecordedFrame>,
     /// The current frame as validated; every later stage reads this copy.
@@ -227,6 +245,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
             unknown_sensor_view: None,
             duplicate_views: Box::new([DuplicateView::default(); MAX_TRACKS]),
             merged: Box::new([false; MAX_TRACKS]),
+            frame_groups: Box::new(crate::grouping::frame_groups::FrameGroups::new()),
+            grouped_frame: false,
+            group_first_index: Box::new([0; MAX_MEASUREMENTS_PER_FRAME]),
+            group_is_centre: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
+            owned_counts: Box::new([0; MAX_TRACKS]),
+            shadowed: Box::new([false; MAX_TRACKS]),
+            ending: Box::new([false; MAX_TRACKS]),
             recorded: Box::new(RecordedFrame::new()),
             validated: Box::new(ValidatedFrame::new()),
             late_outputs: alloc::vec::Vec::with_capacity(if ring.is_enabled() { MAX_TRACKS } else { 0 }),
@@ -293,14 +318,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
         observer.stage_finished(Stage::Predict);
         self.fuse_priors();
         observer.stage_finished(Stage::LearnedWait);
+        self.group_detections();
         self.associate()?;
         observer.stage_finished(Stage::Associate);
         self.update(t);
         self.coast();
         self.learn_sensors();
         self.initiate(t);
+        self.end_shadowed_and_ghost_tracks();
         self.delete(t);
         self.merge_duplicates();
+        self.name_groups_by_representative();
         observer.stage_finished(Stage::Update);
         self.last_timestamp_s = Some(t);
         self.last_step.counts.frames_tracked += 1;

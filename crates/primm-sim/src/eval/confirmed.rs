@@ -11,10 +11,20 @@
 //! * identity counts use the confirmed rows of tracks not born of clutter as matches; the
 //!   ground-truth object frames stay all rows with a ground-truth id, so an object that is only
 //!   followed by a tentative track is missed (IDFN);
-//! * a *false track* is a confirmed track born of clutter or whose confirmed rows are more than
-//!   half without a ground-truth id; the rate divides their number by the sequences' time;
+//! * a *false track* is a confirmed track born of clutter or whose confirmed frames are more than
+//!   half on clutter alone (no row of the track in that frame has a ground-truth id); the rate
+//!   divides their number by the sequences' time;
 //! * a *fragmentation* is an interruption of an object's coverage by confirmed tracks (the MOT
-//!   "Frag" count).
+//!   "Frag" count);
+//! * *confirmed tracks per object frame*: the (frame, confirmed track) pairs with a row over the
+//!   ground-truth object frames, 1 when every detected object is followed by one confirmed track
+//!   and nothing else is; above 1 when objects are followed by several tracks or clutter by
+//!   confirmed tracks;
+//! * a track is *born of a ghost* when its first row is a multipath ghost (where the data say
+//!   what produced each measurement, [`AssociationRecord::origin`]).
+//!
+//! Like the identity counts, everything is counted per object frame and track frame: an object
+//! with several detections in one frame, or a track that took several, counts once.
 //!
 //! Counts of one sequence come from [`confirmed_track_counts`]; [`ConfirmedTrackCounts::merge`]
 //! adds sequences. `docs/evaluation-metrics.md` defines every number exactly.
@@ -26,6 +36,7 @@ use serde_json::Value;
 
 use super::identity::{identity_counts, IdentityCounts};
 use super::record::{time_order, AssociationRecord};
+use crate::io::MeasurementOrigin;
 
 /// Counts on confirmed tracks of one or more sequences; they add up over sequences.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -38,9 +49,16 @@ pub struct ConfirmedTrackCounts {
     pub identity: IdentityCounts,
     /// Tracks with at least one confirmed row.
     pub confirmed_tracks: u64,
-    /// Confirmed tracks born of clutter or with more than half of their confirmed rows without a
-    /// ground-truth id.
+    /// Confirmed tracks born of clutter or with more than half of their confirmed frames on
+    /// clutter alone.
     pub false_tracks: u64,
+    /// Confirmed tracks whose first row is a multipath ghost.
+    #[serde(default)]
+    pub ghost_born_tracks: u64,
+    /// Rows whose origin (object, clutter, ghost) is known; without any, whether a track is born
+    /// of a ghost is unknown.
+    #[serde(default)]
+    pub rows_with_origin: u64,
     /// Interruptions of the ground-truth objects' coverage by confirmed tracks.
     pub fragmentations: u64,
     /// Rows without a ground-truth id (clutter measurements).
@@ -58,6 +76,8 @@ impl ConfirmedTrackCounts {
         self.identity.merge(&other.identity);
         self.confirmed_tracks += other.confirmed_tracks;
         self.false_tracks += other.false_tracks;
+        self.ghost_born_tracks += other.ghost_born_tracks;
+        self.rows_with_origin += other.rows_with_origin;
         self.fragmentations += other.fragmentations;
         self.clutter_rows += other.clutter_rows;
         self.clutter_rows_in_confirmed_tracks += other.clutter_rows_in_confirmed_tracks;
@@ -67,6 +87,20 @@ impl ConfirmedTrackCounts {
     /// IDF1 of the confirmed rows; `None` without ground-truth and estimated object frames.
     pub fn idf1(&self) -> Option<f64> {
         self.identity.idf1()
+    }
+
+    /// Confirmed tracks per ground-truth object frame: estimated over ground-truth object frames
+    /// of the confirmed rows; `None` without ground-truth object frames.
+    pub fn tracks_per_object_frame(&self) -> Option<f64> {
+        let objects = self.identity.gt_object_frames;
+        (objects > 0).then(|| self.identity.estimated_object_frames as f64 / objects as f64)
+    }
+
+    /// Share of the confirmed tracks born of a ghost; `None` without confirmed tracks or when no
+    /// row says what produced it.
+    pub fn ghost_born_share(&self) -> Option<f64> {
+        (self.confirmed_tracks > 0 && self.rows_with_origin > 0)
+            .then(|| self.ghost_born_tracks as f64 / self.confirmed_tracks as f64)
     }
 
     /// False tracks per minute of sequence time; `None` when the sequences last no time.
@@ -98,14 +132,24 @@ pub struct UnknownTrackStatus {
 /// The tracks of one sequence whose first row (in time order, ties in input order) has no
 /// ground-truth id.
 pub fn tracks_born_of_clutter(records: &[AssociationRecord]) -> BTreeSet<u64> {
-    let mut first_ground_truth: BTreeMap<u64, Option<u64>> = BTreeMap::new();
+    tracks_born_of(records, |first| first.ground_truth_id.is_none())
+}
+
+/// The tracks of one sequence whose first row (in time order, ties in input order) is a
+/// multipath ghost.
+pub fn tracks_born_of_ghosts(records: &[AssociationRecord]) -> BTreeSet<u64> {
+    tracks_born_of(records, |first| first.origin == Some(MeasurementOrigin::Ghost))
+}
+
+/// The tracks whose first row (in time order, ties in input order) passes `test`.
+fn tracks_born_of(records: &[AssociationRecord], test: impl Fn(&AssociationRecord) -> bool) -> BTreeSet<u64> {
+    let mut first_row: BTreeMap<u64, usize> = BTreeMap::new();
     for index in time_order(records) {
-        let record = &records[index];
-        if let Some(track) = record.track_id {
-            first_ground_truth.entry(track).or_insert(record.ground_truth_id);
+        if let Some(track) = records[index].track_id {
+            first_row.entry(track).or_insert(index);
         }
     }
-    first_ground_truth.into_iter().filter(|(_, gt)| gt.is_none()).map(|(track, _)| track).collect()
+    first_row.into_iter().filter(|(_, index)| test(&records[*index])).map(|(track, _)| track).collect()
 }
 
 /// The counts on confirmed tracks of one sequence.
@@ -136,24 +180,35 @@ pub fn confirmed_track_counts(
         })
         .collect();
     let mut identity = identity_counts(&matched);
-    let clutter_born_rows =
-        records.iter().filter(|r| r.is_confirmed_track_frame() && from_clutter(r)).count() as u64;
-    identity.estimated_object_frames += clutter_born_rows;
-    identity.idfp += clutter_born_rows;
+    let clutter_born_frames: BTreeSet<(u64, u64)> = records
+        .iter()
+        .filter(|r| r.is_confirmed_track_frame() && from_clutter(r))
+        .filter_map(|r| r.track_id.map(|track| (r.frame, track)))
+        .collect();
+    identity.estimated_object_frames += clutter_born_frames.len() as u64;
+    identity.idfp += clutter_born_frames.len() as u64;
 
-    // Per confirmed track: its confirmed rows and how many of them have no ground-truth id.
-    let mut confirmed_rows: BTreeMap<u64, (u64, u64)> = BTreeMap::new();
+    // Per confirmed track and frame: whether any of its rows there has a ground-truth id.
+    let mut confirmed_frames: BTreeMap<(u64, u64), bool> = BTreeMap::new();
     for record in records.iter().filter(|r| r.is_confirmed_track_frame()) {
         if let Some(track) = record.track_id {
-            let entry = confirmed_rows.entry(track).or_default();
-            entry.0 += 1;
-            entry.1 += u64::from(record.ground_truth_id.is_none());
+            *confirmed_frames.entry((track, record.frame)).or_default() |= record.ground_truth_id.is_some();
         }
     }
-    let false_tracks = confirmed_rows
+    // Per confirmed track: its confirmed frames and how many of them are on clutter alone.
+    let mut confirmed_tracks: BTreeMap<u64, (u64, u64)> = BTreeMap::new();
+    for ((track, _), real) in confirmed_frames {
+        let entry = confirmed_tracks.entry(track).or_default();
+        entry.0 += 1;
+        entry.1 += u64::from(!real);
+    }
+    let false_tracks = confirmed_tracks
         .iter()
-        .filter(|(track, (rows, clutter))| born_of_clutter.contains(track) || 2 * clutter > *rows)
+        .filter(|(track, (frames, clutter))| born_of_clutter.contains(track) || 2 * clutter > *frames)
         .count() as u64;
+    let born_of_ghosts = tracks_born_of_ghosts(records);
+    let ghost_born_tracks =
+        confirmed_tracks.keys().filter(|track| born_of_ghosts.contains(track)).count() as u64;
 
     let clutter_rows = records.iter().filter(|r| r.ground_truth_id.is_none()).count() as u64;
     let clutter_rows_in_confirmed_tracks =
@@ -162,8 +217,10 @@ pub fn confirmed_track_counts(
     Ok(ConfirmedTrackCounts {
         sequences: 1,
         identity,
-        confirmed_tracks: confirmed_rows.len() as u64,
+        confirmed_tracks: confirmed_tracks.len() as u64,
         false_tracks,
+        ghost_born_tracks,
+        rows_with_origin: records.iter().filter(|r| r.origin.is_some()).count() as u64,
         fragmentations: fragmentations(&matched),
         clutter_rows,
         clutter_rows_in_confirmed_tracks,
@@ -388,6 +445,65 @@ mod tests {
         let error = confirmed_track_counts(&records).unwrap_err();
         assert_eq!(error, UnknownTrackStatus { row: 1, frame: 1, track_id: 2 });
         assert!(error.to_string().contains("not recorded"), "{error}");
+    }
+
+    #[test]
+    fn several_detections_per_object_and_track_count_once_per_frame() {
+        // Object 1 gives three detections per frame in frames 0..=3, all taken by track 1 once
+        // it is confirmed (frame 1 on); a second confirmed track, 2, takes one of them in frames
+        // 2 and 3 (a duplicate). A clutter detection in frame 3 is taken by track 1 too.
+        let mut records = Vec::new();
+        for frame in 0..4 {
+            records.extend((0..3).map(|_| row(frame, Some(1), Some(1), frame >= 1)));
+        }
+        records.push(row(2, Some(1), Some(2), true));
+        records.push(row(3, Some(1), Some(2), true));
+        records.push(row(3, None, Some(1), true));
+        let counts = confirmed_track_counts(&records).unwrap();
+        assert_eq!(counts.identity.gt_object_frames, 4);
+        // Track 1 in frames 1..=3, track 2 in frames 2 and 3.
+        assert_eq!(counts.identity.estimated_object_frames, 5);
+        assert_eq!((counts.identity.idtp, counts.identity.idfp, counts.identity.idfn), (3, 2, 1));
+        assert_eq!(counts.identity.idsw, 0, "track 1 still follows the object beside track 2");
+        assert!((counts.tracks_per_object_frame().unwrap() - 1.25).abs() < 1e-12);
+        assert_eq!((counts.confirmed_tracks, counts.false_tracks), (2, 0));
+        assert_eq!((counts.clutter_rows, counts.clutter_rows_in_confirmed_tracks), (1, 1));
+    }
+
+    #[test]
+    fn a_track_whose_first_row_is_a_ghost_is_born_of_a_ghost() {
+        // Track 3 starts on a ghost and is confirmed; track 4 starts on clutter (not a ghost);
+        // track 5 starts on object 1 and later takes a ghost; track 6 starts on a ghost but is
+        // never confirmed.
+        let ghost = |frame, track, confirmed| {
+            let mut r = row(frame, None, Some(track), confirmed);
+            r.origin = Some(MeasurementOrigin::Ghost);
+            r
+        };
+        let mut clutter = row(0, None, Some(4), false);
+        clutter.origin = Some(MeasurementOrigin::Clutter);
+        let mut object = row(0, Some(1), Some(5), false);
+        object.origin = Some(MeasurementOrigin::Object);
+        let records = vec![
+            ghost(0, 3, false),
+            ghost(1, 3, true),
+            clutter,
+            row(1, None, Some(4), true),
+            object,
+            ghost(1, 5, true),
+            ghost(0, 6, false),
+        ];
+        assert_eq!(tracks_born_of_ghosts(&records), BTreeSet::from([3, 6]));
+        let counts = confirmed_track_counts(&records).unwrap();
+        assert_eq!((counts.confirmed_tracks, counts.ghost_born_tracks), (3, 1));
+        assert!((counts.ghost_born_share().unwrap() - 1.0 / 3.0).abs() < 1e-12);
+        // Without any origin in the rows the share is unknown, not zero.
+        let unknown: Vec<AssociationRecord> =
+            records.iter().map(|r| AssociationRecord { origin: None, ..*r }).collect();
+        assert_eq!(confirmed_track_counts(&unknown).unwrap().ghost_born_share(), None);
+        let json = counts.to_json();
+        assert_eq!(json["ghost_born_tracks"], json!(1));
+        assert!((json["ghost_born_share"].as_f64().unwrap() - 1.0 / 3.0).abs() < 1e-12);
     }
 
     #[test]

@@ -78,9 +78,9 @@ pub struct MethodCounts {
     pub sequences: u64,
     /// Priors scored in the RMSE.
     pub rmse_samples: u64,
-    /// Ground-truth object frames (measurements of a known object).
+    /// Ground-truth object frames ((frame, object) pairs with a measurement).
     pub gt_object_frames: u64,
-    /// Estimated object frames (measurements a track took).
+    /// Estimated object frames ((frame, track) pairs with a measurement the track took).
     pub estimated_object_frames: u64,
     /// Identity true positives.
     pub idtp: u64,
@@ -194,7 +194,7 @@ pub struct ConfirmedTracksDocument {
     pub idfn: u64,
     /// Ground-truth object frames.
     pub gt_object_frames: u64,
-    /// Rows taken by confirmed tracks.
+    /// (Frame, track) pairs of confirmed tracks.
     pub estimated_object_frames: u64,
     /// Confirmed tracks.
     pub tracks: u64,
@@ -202,6 +202,14 @@ pub struct ConfirmedTracksDocument {
     pub false_tracks: u64,
     /// False tracks per minute of data.
     pub false_tracks_per_minute: Option<f64>,
+    /// Confirmed tracks per ground-truth object frame (estimated over ground-truth object
+    /// frames).
+    pub tracks_per_object_frame: Option<f64>,
+    /// Confirmed tracks whose first measurement was a multipath ghost.
+    pub ghost_born_tracks: u64,
+    /// Their share of the confirmed tracks; `None` where the data do not say which
+    /// measurements are ghosts.
+    pub ghost_born_share: Option<f64>,
     /// Fragmentations.
     pub fragmentations: u64,
     /// Rows without a ground-truth object (clutter).
@@ -226,6 +234,9 @@ impl From<&ConfirmedTrackCounts> for ConfirmedTracksDocument {
             tracks: counts.confirmed_tracks,
             false_tracks: counts.false_tracks,
             false_tracks_per_minute: counts.false_tracks_per_minute(),
+            tracks_per_object_frame: counts.tracks_per_object_frame(),
+            ghost_born_tracks: counts.ghost_born_tracks,
+            ghost_born_share: counts.ghost_born_share(),
             fragmentations: counts.fragmentations,
             clutter_rows: counts.clutter_rows,
             clutter_rows_in_confirmed_tracks: counts.clutter_rows_in_confirmed_tracks,

@@ -129,6 +129,7 @@ mod tests {
                 measured: glam::DVec2::ZERO,
                 true_position: None,
                 true_velocity: None,
+                origin: None,
                 track_id: None,
                 prior: None,
                 velocity: None,

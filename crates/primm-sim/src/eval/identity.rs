@@ -1,24 +1,26 @@
 //! Identity metrics: ID switches (IDSW) and IDF1 (`eq:idf1`), as defined in the paper's
 //! Section IV-A "Evaluation Metrics".
 //!
-//! A ground-truth object frame is a row with a ground-truth id; an estimated object frame is a
-//! row whose measurement a track consumed. A ground-truth object and a track are *matched* in a
-//! row when that row carries both ids.
+//! A ground-truth object frame is a (frame, ground-truth id) pair with at least one row; an
+//! estimated object frame is a (frame, track) pair with at least one row whose measurement the
+//! track consumed. A ground-truth object and a track are *matched* in a frame when a row of that
+//! frame carries both ids. An object seen with several detections in one frame is one object
+//! frame, and a track that took several detections of one frame is one estimated object frame;
+//! with one measurement per object and frame and one per track and frame, object frames are rows.
 //!
-//! * **IDSW**: for every ground-truth id, rows are visited in frame order while remembering the
-//!   track most recently matched to it. A matched row whose track differs from the remembered one
-//!   adds one switch. Unmatched rows (no track) leave the memory unchanged, so a gap followed by
-//!   the same track is no switch, and returning to an older track after a switch is another one.
-//! * **IDF1**: per sequence, an overlap matrix counts the rows in which each (ground truth, track)
-//!   pair is matched. A one-to-one assignment between ground-truth ids and track ids that
+//! * **IDSW**: for every ground-truth id, frames are visited in order while remembering the
+//!   track most recently matched to it. A frame whose matched tracks do not include the
+//!   remembered one adds one switch, to the track that took most of the object's rows in that
+//!   frame (the earliest row's on a tie). Frames without a match leave the memory unchanged, so
+//!   a gap followed by the same track is no switch, and returning to an older track after a
+//!   switch is another one.
+//! * **IDF1**: per sequence, an overlap matrix counts the frames in which each (ground truth,
+//!   track) pair is matched. A one-to-one assignment between ground-truth ids and track ids that
 //!   maximises the total overlap gives IDTP; IDFP is the number of estimated object frames minus
 //!   IDTP and IDFN the number of ground-truth object frames minus IDTP. Counts are summed over
 //!   sequences ([`IdentityCounts::merge`]) before `IDF1 = 2 IDTP / (2 IDTP + IDFP + IDFN)`.
-//!
-//! Rows are counted one by one; with the usual one measurement per object and frame and one
-//! measurement per track and frame this equals counting object frames.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, BTreeSet};
 
 use pathfinding::kuhn_munkres::kuhn_munkres;
 use pathfinding::matrix::Matrix;
@@ -29,9 +31,9 @@ use super::record::{time_order, AssociationRecord};
 /// Identity counts of one or more sequences; they add up over sequences.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct IdentityCounts {
-    /// Rows with a ground-truth id.
+    /// (Frame, ground-truth id) pairs with a row.
     pub gt_object_frames: u64,
-    /// Rows consumed by a track.
+    /// (Frame, track) pairs with a row the track consumed.
     pub estimated_object_frames: u64,
     /// Overlap of the optimal one-to-one ground truth/track assignment.
     pub idtp: u64,
@@ -62,21 +64,48 @@ impl IdentityCounts {
     }
 }
 
-/// Indices of the rows of one sequence at which an ID switch happens, in time order.
+/// Indices of the rows of one sequence at which an ID switch happens, in time order: per switch,
+/// the first row (in input order) of the frame's new track among the object's rows.
 pub fn id_switch_rows(records: &[AssociationRecord]) -> Vec<usize> {
-    let mut last_track: HashMap<u64, u64> = HashMap::new();
-    let mut switches = Vec::new();
+    // Per ground-truth object and frame, the matched rows in input order.
+    let mut matches: BTreeMap<u64, BTreeMap<u64, Vec<usize>>> = BTreeMap::new();
     for index in time_order(records) {
         let record = &records[index];
-        let (Some(gt), Some(track)) = (record.ground_truth_id, record.track_id) else {
-            continue;
-        };
-        if let Some(previous) = last_track.insert(gt, track) {
-            if previous != track {
-                switches.push(index);
-            }
+        if let (Some(gt), Some(_)) = (record.ground_truth_id, record.track_id) {
+            matches.entry(gt).or_default().entry(record.frame).or_default().push(index);
         }
     }
+    let mut switches = Vec::new();
+    for frames in matches.values() {
+        let mut last_track: Option<u64> = None;
+        for rows in frames.values() {
+            // The frame's tracks with their row count and first row, in order of first row
+            // (the rows of a frame are in input order).
+            let mut tracks: Vec<(u64, usize, usize)> = Vec::new();
+            for &index in rows {
+                let track = records[index].track_id.expect("a matched row has a track");
+                match tracks.iter_mut().find(|(t, _, _)| *t == track) {
+                    Some(entry) => entry.1 += 1,
+                    None => tracks.push((track, 1, index)),
+                }
+            }
+            if tracks.iter().any(|(track, _, _)| Some(*track) == last_track) {
+                continue;
+            }
+            // The track with most rows; the earliest on a tie.
+            let mut best = tracks[0];
+            for &candidate in &tracks[1..] {
+                if candidate.1 > best.1 {
+                    best = candidate;
+                }
+            }
+            if last_track.is_some() {
+                switches.push(best.2);
+            }
+            last_track = Some(best.0);
+        }
+    }
+    switches.sort_by_key(|&index| (records[index].frame, index));
     switches
 }
 
@@ -95,25 +124,33 @@ pub fn identity_counts(records: &[AssociationRecord]) -> IdentityCounts {
 ///
 /// * Switches are detected over the whole sequence, so the memory of the most recent track also
 ///   sees rows outside the subset; a switch counts when the row where it happens is selected.
-/// * IDF1 counts use only the selected rows: their ground-truth and estimated object frames and
-///   an overlap matrix built from them.
+/// * IDF1 counts use only the selected rows: the ground-truth and estimated object frames they
+///   hold and an overlap matrix built from them.
 ///
 /// # Panics
 /// When `in_subset` does not have one flag per row.
 pub fn identity_counts_subset(records: &[AssociationRecord], in_subset: &[bool]) -> IdentityCounts {
     assert_eq!(records.len(), in_subset.len(), "one subset flag per row is required");
     let mut counts = IdentityCounts::default();
-    let mut overlap: BTreeMap<(u64, u64), u64> = BTreeMap::new();
+    let mut object_frames: BTreeSet<(u64, u64)> = BTreeSet::new();
+    let mut track_frames: BTreeSet<(u64, u64)> = BTreeSet::new();
+    let mut matched_frames: BTreeSet<(u64, u64, u64)> = BTreeSet::new();
     for (record, _) in records.iter().zip(in_subset).filter(|(_, &selected)| selected) {
-        if record.ground_truth_id.is_some() {
-            counts.gt_object_frames += 1;
+        if let Some(gt) = record.ground_truth_id {
+            object_frames.insert((record.frame, gt));
         }
-        if record.track_id.is_some() {
-            counts.estimated_object_frames += 1;
+        if let Some(track) = record.track_id {
+            track_frames.insert((record.frame, track));
         }
         if let (Some(gt), Some(track)) = (record.ground_truth_id, record.track_id) {
-            *overlap.entry((gt, track)).or_insert(0) += 1;
+            matched_frames.insert((gt, track, record.frame));
         }
+    }
+    counts.gt_object_frames = object_frames.len() as u64;
+    counts.estimated_object_frames = track_frames.len() as u64;
+    let mut overlap: BTreeMap<(u64, u64), u64> = BTreeMap::new();
+    for (gt, track, _) in matched_frames {
+        *overlap.entry((gt, track)).or_insert(0) += 1;
     }
     counts.idtp = max_total_overlap(&overlap);
     counts.idfp = counts.estimated_object_frames - counts.idtp;
@@ -323,6 +360,50 @@ mod tests {
         // one-to-one assignment keeps one of them → IDTP 1, IDFP 1, IDFN 1.
         let counts = identity_counts_subset(&records, &[true, false, false, true]);
         assert_eq!((counts.idsw, counts.idtp, counts.idfp, counts.idfn), (0, 1, 1, 1));
+    }
+
+    #[test]
+    fn several_detections_of_one_object_in_one_frame_are_one_object_frame() {
+        // Object 1 in frames 0..=2 with three detections each, all taken by track 7; object 2
+        // once in frame 1 with two detections, neither taken; a clutter detection in frame 2
+        // taken by track 7 too.
+        let mut records = Vec::new();
+        for frame in 0..3 {
+            records.extend((0..3).map(|_| row(frame, Some(1), Some(7))));
+        }
+        records.extend([row(1, Some(2), None), row(1, Some(2), None), row(2, None, Some(7))]);
+        let counts = identity_counts(&records);
+        assert_eq!(counts.gt_object_frames, 4, "three frames of object 1, one of object 2");
+        assert_eq!(counts.estimated_object_frames, 3, "track 7 in three frames");
+        assert_eq!((counts.idtp, counts.idfp, counts.idfn, counts.idsw), (3, 0, 1, 0));
+        assert!((counts.idf1().unwrap() - 6.0 / 7.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_frame_that_still_holds_the_remembered_track_is_no_switch() {
+        // Object 1: frame 0 track 5; frame 1 tracks 6, 6 and 5 (5 still follows it); frame 2
+        // tracks 6 and 6: a switch to 6 there; frame 3 tracks 8, 9, 9: a switch to 9, the
+        // track with most of its rows, at its first row.
+        let records = vec![
+            row(0, Some(1), Some(5)),
+            row(1, Some(1), Some(6)),
+            row(1, Some(1), Some(6)),
+            row(1, Some(1), Some(5)),
+            row(2, Some(1), Some(6)),
+            row(2, Some(1), Some(6)),
+            row(3, Some(1), Some(8)),
+            row(3, Some(1), Some(9)),
+            row(3, Some(1), Some(9)),
+        ];
+        assert_eq!(id_switch_rows(&records), vec![4, 7]);
+        // Tracks 5 and 6 both match object 1 in frame 1: the duplicate is an identity false
+        // positive, the object frame one true positive.
+        let counts = identity_counts(&records);
+        assert_eq!((counts.gt_object_frames, counts.estimated_object_frames), (4, 6));
+        assert_eq!((counts.idtp, counts.idfp, counts.idfn), (2, 4, 2));
+        // On a tie the earliest row's track wins.
+        let tie = vec![row(0, Some(1), Some(5)), row(1, Some(1), Some(4)), row(1, Some(1), Some(3))];
+        assert_eq!(id_switch_rows(&tie), vec![1]);
     }
 
     /// Exhaustive optimum over all injective maps from ground-truth rows to track columns.

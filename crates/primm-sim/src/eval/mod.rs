@@ -44,7 +44,8 @@ pub mod sensor_truth;
 pub mod velocity;
 
 pub use confirmed::{
-    confirmed_track_counts, tracks_born_of_clutter, ConfirmedTrackCounts, UnknownTrackStatus,
+    confirmed_track_counts, tracks_born_of_clutter, tracks_born_of_ghosts, ConfirmedTrackCounts,
+    UnknownTrackStatus,
 };
 pub use document::ReportDocument;
 pub use dropout::{sequence_seed, DropoutMask};
@@ -58,7 +59,10 @@ pub use identity::{
 pub use interaction::{interaction_flags, InteractionFlags, InteractionRules};
 pub use modes::{ModeProbabilityAccumulator, MODE_NAMES};
 pub use plots::{TrajectoryPanel, TrajectoryPlotOptions, TrajectoryPoint};
-pub use record::{counts_as_confirmed, AssociationRecord, EvalError, Method};
+pub use record::{
+    counts_as_confirmed, ground_truth_frame_rows, object_classes, object_frame_rows, AssociationRecord,
+    EvalError, Method,
+};
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;
 pub use scenario::{classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules};

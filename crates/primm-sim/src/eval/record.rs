@@ -3,6 +3,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use crate::io::MeasurementOrigin;
 use primm_core::measurement::ObjectClass;
 use primm_core::readable_number::readable;
 use primm_core::track::TrackStatus;
@@ -34,6 +35,10 @@ pub struct AssociationRecord {
     /// knows it (simulation), m/s.
     #[serde(default)]
     pub true_velocity: Option<DVec2>,
+    /// What produced the measurement (object, clutter or multipath ghost), where the data
+    /// source knows it; `None` when unknown.
+    #[serde(default)]
+    pub origin: Option<MeasurementOrigin>,
     /// Track that this measurement updated or started; `None` when no track took it.
     pub track_id: Option<u64>,
     /// The track's fused one-step prior position before this update (`eq:prior_fusion` for the
@@ -104,6 +109,71 @@ pub enum EvalError {
     Json(#[from] serde_json::Error),
 }
 
+/// For each row of one sequence, whether it stands for its object frame in the metrics that are
+/// computed row by row (prior RMSE, velocity errors, mode probabilities): the first row, in
+/// input order, of its frame with its ground-truth id and track. With several detections of one
+/// object in one frame taken by one track, the track's prior, velocity and mode probabilities
+/// are those of one update, counted once. A row with neither a ground-truth id nor a track stands
+/// for itself.
+pub fn object_frame_rows(records: &[AssociationRecord]) -> Vec<bool> {
+    first_rows(records, |r| {
+        (r.ground_truth_id.is_some() || r.track_id.is_some()).then_some((
+            r.frame,
+            r.ground_truth_id,
+            r.track_id,
+        ))
+    })
+}
+
+/// For each row of one sequence, whether it is the first row, in input order, of its frame with
+/// its ground-truth id (`false` for rows without one): one per ground-truth object frame.
+pub fn ground_truth_frame_rows(records: &[AssociationRecord]) -> Vec<bool> {
+    let first = first_rows(records, |r| r.ground_truth_id.map(|gt| (r.frame, Some(gt), None)));
+    first.into_iter().zip(records).map(|(first, r)| first && r.ground_truth_id.is_some()).collect()
+}
+
+/// The class each row of one sequence is scored under in the per-class metrics: for a row of a
+/// ground-truth object the class most of that object's rows carry (on a tie the class of its
+/// first row in input order), since a detection-level radar labels single detections wrongly now
+/// and then; for a row without one its own class. With one label per object, every row keeps its
+/// own.
+pub fn object_classes(records: &[AssociationRecord]) -> Vec<ObjectClass> {
+    // Per object: its classes with their row counts, in order of first appearance.
+    let mut votes: std::collections::HashMap<u64, Vec<(ObjectClass, usize)>> =
+        std::collections::HashMap::new();
+    for record in records {
+        if let Some(gt) = record.ground_truth_id {
+            let classes = votes.entry(gt).or_default();
+            match classes.iter_mut().find(|(class, _)| *class == record.class) {
+                Some(entry) => entry.1 += 1,
+                None => classes.push((record.class, 1)),
+            }
+        }
+    }
+    let majority: std::collections::HashMap<u64, ObjectClass> = votes
+        .into_iter()
+        .map(|(gt, classes)| {
+            let mut best = classes[0];
+            for &candidate in &classes[1..] {
+                if candidate.1 > best.1 {
+                    best = candidate;
+                }
+            }
+            (gt, best.0)
+        })
+        .collect();
+    records.iter().map(|r| r.ground_truth_id.map_or(r.class, |gt| majority[&gt])).collect()
+}
+
+/// Whether each row is the first with its key; rows without a key are always first.
+fn first_rows(
+    records: &[AssociationRecord],
+    key: impl Fn(&AssociationRecord) -> Option<(u64, Option<u64>, Option<u64>)>,
+) -> Vec<bool> {
+    let mut seen = std::collections::HashSet::new();
+    records.iter().map(|record| key(record).is_none_or(|key| seen.insert(key))).collect()
+}
+
 /// Row indices of one sequence in time order: sorted by frame, ties kept in input order.
 pub(crate) fn time_order(records: &[AssociationRecord]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..records.len()).collect();
@@ -125,6 +195,7 @@ pub(crate) mod test_support {
             measured: DVec2::ZERO,
             true_position: None,
             true_velocity: None,
+            origin: None,
             track_id: track,
             prior: None,
             velocity: None,
@@ -143,6 +214,7 @@ pub(crate) mod test_support {
             measured: position,
             true_position: Some(position),
             true_velocity: None,
+            origin: None,
             track_id: Some(gt),
             prior: None,
             velocity: None,
@@ -192,6 +264,44 @@ mod tests {
         assert_eq!(row.reference_position(), DVec2::new(1.0, 2.0));
         row.true_position = Some(DVec2::new(3.0, 4.0));
         assert_eq!(row.reference_position(), DVec2::new(3.0, 4.0));
+    }
+
+    #[test]
+    fn one_row_stands_for_each_object_frame_and_track() {
+        let rows = [
+            test_support::identity_row(0, Some(1), Some(7)),
+            test_support::identity_row(0, Some(1), Some(7)),
+            test_support::identity_row(0, Some(1), Some(8)),
+            test_support::identity_row(0, Some(1), None),
+            test_support::identity_row(1, Some(1), Some(7)),
+            test_support::identity_row(1, None, Some(7)),
+            test_support::identity_row(1, None, Some(7)),
+            test_support::identity_row(1, None, None),
+            test_support::identity_row(1, None, None),
+        ];
+        assert_eq!(object_frame_rows(&rows), [true, false, true, true, true, true, false, true, true]);
+        assert_eq!(
+            ground_truth_frame_rows(&rows),
+            [true, false, false, false, true, false, false, false, false]
+        );
+    }
+
+    #[test]
+    fn a_row_is_scored_under_its_objects_majority_class() {
+        let labelled =
+            |gt: Option<u64>, class| AssociationRecord { class, ..test_support::identity_row(0, gt, None) };
+        let (car, pedestrian) = (ObjectClass::Car, ObjectClass::Pedestrian);
+        let rows = [
+            labelled(Some(1), car),
+            labelled(Some(1), pedestrian),
+            labelled(Some(1), car),
+            labelled(Some(2), pedestrian),
+            labelled(Some(2), car),
+            labelled(None, pedestrian),
+        ];
+        // Object 1: two car labels against one; object 2: a tie, its first row's class; the
+        // row without an object keeps its own label.
+        assert_eq!(object_classes(&rows), [car, car, car, pedestrian, pedestrian, pedestrian]);
     }
 
     #[test]

@@ -291,7 +291,9 @@ impl ScenarioRules {
 }
 
 /// Motion label of every row of one sequence (`None`: no ground-truth id, too little history, or
-/// no rule matches). The result has one entry per row, in input order.
+/// no rule matches). The result has one entry per row, in input order. The window holds one row
+/// per frame of the object, its first in input order; the object's other rows of that frame
+/// (several detections of it) take that row's label.
 pub fn classify_sequence(
     records: &[AssociationRecord],
     rules: &ScenarioRules,
@@ -303,6 +305,10 @@ pub fn classify_sequence(
             continue;
         };
         let rows = history.entry(gt).or_default();
+        if let Some(&last) = rows.last().filter(|&&last| records[last].frame == records[index].frame) {
+            labels[index] = labels[last];
+            continue;
+        }
         rows.push(index);
         if rows.len() < rules.window_len {
             continue;
@@ -488,6 +494,26 @@ mod tests {
             .filter(|(row, label)| row.ground_truth_id == Some(2) && label.is_some())
             .count();
         assert_eq!(object2_labelled, 0);
+    }
+
+    #[test]
+    fn several_rows_of_an_object_in_one_frame_fill_one_place_of_the_window_and_share_its_label() {
+        // Object 1 moves straight for 12 frames with three detections in every frame.
+        let mut records = Vec::new();
+        for (k, position) in arc(10.0, 0.0, 12).into_iter().enumerate() {
+            for offset in [0.0, 0.5, -0.5] {
+                let mut row = position_row(k as u64, k as f64 * DT, 1, position);
+                row.measured += DVec2::Y * offset;
+                records.push(row);
+            }
+        }
+        let labels = classify_sequence(&records, &ScenarioRules::default());
+        // Ten frames make a window, as with one row per frame: frames 9, 10 and 11 are labelled,
+        // every row of them.
+        for (row, label) in records.iter().zip(&labels) {
+            let expected = (row.frame >= 9).then_some(MotionScenario::Straight);
+            assert_eq!(*label, expected, "frame {}", row.frame);
+        }
     }
 
     #[test]

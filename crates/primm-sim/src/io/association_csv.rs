@@ -93,14 +93,6 @@ pub enum AssociationCsvError {
         /// Measurement position.
         measurement: u16,
     },
-    /// One track took two measurements of the same frame.
-    #[error("frame {frame}: track {track_id} took more than one measurement")]
-    TrackTwiceInFrame {
-        /// Frame index.
-        frame: u64,
-        /// The track.
-        track_id: u64,
-    },
 }
 
 /// Writes association rows.
@@ -234,7 +226,8 @@ pub fn read_association_rows<R: Read>(reader: R) -> Result<Vec<AssociationRow>, 
 
 /// The evaluation records of `sequence` (one per measurement, as `primm eval` builds them)
 /// with the track, prior and track status of each measurement taken from `rows`. Measurements
-/// without a row were taken by no track.
+/// without a row were taken by no track. A track may take several measurements of one frame (a
+/// tracker that groups a radar's detections); the metrics count it once per frame.
 pub fn association_records_from_rows(
     sequence: &Sequence,
     rows: &[AssociationRow],
@@ -248,7 +241,6 @@ pub fn association_records_from_rows(
         }
     }
     let mut seen = vec![false; records.len()];
-    let mut tracks_in_frame: HashMap<(u64, u64), ()> = HashMap::new();
     for row in rows {
         let Some(&i) = index.get(&(row.frame, row.measurement)) else {
             return Err(AssociationCsvError::UnknownMeasurement {
@@ -259,11 +251,6 @@ pub fn association_records_from_rows(
         };
         if std::mem::replace(&mut seen[i], true) {
             return Err(AssociationCsvError::Duplicate { frame: row.frame, measurement: row.measurement });
-        }
-        if let Some(track_id) = row.track_id {
-            if tracks_in_frame.insert((row.frame, track_id), ()).is_some() {
-                return Err(AssociationCsvError::TrackTwiceInFrame { frame: row.frame, track_id });
-            }
         }
         records[i].track_id = row.track_id;
         records[i].prior = row.prior_m.filter(|_| row.track_id.is_some());
@@ -295,6 +282,7 @@ mod tests {
                     },
                     true_position: None,
                     true_velocity: None,
+                    origin: None,
                 });
             }
             sequence.frames.push(frame);
@@ -380,16 +368,18 @@ mod tests {
     }
 
     #[test]
-    fn a_measurement_listed_twice_or_a_track_taking_two_measurements_of_a_frame_is_refused() {
+    fn a_measurement_listed_twice_is_refused_and_a_track_may_take_several_of_a_frame() {
         let twice = rows("0,0,1,,,1\n0,0,2,,,1\n").unwrap();
         assert!(matches!(
             association_records_from_rows(&sequence(), &twice),
             Err(AssociationCsvError::Duplicate { .. })
         ));
-        let greedy = rows("0,0,1,,,1\n0,1,1,,,1\n").unwrap();
-        assert!(matches!(
-            association_records_from_rows(&sequence(), &greedy),
-            Err(AssociationCsvError::TrackTwiceInFrame { frame: 0, track_id: 1 })
-        ));
+        // A tracker that groups detections: track 1 takes both measurements of frame 0.
+        let grouped = rows("0,0,1,,,1\n0,1,1,,,1\n").unwrap();
+        let records = association_records_from_rows(&sequence(), &grouped).unwrap();
+        assert_eq!((records[0].track_id, records[1].track_id), (Some(1), Some(1)));
+        // Two objects, one track: one estimated object frame, matched to one of them.
+        let counts = crate::eval::identity_counts(&records);
+        assert_eq!((counts.gt_object_frames, counts.estimated_object_frames, counts.idtp), (4, 1, 1));
     }
 }

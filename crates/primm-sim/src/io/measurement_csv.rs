@@ -6,10 +6,10 @@
 //! frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw
 //! ```
 //!
-//! followed by `true_vx,true_vy`. The first ten columns are required; `sensor_id`, `ego_x`,
-//! `ego_y`, `ego_yaw`, `true_vx` and `true_vy` are optional and unknown columns are ignored. The
-//! reader finds columns by name, so their order does not matter; the writer always writes all
-//! sixteen in the order above.
+//! followed by `true_vx,true_vy,origin`. The first ten columns are required; `sensor_id`,
+//! `ego_x`, `ego_y`, `ego_yaw`, `true_vx`, `true_vy` and `origin` are optional and unknown
+//! columns are ignored. The reader finds columns by name, so their order does not matter; the
+//! writer always writes all seventeen in the order above.
 //!
 //! * `frame`: 0-based frame index, non-decreasing from row to row; all rows of one frame are
 //!   consecutive and a larger index starts a new frame. Indices may skip values.
@@ -26,10 +26,12 @@
 //!   none (frame-level).
 //! * `true_vx`, `true_vy`: true velocity over ground of the object's centre in the car frame's
 //!   axes, m/s, or both empty.
+//! * `origin`: what produced the measurement, where known: `object` (a real object), `clutter`
+//!   or `ghost` (a multipath ghost); empty when unknown.
 //!
 //! A frame without measurements is written as one *empty-frame row*: `frame`, `t` and the
 //! frame-level columns filled, every measurement column (`gt_id` … `true_y`, `true_vx`,
-//! `true_vy`) empty. Such a row must be the only row of its frame.
+//! `true_vy`, `origin`) empty. Such a row must be the only row of its frame.
 //!
 //! Floats are written with Rust's shortest representation that parses back to the same `f64`,
 //! so a write/read round trip is exact. Lines starting with `#` are comments.
@@ -40,7 +42,7 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec2;
 
-use super::recording::{EgoPose, RecordedFrame, RecordedMeasurement, Sequence};
+use super::recording::{EgoPose, MeasurementOrigin, RecordedFrame, RecordedMeasurement, Sequence};
 use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use primm_core::readable_number::readable;
 
@@ -53,6 +55,10 @@ pub const OPTIONAL_COLUMNS: [&str; 4] = ["sensor_id", "ego_x", "ego_y", "ego_yaw
 
 /// Optional measurement columns understood by the reader: the true velocity, m/s.
 pub const TRUE_VELOCITY_COLUMNS: [&str; 2] = ["true_vx", "true_vy"];
+
+/// Optional measurement column understood by the reader: what produced the measurement
+/// (`object`, `clutter`, `ghost`, or empty when unknown).
+pub const ORIGIN_COLUMN: &str = "origin";
 
 /// Columns holding measurement values; all empty on an empty-frame row.
 const MEASUREMENT_COLUMNS: [&str; 8] = ["gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y"];
@@ -81,6 +87,9 @@ pub enum CsvErrorKind {
     /// The class name is not one of the known classes.
     #[error("unknown object class `{0}` (expected `car`, `pedestrian` or `two_wheeler`, or one of their names in docs/scenario.md)")]
     UnknownClass(String),
+    /// The `origin` value is not one of `object`, `clutter`, `ghost` (or empty).
+    #[error("unknown origin `{0}` (expected `object`, `clutter`, `ghost` or an empty field)")]
+    UnknownOrigin(String),
     /// A value required on this row is empty.
     #[error("missing value")]
     MissingValue,
@@ -231,6 +240,7 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
         .iter()
         .chain(OPTIONAL_COLUMNS.iter())
         .chain(TRUE_VELOCITY_COLUMNS.iter())
+        .chain(std::iter::once(&ORIGIN_COLUMN))
         .copied()
         .collect();
     out.write_record(&header).map_err(CsvError::from_csv)?;
@@ -262,7 +272,7 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
             row.extend(std::iter::repeat_n(String::new(), MEASUREMENT_COLUMNS.len()));
             row.push(sensor.clone());
             row.extend(ego.iter().cloned());
-            row.extend(std::iter::repeat_n(String::new(), TRUE_VELOCITY_COLUMNS.len()));
+            row.extend(std::iter::repeat_n(String::new(), TRUE_VELOCITY_COLUMNS.len() + 1));
             out.write_record(&row).map_err(CsvError::from_csv)?;
             continue;
         }
@@ -290,6 +300,7 @@ pub fn write_sequence<W: Write>(writer: W, sequence: &Sequence) -> Result<(), Cs
                 ego[2].clone(),
                 fmt_opt_f64(recorded.true_velocity.map(|v| v.x)).map_err(|k| fail(line, k))?,
                 fmt_opt_f64(recorded.true_velocity.map(|v| v.y)).map_err(|k| fail(line, k))?,
+                recorded.origin.map(MeasurementOrigin::name).unwrap_or_default().to_owned(),
             ];
             out.write_record(&row).map_err(CsvError::from_csv)?;
         }
@@ -313,6 +324,7 @@ struct Columns {
     sensor_id: Option<usize>,
     ego: [Option<usize>; 3],
     true_velocity: [Option<usize>; 2],
+    origin: Option<usize>,
 }
 
 impl Columns {
@@ -343,6 +355,7 @@ impl Columns {
             sensor_id: find("sensor_id")?,
             ego: [find("ego_x")?, find("ego_y")?, find("ego_yaw")?],
             true_velocity: [find("true_vx")?, find("true_vy")?],
+            origin: find(ORIGIN_COLUMN)?,
         })
     }
 }
@@ -453,8 +466,8 @@ impl RowParser<'_> {
         if class_text.is_empty() {
             // An empty-frame row: every measurement column must be empty.
             let indices = [c_gt, c_class, c_x, c_y, c_vr, c_rcs, c_tx, c_ty];
-            let velocity = columns.true_velocity.iter().flatten();
-            if indices.iter().chain(velocity).any(|&index| !self.field(index).is_empty()) {
+            let optional = columns.true_velocity.iter().chain(std::iter::once(&columns.origin)).flatten();
+            if indices.iter().chain(optional).any(|&index| !self.field(index).is_empty()) {
                 return Err(self.error("class", CsvErrorKind::MissingValue));
             }
             return Ok(None);
@@ -486,9 +499,21 @@ impl RowParser<'_> {
             }
         };
         let true_velocity = self.true_velocity(columns.true_velocity)?;
+        let origin = self.origin(columns.origin)?;
         let measurement =
             Measurement { x_m, y_m, radial_velocity_mps, rcs_dbsm, class, sensor_id, ground_truth_id };
-        Ok(Some(RecordedMeasurement { measurement, true_position, true_velocity }))
+        Ok(Some(RecordedMeasurement { measurement, true_position, true_velocity, origin }))
+    }
+
+    /// The optional `origin` column: empty (or absent) when unknown.
+    fn origin(&self, index: Option<usize>) -> Result<Option<MeasurementOrigin>, CsvError> {
+        let text = index.map_or("", |index| self.field(index));
+        if text.is_empty() {
+            return Ok(None);
+        }
+        MeasurementOrigin::from_name(text)
+            .map(Some)
+            .ok_or_else(|| self.error(ORIGIN_COLUMN, CsvErrorKind::UnknownOrigin(text.to_owned())))
     }
 
     /// The optional `true_vx, true_vy` group: both or neither (absent columns count as empty).
@@ -658,7 +683,7 @@ mod tests {
     const HEADER: &str = "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw\n";
     /// The header the writer writes.
     const WRITTEN_HEADER: &str =
-        "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw,true_vx,true_vy\n";
+        "frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y,sensor_id,ego_x,ego_y,ego_yaw,true_vx,true_vy,origin\n";
 
     fn measurement(class: ObjectClass, id: Option<u64>, x: f64) -> RecordedMeasurement {
         RecordedMeasurement {
@@ -673,6 +698,7 @@ mod tests {
             },
             true_position: id.map(|_| DVec2::new(x + 0.1, 0.7)),
             true_velocity: id.map(|_| DVec2::new(-13.25, 1.0 / 7.0)),
+            origin: Some(if id.is_some() { MeasurementOrigin::Object } else { MeasurementOrigin::Ghost }),
         }
     }
 
@@ -715,7 +741,8 @@ mod tests {
         assert!(text.starts_with(WRITTEN_HEADER));
         // The empty frame is one row with empty measurement fields.
         assert!(text.lines().any(|l| l.starts_with("1,0.0213,,,,,,,,,1,")), "{text}");
-        assert!(text.lines().any(|l| l.ends_with(",-13.25,0.14285714285714285")), "{text}");
+        assert!(text.lines().any(|l| l.ends_with(",-13.25,0.14285714285714285,object")), "{text}");
+        assert!(text.lines().any(|l| l.ends_with(",,,ghost")), "{text}");
         let back = read_sequence(text.as_bytes(), "sample").unwrap();
         assert_eq!(back, sequence);
         assert!(back.frames[1].measurements.is_empty());
@@ -756,15 +783,54 @@ mod tests {
         assert_eq!(measurements[0].true_velocity, Some(DVec2::new(8.25, -0.5)));
         assert_eq!(measurements[1].true_velocity, None);
         // Both or neither.
-        let err = read_err(&format!("{}0,0,3,car,1,2,3,4,5,6,,,,,1.5,\n", WRITTEN_HEADER));
+        let err = read_err(&format!("{}0,0,3,car,1,2,3,4,5,6,,,,,1.5,,\n", WRITTEN_HEADER));
         assert!(matches!(err.kind, CsvErrorKind::IncompleteGroup(_)));
         assert_eq!(err.column.as_deref(), Some("true_vy"));
-        let err = read_err(&format!("{}0,0,3,car,1,2,3,4,5,6,,,,,abc,1\n", WRITTEN_HEADER));
+        let err = read_err(&format!("{}0,0,3,car,1,2,3,4,5,6,,,,,abc,1,\n", WRITTEN_HEADER));
         assert!(matches!(err.kind, CsvErrorKind::BadNumber(_)));
         assert_eq!(err.column.as_deref(), Some("true_vx"));
         // An empty-frame row leaves them empty too.
-        let err = read_err(&format!("{}0,0,,,,,,,,,,,,,1,2\n", WRITTEN_HEADER));
+        let err = read_err(&format!("{}0,0,,,,,,,,,,,,,1,2,\n", WRITTEN_HEADER));
         assert_eq!(err.column.as_deref(), Some("class"));
+    }
+
+    #[test]
+    fn the_origin_column_is_optional_read_by_name_and_checked() {
+        // Files without the column (older files, converted recordings): origin unknown.
+        let sequence = read_sequence(format!("{HEADER}0,0,3,car,1,2,3,4,5,6,,,,\n").as_bytes(), "x").unwrap();
+        assert_eq!(sequence.frames[0].measurements[0].origin, None);
+        let text = "origin,frame,t,gt_id,class,x,y,vr,rcs,true_x,true_y\n\
+                    ghost,0,0.1,-1,car,1,2,3,4,,\n\
+                    clutter,0,0.1,-1,pedestrian,1,2,3,4,,\n\
+                    object,0,0.1,5,car,1,2,3,4,,\n\
+                    ,0,0.1,6,car,1,2,3,4,,\n";
+        let origins: Vec<Option<MeasurementOrigin>> = read_sequence(text.as_bytes(), "x").unwrap().frames[0]
+            .measurements
+            .iter()
+            .map(|m| m.origin)
+            .collect();
+        assert_eq!(
+            origins,
+            [
+                Some(MeasurementOrigin::Ghost),
+                Some(MeasurementOrigin::Clutter),
+                Some(MeasurementOrigin::Object),
+                None
+            ]
+        );
+        let err = read_err(&format!("{}0,0,3,car,1,2,3,4,5,6,,,,,,,mirror\n", WRITTEN_HEADER));
+        assert!(matches!(err.kind, CsvErrorKind::UnknownOrigin(ref o) if o == "mirror"), "{err}");
+        assert_eq!((err.line, err.column.as_deref()), (Some(2), Some("origin")));
+        // An empty-frame row leaves it empty.
+        let err = read_err(&format!("{}0,0,,,,,,,,,,,,,,,ghost\n", WRITTEN_HEADER));
+        assert_eq!(err.column.as_deref(), Some("class"));
+        // Every origin survives a write and a read.
+        for origin in MeasurementOrigin::ALL.map(Some).into_iter().chain([None]) {
+            let mut sequence = sample();
+            sequence.frames[0].measurements[0].origin = origin;
+            let back = read_sequence(to_text(&sequence).as_bytes(), "sample").unwrap();
+            assert_eq!(back.frames[0].measurements[0].origin, origin);
+        }
     }
 
     #[test]

@@ -13,4 +13,6 @@ pub use measurement_csv::{
     dataset_files, read_dataset_dir, read_sequence, read_sequence_file, write_sequence, write_sequence_file,
     CsvError, CsvErrorKind,
 };
-pub use recording::{EgoPose, RecordedFrame, RecordedMeasurement, Sequence, TooManyMeasurements};
+pub use recording::{
+    EgoPose, MeasurementOrigin, RecordedFrame, RecordedMeasurement, Sequence, TooManyMeasurements,
+};

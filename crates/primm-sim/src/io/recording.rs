@@ -22,6 +22,43 @@ pub struct RecordedMeasurement {
     /// y left), m/s (simulated data only).
     #[serde(default)]
     pub true_velocity: Option<DVec2>,
+    /// What produced the measurement, where the data source knows it (simulation): a real
+    /// object, clutter or a multipath ghost.
+    #[serde(default)]
+    pub origin: Option<MeasurementOrigin>,
+}
+
+/// What produced a measurement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeasurementOrigin {
+    /// A reflection of a real object (its ground-truth id says which).
+    Object,
+    /// A false detection of the static world or of noise: guard rails, poles, kerbs.
+    Clutter,
+    /// A multipath ghost: the mirror image of a real object's reflection in a wall or guard
+    /// rail, or a delayed copy of it farther along the line of sight.
+    Ghost,
+}
+
+impl MeasurementOrigin {
+    /// All origins.
+    pub const ALL: [MeasurementOrigin; 3] =
+        [MeasurementOrigin::Object, MeasurementOrigin::Clutter, MeasurementOrigin::Ghost];
+
+    /// The origin's name in files: `object`, `clutter` or `ghost`.
+    pub fn name(self) -> &'static str {
+        match self {
+            MeasurementOrigin::Object => "object",
+            MeasurementOrigin::Clutter => "clutter",
+            MeasurementOrigin::Ghost => "ghost",
+        }
+    }
+
+    /// The origin called `name` ([`name`](Self::name)), if any.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|origin| origin.name() == name)
+    }
 }
 
 /// One radar scan: its index in the sequence, time, sensor, ego pose and measurements.
@@ -52,6 +89,7 @@ impl RecordedFrame {
             measured: m.measurement.position(),
             true_position: m.true_position,
             true_velocity: m.true_velocity,
+            origin: m.origin,
             track_id: None,
             prior: None,
             velocity: None,

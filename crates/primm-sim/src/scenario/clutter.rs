@@ -36,7 +36,7 @@ use rand_distr::{Distribution, Poisson, StandardNormal};
 
 use super::config::{ClutterConfig, RadarConfig};
 use super::kinematics::wrap_angle;
-use crate::io::RecordedMeasurement;
+use crate::io::{MeasurementOrigin, RecordedMeasurement};
 use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 use primm_core::pose::SensorMount;
 
@@ -90,13 +90,14 @@ fn symmetric(rng: &mut ChaCha12Rng, half_width: f64) -> f64 {
     }
 }
 
-/// A false detection of `mount` at car-frame `position`.
+/// A false detection of `mount` at car-frame `position`, of `origin` clutter or ghost.
 fn false_detection(
     mount: &SensorMount,
     position: DVec2,
     radial_velocity_mps: f64,
     rcs_dbsm: f64,
     class: ObjectClass,
+    origin: MeasurementOrigin,
 ) -> RecordedMeasurement {
     RecordedMeasurement {
         measurement: Measurement {
@@ -110,6 +111,7 @@ fn false_detection(
         },
         true_position: None,
         true_velocity: None,
+        origin: Some(origin),
     }
 }
 
@@ -143,6 +145,7 @@ fn ghost(
         radial_velocity,
         real.rcs_dbsm - clutter.ghost_rcs_drop_db,
         real.class,
+        MeasurementOrigin::Ghost,
     ))
 }
 
@@ -171,7 +174,7 @@ fn clutter_detection(
     } else {
         doppler_bias_mps + radar.doppler_noise_mps * unit_normal(rng)
     };
-    false_detection(mount, position, radial_velocity, rcs, class)
+    false_detection(mount, position, radial_velocity, rcs, class, MeasurementOrigin::Clutter)
 }
 
 /// The range interval of the clutter of `mount`, metres: the configured one, cut at the
@@ -207,6 +210,7 @@ mod tests {
             },
             true_position: Some(position),
             true_velocity: Some(DVec2::ZERO),
+            origin: Some(MeasurementOrigin::Object),
         }
     }
 

@@ -6,7 +6,7 @@ use glam::DVec2;
 use super::config::{ExtendedObjectConfig, Preset, RadarMount, ScenarioConfig};
 use super::kinematics::wrap_angle;
 use super::{GeneratedSequence, ObjectState, ScenarioGenerator, Split};
-use crate::io::{read_sequence_file, RecordedFrame, RecordedMeasurement};
+use crate::io::{read_sequence_file, MeasurementOrigin, RecordedFrame, RecordedMeasurement};
 use primm_core::measurement::ObjectClass;
 use primm_core::pose::SensorMount;
 
@@ -238,8 +238,8 @@ fn extended_vehicles_leave_traffic_and_timing_as_they_are() {
 
 /// The presets without extended objects generate exactly what they generated before the model
 /// existed: the fixtures were written by `primm generate --split evaluation --sequences 1
-/// --duration-s 1.5 --preset P` before extended objects and true velocities were added, so they
-/// hold no velocity columns.
+/// --duration-s 1.5 --preset P` before extended objects, true velocities and origins were
+/// added, so they hold no velocity and no origin columns.
 #[test]
 fn presets_without_extended_objects_are_unchanged() {
     let directory = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/fixtures/presets");
@@ -252,7 +252,10 @@ fn presets_without_extended_objects_are_unchanged() {
         for measurement in generated.frames.iter_mut().flat_map(|f| f.measurements.iter_mut()) {
             let real = measurement.measurement.ground_truth_id.is_some();
             assert_eq!(measurement.true_velocity.is_some(), real, "{preset}");
+            assert_eq!(measurement.origin == Some(MeasurementOrigin::Object), real, "{preset}");
+            assert!(measurement.origin.is_some(), "{preset}: every generated row says where it came from");
             measurement.true_velocity = None;
+            measurement.origin = None;
         }
         assert_eq!(generated.frames, expected.frames, "{preset} changed");
         assert!(expected.measurement_count() > 20, "{preset}: a fixture with too few measurements");

@@ -18,7 +18,10 @@
 //!   objects (see [`ClutterConfig`]);
 //! * optionally, vehicles measured as extended objects: separate detections from the visible
 //!   contour and corners of each vehicle's box, sometimes several per scan (see
-//!   [`ExtendedObjectConfig`]).
+//!   [`ExtendedObjectConfig`]);
+//! * optionally, detection-level output: several detections per object and scan, wheel
+//!   micro-Doppler, multipath ghosts mirrored in the walls along the roads and wrong class labels
+//!   (see [`PointCloudConfig`]).
 //!
 //! Everything is deterministic given the configuration and a seed. See `docs/scenario.md` for
 //! the full model description, its limits, and every parameter.
@@ -40,6 +43,9 @@ mod events;
 mod extended_tests;
 mod kinematics;
 mod path;
+mod point_cloud;
+#[cfg(test)]
+mod point_cloud_tests;
 mod radar;
 mod road;
 #[cfg(test)]
@@ -54,9 +60,9 @@ use serde::{Deserialize, Serialize};
 
 pub use config::{
     CarConfig, ClutterConfig, ConfigError, DriverConfig, EgoConfig, EgoPlacement, ExtendedObjectConfig,
-    Interval, MotionLimits, OutputConfig, PedestrianConfig, Preset, RadarConfig, RadarMount, RadarReport,
-    ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError, SequenceConfig, SplitConfig,
-    TrafficConfig, WalkerConfig, MAX_DETECTIONS_PER_OBJECT,
+    Interval, MotionLimits, OutputConfig, PedestrianConfig, PointCloudConfig, Preset, RadarConfig,
+    RadarMount, RadarReport, ReflectionConfig, RoadConfig, ScenarioConfig, ScenarioTomlError, SequenceConfig,
+    SplitConfig, TrafficConfig, WalkerConfig, MAX_DETECTIONS_PER_OBJECT,
 };
 pub use events::{
     count_events, EventCounts, CLOSE_PROXIMITY_DISTANCE_M, CROSSING_DISTANCE_M,
@@ -79,6 +85,9 @@ const STREAM_CLUTTER: u64 = 4;
 /// Random stream of the extended-object detections of vehicles, so that the point model's
 /// stream, and with it every preset without extended objects, stays as it was.
 const STREAM_EXTENDED: u64 = 5;
+/// Random stream of the point-cloud detections, so that every preset without them stays as it
+/// was.
+const STREAM_POINT_CLOUD: u64 = 6;
 
 /// True state of one object at one frame (world frame).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -226,15 +235,18 @@ impl ScenarioGenerator {
         };
         let mut world = world::World::new(cfg, rng_for(STREAM_WORLD));
         let scans = radar::schedule(&cfg.radar, cfg.sequence.duration_s, &mut rng_for(STREAM_SCHEDULE));
-        let mut sensor_rng = rng_for(STREAM_SENSOR);
+        let mut random = radar::ScanRandom {
+            sensor: rng_for(STREAM_SENSOR),
+            extended: rng_for(STREAM_EXTENDED),
+            point_cloud: rng_for(STREAM_POINT_CLOUD),
+        };
         let mut clutter_rng = rng_for(STREAM_CLUTTER);
-        let mut extended_rng = rng_for(STREAM_EXTENDED);
         let warmup = cfg.sequence.warmup_s;
         let mut sequence = Sequence::new(name);
         let mut truth = Vec::with_capacity(scans.len());
         for (index, scan) in scans.iter().enumerate() {
             world.advance_to(warmup + scan.t);
-            let mut scanned = radar::scan(&world, cfg, scan.sensor, &mut sensor_rng, &mut extended_rng);
+            let mut scanned = radar::scan(&world, cfg, scan.sensor, &mut random);
             clutter::add_false_detections(
                 &cfg.clutter,
                 &cfg.radar,

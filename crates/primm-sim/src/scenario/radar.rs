@@ -29,8 +29,9 @@ use super::config::{
     ExtendedObjectConfig, RadarConfig, RadarMount, RadarReport, ReflectionConfig, ScenarioConfig,
 };
 use super::kinematics::wrap_angle;
+use super::point_cloud::{PointScan, PointTarget};
 use super::world::{Agent, World};
-use crate::io::{EgoPose, RecordedMeasurement};
+use crate::io::{EgoPose, MeasurementOrigin, RecordedMeasurement};
 use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
 
 /// One scheduled scan: time since the start of recording and the index of the sensor in the
@@ -81,7 +82,7 @@ pub(crate) fn sensor_pose(ego: &EgoPose, mount: &RadarMount) -> (DVec2, f64) {
 }
 
 /// Whether the segment from `a` to `b` passes through the box of `agent`.
-fn segment_hits_box(a: DVec2, b: DVec2, agent: &Agent) -> bool {
+pub(super) fn segment_hits_box(a: DVec2, b: DVec2, agent: &Agent) -> bool {
     let dir = agent.kin.direction();
     let to_local = |p: DVec2| {
         let rel = p - agent.kin.position;
@@ -118,17 +119,32 @@ fn segment_hits_box(a: DVec2, b: DVec2, agent: &Agent) -> bool {
 
 /// One scan's sensor: its mount, pose and field of view, and the unit normal its noise is drawn
 /// from.
-struct ScanSensor<'a> {
-    radar: &'a RadarConfig,
-    mount: &'a RadarMount,
-    origin: DVec2,
-    boresight: f64,
-    half_fov: f64,
-    unit: Normal<f64>,
+pub(super) struct ScanSensor<'a> {
+    pub(super) radar: &'a RadarConfig,
+    pub(super) mount: &'a RadarMount,
+    pub(super) origin: DVec2,
+    pub(super) boresight: f64,
+    pub(super) half_fov: f64,
+    pub(super) unit: Normal<f64>,
+}
+
+impl<'a> ScanSensor<'a> {
+    /// The sensor `mount` of `radar` on the ego vehicle at `ego`.
+    fn new(radar: &'a RadarConfig, mount: &'a RadarMount, ego: &EgoPose) -> Self {
+        let (origin, boresight) = sensor_pose(ego, mount);
+        Self {
+            radar,
+            mount,
+            origin,
+            boresight,
+            half_fov: mount.layout.half_fov_rad,
+            unit: Normal::new(0.0, 1.0).expect("unit normal"),
+        }
+    }
 }
 
 /// The box faces of an object turned towards the sensor, weighted by their apparent width.
-struct VisibleFaces {
+pub(super) struct VisibleFaces {
     corners: [DVec2; 4],
     faces: [(usize, f64); 4],
     total: f64,
@@ -151,30 +167,34 @@ pub(crate) struct ScanMeasurements {
     pub doppler_bias_mps: f64,
 }
 
+/// The random streams of the measurement models.
+pub(crate) struct ScanRandom {
+    /// The point model's, the scan's Doppler bias and the order of the detections.
+    pub sensor: ChaCha12Rng,
+    /// The extended-object detections of vehicles.
+    pub extended: ChaCha12Rng,
+    /// The point-cloud detections ([`super::point_cloud`]).
+    pub point_cloud: ChaCha12Rng,
+}
+
 /// Produces the object measurements of one scan of sensor `sensor_index`. The point model draws
-/// from `rng`; the extended-object detections of vehicles, when switched on, from
-/// `extended_rng` alone.
+/// from `random.sensor`; the extended-object detections of vehicles, when switched on, from
+/// `random.extended` alone, and the point-cloud detections from `random.point_cloud` alone.
 pub(crate) fn scan(
     world: &World<'_>,
     cfg: &ScenarioConfig,
     sensor_index: usize,
-    rng: &mut ChaCha12Rng,
-    extended_rng: &mut ChaCha12Rng,
+    random: &mut ScanRandom,
 ) -> ScanMeasurements {
+    let ScanRandom { sensor: rng, extended: extended_rng, point_cloud: point_rng } = random;
     let radar = &cfg.radar;
     let mount = &radar.sensors[sensor_index];
     let ego = world.ego_pose();
-    let (origin, boresight) = sensor_pose(&ego, mount);
-    let sensor = ScanSensor {
-        radar,
-        mount,
-        origin,
-        boresight,
-        half_fov: mount.layout.half_fov_rad,
-        unit: Normal::new(0.0, 1.0).expect("unit normal"),
-    };
+    let sensor = ScanSensor::new(radar, mount, &ego);
+    let origin = sensor.origin;
     let scan_bias = radar.scan_doppler_bias_mps * sensor.unit.sample(rng);
     let mut out = Vec::new();
+    let point_scan = cfg.point_cloud.enabled.then(|| PointScan::new(world, &sensor, cfg, &ego, scan_bias));
 
     for (index, object) in world.agents.iter().enumerate() {
         if object.is_ego {
@@ -191,6 +211,11 @@ pub(crate) fn scan(
             position: ego.world_to_car(object.kin.position),
             velocity: ego.rotate_to_car(object.kin.velocity()),
         };
+        if let Some(point_scan) = &point_scan {
+            let target = PointTarget { index, faces: &faces, range, max_range, truth };
+            point_scan.object_detections(&target, &mut out, point_rng);
+            continue;
+        }
         if cfg.extended_objects.enabled && object.class != ObjectClass::Pedestrian {
             let target = ExtendedTarget { index, faces: &faces, truth, max_range };
             extended_detections(
@@ -228,6 +253,7 @@ pub(crate) fn scan(
             },
             true_position: Some(truth.position),
             true_velocity: Some(truth.velocity),
+            origin: Some(MeasurementOrigin::Object),
         });
     }
     // Detection lists carry no meaningful order.
@@ -237,11 +263,11 @@ pub(crate) fn scan(
 
 /// The true centre and velocity over ground of an object in the car frame of the scan.
 #[derive(Debug, Clone, Copy)]
-struct ObjectTruth {
+pub(super) struct ObjectTruth {
     /// Centre of the box, metres.
-    position: DVec2,
+    pub(super) position: DVec2,
     /// Velocity of the centre over ground, in the car's axes, m/s.
-    velocity: DVec2,
+    pub(super) velocity: DVec2,
 }
 
 /// A vehicle measured as an extended object in one scan.
@@ -337,7 +363,7 @@ impl VisibleContour {
 
 /// The number of detections of one vehicle in one scan, drawn from `probabilities` (entry `k`:
 /// probability of `k + 1` detections; they sum to 1).
-fn detection_count(probabilities: &[f64], rng: &mut ChaCha12Rng) -> usize {
+pub(super) fn detection_count(probabilities: &[f64], rng: &mut ChaCha12Rng) -> usize {
     let mut pick: f64 = rng.random();
     for (k, p) in probabilities.iter().enumerate() {
         if pick < *p {
@@ -396,6 +422,7 @@ fn extended_detections(
             },
             true_position: Some(target.truth.position),
             true_velocity: Some(target.truth.velocity),
+            origin: Some(MeasurementOrigin::Object),
         });
     }
 }
@@ -472,7 +499,7 @@ fn object_echo(
 }
 
 /// A reflection point: on a visible face (sometimes a corner), or sometimes inside the box.
-fn reflection_point(
+pub(super) fn reflection_point(
     object: &Agent,
     faces: &VisibleFaces,
     refl: &ReflectionConfig,
@@ -512,7 +539,7 @@ fn reflection_point(
 /// Whether the sensor sees `point` of object `index`: within range and field of view, not
 /// faded out at long range, and not hidden behind another object (or seen despite it). Returns
 /// the point relative to the sensor, its range and its azimuth.
-fn detected(
+pub(super) fn detected(
     world: &World<'_>,
     sensor: &ScanSensor<'_>,
     index: usize,
@@ -561,8 +588,24 @@ fn measure_centre(
     measure_point(sensor, object, refl, centre, rel, range, azimuth, rng)
 }
 
+/// The measured position (world frame) of a point at `point_range` and `azimuth` from the
+/// sensor: range and azimuth noise in the sensor's polar frame, and the mount's misalignment.
+pub(super) fn measure_position(
+    sensor: &ScanSensor<'_>,
+    point_range: f64,
+    azimuth: f64,
+    rng: &mut ChaCha12Rng,
+) -> DVec2 {
+    let (radar, mount, unit) = (sensor.radar, sensor.mount, &sensor.unit);
+    let sigma_az = radar.azimuth_noise_deg.to_radians() * mount.azimuth_noise_scale / azimuth.cos().max(0.5);
+    let measured_range = point_range + radar.range_noise_m * unit.sample(rng);
+    let measured_az = azimuth + mount.azimuth_bias_deg.to_radians() + sigma_az * unit.sample(rng);
+    sensor.origin + DVec2::from_angle(sensor.boresight + measured_az) * measured_range
+}
+
 /// The measured position, radial velocity and RCS of a detected reflection point.
-fn measure_point(
+#[allow(clippy::too_many_arguments)]
+pub(super) fn measure_point(
     sensor: &ScanSensor<'_>,
     object: &Agent,
     refl: &ReflectionConfig,
@@ -572,12 +615,8 @@ fn measure_point(
     azimuth: f64,
     rng: &mut ChaCha12Rng,
 ) -> (DVec2, f64, f64) {
-    let (radar, mount, unit) = (sensor.radar, sensor.mount, &sensor.unit);
-    // Measured point: range and azimuth noise in the sensor's polar frame.
-    let sigma_az = radar.azimuth_noise_deg.to_radians() * mount.azimuth_noise_scale / azimuth.cos().max(0.5);
-    let measured_range = point_range + radar.range_noise_m * unit.sample(rng);
-    let measured_az = azimuth + mount.azimuth_bias_deg.to_radians() + sigma_az * unit.sample(rng);
-    let measured = sensor.origin + DVec2::from_angle(sensor.boresight + measured_az) * measured_range;
+    let (radar, unit) = (sensor.radar, &sensor.unit);
+    let measured = measure_position(sensor, point_range, azimuth, rng);
 
     // Doppler: velocity of the reflecting point along the line of sight.
     let line_of_sight = point_rel / point_range;

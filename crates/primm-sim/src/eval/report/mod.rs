@@ -31,7 +31,9 @@ use super::ego_motion::EgoMotion;
 use super::identity::{identity_counts, identity_counts_subset, IdentityCounts};
 use super::interaction::{interaction_flags, InteractionRules};
 use super::modes::{ModeProbabilityAccumulator, MODE_NAMES};
-use super::record::{AssociationRecord, EvalError, Method};
+use super::record::{
+    ground_truth_frame_rows, object_classes, object_frame_rows, AssociationRecord, EvalError, Method,
+};
 use super::rmse::RmseAccumulator;
 use super::scenario::{classify_sequence, MotionCategory, ScenarioRules};
 mod tables;
@@ -197,27 +199,37 @@ impl MethodEvaluator {
         }
     }
 
-    /// Adds the rows of one nominal sequence (all of its measurements).
+    /// Adds the rows of one nominal sequence (all of its measurements). Metrics computed row by
+    /// row count one row per object frame and track ([`object_frame_rows`]); per-class metrics
+    /// score an object's rows under its majority class ([`object_classes`]).
     pub fn add_sequence(&mut self, records: &[AssociationRecord]) {
         let labels = classify_sequence(records, &self.scenario_rules);
         let flags = interaction_flags(records, &self.interaction_rules);
+        let representative = object_frame_rows(records);
+        let object_frame = ground_truth_frame_rows(records);
+        let classes = object_classes(records);
         let result = &mut self.result;
-        for (record, label) in records.iter().zip(&labels) {
+        let rows = records.iter().zip(&labels).zip(representative.iter().zip(&object_frame)).zip(&classes);
+        for (((record, label), (&representative, &object_frame)), &class) in rows {
+            if let Some(label) = label.filter(|_| object_frame) {
+                *result.scenario_gt_frames.entry(label.category()).or_default() += 1;
+            }
+            if !representative {
+                continue;
+            }
             result.rmse.push_record(record);
-            result.class_rmse.entry(record.class).or_default().push_record(record);
+            result.class_rmse.entry(class).or_default().push_record(record);
             if result.velocity.push_record(record) {
-                result.class_velocity.entry(record.class).or_default().push_record(record);
+                result.class_velocity.entry(class).or_default().push_record(record);
             }
             if result.confirmed_motion.push_record(record) {
-                result.class_confirmed_motion.entry(record.class).or_default().push_record(record);
+                result.class_confirmed_motion.entry(class).or_default().push_record(record);
             }
             if result.modes.push_record(record) {
-                result.class_modes.entry(record.class).or_default().push_record(record);
+                result.class_modes.entry(class).or_default().push_record(record);
             }
             if let Some(label) = label {
-                let category = label.category();
-                result.scenario_rmse.entry(category).or_default().push_record(record);
-                *result.scenario_gt_frames.entry(category).or_default() += 1;
+                result.scenario_rmse.entry(label.category()).or_default().push_record(record);
             }
         }
         result.identity.merge(&identity_counts(records));
@@ -241,7 +253,10 @@ impl MethodEvaluator {
                 continue;
             }
             let acc = self.result.ego_rmse.entry(motion).or_default();
-            for (record, _) in records.iter().zip(&selected).filter(|(_, &s)| s) {
+            let representative = object_frame_rows(records);
+            for ((record, _), _) in
+                records.iter().zip(&selected).zip(&representative).filter(|((_, &s), &r)| s && r)
+            {
                 acc.push_record(record);
             }
             self.result
@@ -391,6 +406,36 @@ mod tests {
         let mut evaluator = MethodEvaluator::new(method);
         evaluator.add_sequence(&sequence(error));
         evaluator.finish()
+    }
+
+    #[test]
+    fn several_detections_of_an_object_are_scored_once_per_frame_under_its_majority_class() {
+        // Object 1 (a car) seen with three detections per frame over 12 frames, all taken by
+        // track 1 with the same prior; one detection in three frames is labelled pedestrian.
+        let mut records = Vec::new();
+        for frame in 0..12u64 {
+            let truth = DVec2::new(frame as f64, 0.0);
+            for k in 0..3 {
+                let mut row = position_row(frame, frame as f64 * 0.1, 1, truth);
+                row.measured = truth + DVec2::new(0.0, k as f64);
+                row.prior = (frame > 0).then_some(truth + DVec2::X * 0.5);
+                if k == 2 && frame % 4 == 0 {
+                    row.class = ObjectClass::Pedestrian;
+                }
+                records.push(row);
+            }
+        }
+        let mut evaluator = MethodEvaluator::new(Method::Imm);
+        evaluator.add_sequence(&records);
+        let result = evaluator.finish();
+        // One prior per frame after the first, all under the car class.
+        assert_eq!(result.rmse.count(), 11);
+        assert!((result.rmse.rmse_xy().unwrap() - 0.5).abs() < 1e-12);
+        assert_eq!(result.class_rmse.keys().copied().collect::<Vec<_>>(), vec![ObjectClass::Car]);
+        assert_eq!(result.class_rmse[&ObjectClass::Car].count(), 11);
+        assert_eq!((result.identity.gt_object_frames, result.identity.idtp), (12, 12));
+        // The straight motion is labelled from the tenth frame on, once per frame.
+        assert_eq!(result.scenario_frames(MotionCategory::Straight), 3);
     }
 
     #[test]
@@ -713,9 +758,16 @@ mod tests {
         report.insert(evaluate(Method::PrImm, 0.5));
         let table = report.table_confirmed_tracks();
         assert!(table.starts_with("Confirmed tracks (GT object frames = 24, clutter rows = 0"), "{table}");
-        assert_eq!(row(&table, "IMM (CV+CA+CT)"), vec!["0.7826*", "1*", "4*", "0*", "0.00*", "1", "0*", "3"]);
-        assert_eq!(row(&table, "PR-IMM"), vec!["0.7500", "1*", "6", "0*", "0.00*", "0*", "0*", "3"]);
-        assert_eq!(row(&table, "CV "), vec!["n/a"; 8]);
+        // 22 confirmed track frames over 24 object frames; no row says whether it is a ghost.
+        assert_eq!(
+            row(&table, "IMM (CV+CA+CT)"),
+            vec!["0.7826*", "1*", "4*", "0*", "0.00*", "1", "0*", "0.92", "n/a", "3"]
+        );
+        assert_eq!(
+            row(&table, "PR-IMM"),
+            vec!["0.7500", "1*", "6", "0*", "0.00*", "0*", "0*", "1.00", "n/a", "3"]
+        );
+        assert_eq!(row(&table, "CV "), vec!["n/a"; 10]);
         assert!(table.contains("n/a CV: the rows do not say whether their track was confirmed"), "{table}");
         assert!(table.contains("n/a PR: not evaluated"), "{table}");
         assert!(report.to_text().contains("Confirmed tracks"));

@@ -211,8 +211,9 @@ impl EvaluationReport {
     }
 
     /// Identity, false tracks and fragmentations on confirmed tracks only, per method (rows):
-    /// IDF1, IDSW, IDFP, false tracks, false tracks per minute, fragmentations, confirmed tracks
-    /// and the clutter rows they took ([`super::confirmed`]).
+    /// IDF1, IDSW, IDFP, false tracks, false tracks per minute, fragmentations, the clutter rows
+    /// they took, confirmed tracks per object frame, the share born of a ghost (where the data
+    /// mark ghosts) and confirmed tracks ([`super::confirmed`]).
     pub fn table_confirmed_tracks(&self) -> String {
         let counts: Vec<Option<ConfirmedTrackCounts>> =
             Method::ALL.iter().map(|m| self.result(*m).and_then(|r| r.confirmed)).collect();
@@ -228,6 +229,12 @@ impl EvaluationReport {
             column(ConfirmedTrackCounts::false_tracks_per_minute, Better::Lower, 2),
             column(|c| Some(c.fragmentations as f64), Better::Lower, 0),
             column(|c| Some(c.clutter_rows_in_confirmed_tracks as f64), Better::Lower, 0),
+            // One track per object frame is right; neither fewer nor more is better.
+            column(ConfirmedTrackCounts::tracks_per_object_frame, Better::Lower, 2)
+                .into_iter()
+                .map(Cell::unmarked)
+                .collect(),
+            column(ConfirmedTrackCounts::ghost_born_share, Better::Lower, 3),
         ];
         let header: Vec<String> = [
             "Model",
@@ -238,6 +245,8 @@ impl EvaluationReport {
             "False tracks/min",
             "Frag",
             "Clutter taken",
+            "Tracks/object",
+            "Ghost-born",
             "Tracks",
         ]
         .iter()
@@ -266,8 +275,8 @@ impl EvaluationReport {
         let mut text = render_table(&title, &header, &rows);
         self.append_notes(
             &mut text,
-            "* highest IDF1 / lowest other value in its column; estimated object frames are rows of \
-             confirmed tracks only",
+            "* highest IDF1 / lowest other value in its column (not Tracks/object); estimated object \
+             frames are frames of confirmed tracks only",
         );
         for method in Method::ALL {
             if self.result(method).is_some_and(|r| r.confirmed.is_none()) {

@@ -4,7 +4,8 @@ use super::behaviour::{DriverConfig, MotionLimits, WalkerConfig};
 use super::mount::RadarMount;
 use super::types::{
     CarConfig, ClutterConfig, EgoConfig, EgoPlacement, ExtendedObjectConfig, OutputConfig, PedestrianConfig,
-    RadarConfig, RadarReport, ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig, TrafficConfig,
+    PointCloudConfig, RadarConfig, RadarReport, ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig,
+    TrafficConfig,
 };
 use super::ScenarioConfig;
 
@@ -24,6 +25,7 @@ impl Default for ScenarioConfig {
             clutter: ClutterConfig::default(),
             extended_objects: ExtendedObjectConfig::default(),
             output: OutputConfig::default(),
+            point_cloud: PointCloudConfig::default(),
         }
     }
 }
@@ -254,6 +256,33 @@ impl ExtendedObjectConfig {
     /// `detection_count_probabilities`.
     pub fn mean_detection_count(&self) -> f64 {
         self.detection_count_probabilities.iter().enumerate().map(|(k, p)| (k + 1) as f64 * p).sum()
+    }
+}
+
+impl Default for PointCloudConfig {
+    /// Switched off; the other values describe the model once it is switched on.
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            car_extra_detections_at_reference: 5.0,
+            reference_range_m: 25.0,
+            max_detections_per_car: 12,
+            wheel_probability: 0.2,
+            wheelbase_fraction: 0.6,
+            pedestrian_detection_count_probabilities: vec![0.6, 0.4],
+            wall_offset_m: 12.0,
+            ghost_probability: 0.3,
+            max_ghost_detections: 2,
+            ghost_rcs_drop_db: 8.0,
+            class_flip_probability: 0.1,
+        }
+    }
+}
+
+impl PointCloudConfig {
+    /// The model of the `point_cloud` preset: switched on with the default values.
+    pub fn detections() -> Self {
+        Self { enabled: true, ..Self::default() }
     }
 }
 

@@ -25,8 +25,8 @@ pub use mount::RadarMount;
 pub use presets::Preset;
 pub use types::{
     CarConfig, ClutterConfig, EgoConfig, EgoPlacement, ExtendedObjectConfig, OutputConfig, PedestrianConfig,
-    RadarConfig, RadarReport, ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig, TrafficConfig,
-    MAX_DETECTIONS_PER_OBJECT,
+    PointCloudConfig, RadarConfig, RadarReport, ReflectionConfig, RoadConfig, SequenceConfig, SplitConfig,
+    TrafficConfig, MAX_DETECTIONS_PER_OBJECT,
 };
 
 /// A closed interval `[min, max]` from which a value is drawn uniformly.
@@ -90,6 +90,9 @@ pub struct ScenarioConfig {
     pub extended_objects: ExtendedObjectConfig,
     /// What the written frames carry besides the measurements (ego pose, sensor ids).
     pub output: OutputConfig,
+    /// Detection-level output: several detections per object and scan, wheel micro-Doppler,
+    /// multipath ghosts behind walls, flipped class labels (off by default).
+    pub point_cloud: PointCloudConfig,
 }
 
 impl ScenarioConfig {

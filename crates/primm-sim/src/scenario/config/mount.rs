@@ -84,6 +84,7 @@ impl TryFrom<RadarMountFields> for RadarMount {
             azimuth_std_rad: 0.0,
             azimuth_std_max_factor: 1.0,
             reflection: primm_core::sensor::ReflectionModel::Outline,
+            detections: Default::default(),
         };
         Ok(RadarMount {
             layout,
@@ -135,6 +136,7 @@ pub(super) fn layout_in_degrees(
         azimuth_std_rad: 0.0,
         azimuth_std_max_factor: 1.0,
         reflection: primm_core::sensor::ReflectionModel::Outline,
+        detections: Default::default(),
     }
 }
 
@@ -159,6 +161,7 @@ impl RadarMount {
                     azimuth_std_rad: 0.0,
                     azimuth_std_max_factor: 1.0,
                     reflection: primm_core::sensor::ReflectionModel::Outline,
+                    detections: Default::default(),
                     ..layout
                 },
                 azimuth_bias_deg,

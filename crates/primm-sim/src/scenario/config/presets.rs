@@ -4,7 +4,8 @@ use serde::{Deserialize, Serialize};
 
 use super::mount::RadarMount;
 use super::types::{
-    CarConfig, ClutterConfig, EgoPlacement, ExtendedObjectConfig, OutputConfig, PedestrianConfig, RadarReport,
+    CarConfig, ClutterConfig, EgoPlacement, ExtendedObjectConfig, OutputConfig, PedestrianConfig,
+    PointCloudConfig, RadarReport,
 };
 use super::ScenarioConfig;
 use primm_core::pose::SensorMount;
@@ -46,11 +47,17 @@ pub enum Preset {
     /// its frames carry no ego pose and no sensor id ([`OutputConfig`]). Cars are measured
     /// with the averaged echo of the default, which lies on the faces towards the sensor.
     DenseStatic,
+    /// The [`Preset::ClutterTurning`] scene seen by detection-level radars
+    /// ([`PointCloudConfig::detections`]): several detections per car over its visible faces
+    /// and wheels (with wheel micro-Doppler), one or two per pedestrian, more pedestrians
+    /// walking in groups side by side, multipath ghosts behind the walls along the roads, about
+    /// three clutter points per scan, and a tenth of the class labels wrong.
+    PointCloud,
 }
 
 impl Preset {
     /// All presets.
-    pub const ALL: [Preset; 11] = [
+    pub const ALL: [Preset; 12] = [
         Preset::Default,
         Preset::Robustness,
         Preset::Turning,
@@ -62,11 +69,12 @@ impl Preset {
         Preset::ExtendedClutterTurning,
         Preset::Centroid,
         Preset::DenseStatic,
+        Preset::PointCloud,
     ];
 
     /// The preset's name (`default`, `robustness`, `turning`, `clutter`, `clutter_turning`,
     /// `extended`, `extended_turning`, `extended_clutter`, `extended_clutter_turning`, `centroid`,
-    /// `dense_static`).
+    /// `dense_static`, `point_cloud`).
     pub fn name(self) -> &'static str {
         match self {
             Preset::Default => "default",
@@ -80,6 +88,7 @@ impl Preset {
             Preset::ExtendedClutterTurning => "extended_clutter_turning",
             Preset::Centroid => "centroid",
             Preset::DenseStatic => "dense_static",
+            Preset::PointCloud => "point_cloud",
         }
     }
 
@@ -102,6 +111,7 @@ impl Preset {
             Preset::ExtendedClutterTurning => ScenarioConfig::extended(Preset::ClutterTurning),
             Preset::Centroid => ScenarioConfig::centroid(),
             Preset::DenseStatic => ScenarioConfig::dense_static(),
+            Preset::PointCloud => ScenarioConfig::point_cloud(),
         }
     }
 }
@@ -198,6 +208,25 @@ impl ScenarioConfig {
             ..ClutterConfig::urban()
         };
         config.output = OutputConfig { ego_pose: false, sensor_id: false };
+        config
+    }
+
+    /// The detection-level preset: see [`Preset::PointCloud`].
+    pub fn point_cloud() -> Self {
+        let mut config = Self::clutter_turning();
+        config.splits.seed_base = 0x504f_494e_5443;
+        config.traffic.pedestrian_group_probability = 0.4;
+        config.traffic.max_group_size = 3;
+        config.traffic.group_spacing_m = [0.6, 1.2];
+        // Car points lie on the faces; the wheels carry the micro-Doppler.
+        config.car_reflection.interior_probability = 0.0;
+        config.car_reflection.micro_doppler_fraction = 0.0;
+        config.clutter = ClutterConfig {
+            mean_false_detections_per_scan: 3.0,
+            ghost_probability: 0.0,
+            ..ClutterConfig::urban()
+        };
+        config.point_cloud = PointCloudConfig::detections();
         config
     }
 
@@ -334,6 +363,7 @@ mod tests {
                     | Preset::ExtendedClutter
                     | Preset::ExtendedClutterTurning
                     | Preset::DenseStatic
+                    | Preset::PointCloud
             );
             assert_eq!(clutter.is_enabled(), expected, "{preset}");
         }
@@ -375,6 +405,24 @@ mod tests {
         for preset in Preset::ALL {
             let centre = preset.config().radar.report == RadarReport::Centre;
             assert_eq!(centre, preset == Preset::Centroid, "{preset}");
+        }
+    }
+
+    #[test]
+    fn the_point_cloud_preset_is_the_turning_clutter_scene_with_detection_level_radars() {
+        let config = Preset::PointCloud.config();
+        assert_eq!(config.point_cloud, PointCloudConfig::detections());
+        assert!((config.clutter.mean_false_detections_per_scan - 3.0).abs() < 1e-12);
+        assert_eq!(config.clutter.ghost_probability, 0.0, "ghosts come from the walls");
+        let mut base = config.clone();
+        base.point_cloud = PointCloudConfig::default();
+        base.clutter = ClutterConfig::urban();
+        base.traffic = Preset::ClutterTurning.config().traffic;
+        base.car_reflection = Preset::ClutterTurning.config().car_reflection;
+        base.splits.seed_base = Preset::ClutterTurning.config().splits.seed_base;
+        assert_eq!(base, Preset::ClutterTurning.config());
+        for preset in Preset::ALL {
+            assert_eq!(preset.config().point_cloud.enabled, preset == Preset::PointCloud, "{preset}");
         }
     }
 

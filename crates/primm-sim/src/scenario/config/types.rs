@@ -394,3 +394,65 @@ pub struct ExtendedObjectConfig {
 
 /// Largest number of detections one vehicle may yield in one scan.
 pub const MAX_DETECTIONS_PER_OBJECT: usize = 8;
+
+/// Detection-level radar output: what a radar gives before any clustering, several
+/// detections per object and scan (the model of the `point_cloud` preset).
+///
+/// When enabled, every object in view yields its own detections instead of one measurement:
+///
+/// * a car `1 + Poisson(car_extra_detections_at_reference · clamp(reference_range_m / range,
+///   0.5, 1.5))` detections (at most `max_detections_per_car`), each a point of its own on the
+///   faces of the box turned towards the sensor, chosen in proportion to their apparent width
+///   (a corner with the car reflection's `corner_probability`), or, with `wheel_probability`,
+///   a point on one of the wheels on the side turned towards the sensor;
+/// * a wheel point's velocity along the car's heading is the body's times `1 − u·cos φ`
+///   (`u`, `φ` uniform: a point on a spoke or the rim of a rolling wheel), between 0 and twice
+///   the body's speed: wheel micro-Doppler;
+/// * a pedestrian 1, 2, … detections with `pedestrian_detection_count_probabilities`, points on
+///   the body box with the pedestrian reflection's micro-Doppler (limbs);
+/// * every point is lost to the field of view, range fading and occlusion as in the point
+///   model, and measured with the radar's range, azimuth and Doppler noise;
+/// * multipath ghosts: the buildings or guard rails of each block stand `wall_offset_m` from
+///   the road centre lines. When the line of sight from the sensor to the mirror image of an
+///   object's reflection point across a wall meets that wall, the object yields, with
+///   `ghost_probability` per wall, a ghost of up to `max_ghost_detections` of its points at the
+///   mirror image, with the radial velocity of the mirrored motion and its RCS lowered by
+///   `ghost_rcs_drop_db`;
+/// * with `class_flip_probability`, a detection (of an object or a ghost) carries the other
+///   class's label.
+///
+/// Clutter comes from the `clutter` section as for any preset. Every draw comes from a random
+/// stream of its own.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PointCloudConfig {
+    /// Whether objects are measured as point clouds.
+    pub enabled: bool,
+    /// Mean number of detections of a car beyond the first, at `reference_range_m`.
+    pub car_extra_detections_at_reference: f64,
+    /// Range at which `car_extra_detections_at_reference` applies, metres; the mean scales with
+    /// `reference / range` within a factor 0.5 to 1.5.
+    pub reference_range_m: f64,
+    /// Largest number of detections of one car in one scan, before losses.
+    pub max_detections_per_car: u32,
+    /// Probability that a car's detection is a wheel return.
+    pub wheel_probability: f64,
+    /// Distance between a car's axles as a fraction of its length.
+    pub wheelbase_fraction: f64,
+    /// Probability that a pedestrian in view yields 1, 2, … detections in one scan (before
+    /// losses); entry `k` is the probability of `k + 1` detections. The entries sum to 1; at
+    /// most [`MAX_DETECTIONS_PER_OBJECT`] entries.
+    pub pedestrian_detection_count_probabilities: Vec<f64>,
+    /// Distance from a road's centre line to the reflecting building fronts and guard rails
+    /// on both of its sides, metres; beyond the sidewalks.
+    pub wall_offset_m: f64,
+    /// Probability that an object whose mirror image in a wall is visible yields a ghost there
+    /// in one scan.
+    pub ghost_probability: f64,
+    /// Largest number of detections of one ghost.
+    pub max_ghost_detections: u32,
+    /// How much weaker a ghost's RCS is than that of the point it mirrors, dB.
+    pub ghost_rcs_drop_db: f64,
+    /// Probability that a detection carries the wrong class label.
+    pub class_flip_probability: f64,
+}

@@ -23,7 +23,8 @@ impl ScenarioConfig {
         self.validate_radar()?;
         self.validate_reflections()?;
         self.validate_clutter()?;
-        self.validate_extended_objects()
+        self.validate_extended_objects()?;
+        self.validate_point_cloud()
     }
 
     /// `sequence.*`.
@@ -330,23 +331,10 @@ impl ScenarioConfig {
     /// `extended_objects.*`: a count distribution that sums to 1.
     fn validate_extended_objects(&self) -> Result<(), ConfigError> {
         let e = &self.extended_objects;
-        let counts = &e.detection_count_probabilities;
-        if counts.is_empty() || counts.len() > MAX_DETECTIONS_PER_OBJECT {
-            return Err(ConfigError::new(
-                "extended_objects.detection_count_probabilities",
-                format!("must list between 1 and {MAX_DETECTIONS_PER_OBJECT} probabilities"),
-            ));
-        }
-        for (k, &p) in counts.iter().enumerate() {
-            probability(&format!("extended_objects.detection_count_probabilities[{k}]"), p)?;
-        }
-        let total: f64 = counts.iter().sum();
-        if (total - 1.0).abs() > 1e-9 {
-            return Err(ConfigError::new(
-                "extended_objects.detection_count_probabilities",
-                format!("must sum to 1 (got {})", readable(total)),
-            ));
-        }
+        count_distribution(
+            "extended_objects.detection_count_probabilities",
+            &e.detection_count_probabilities,
+        )?;
         probability("extended_objects.corner_probability", e.corner_probability)?;
         non_negative("extended_objects.contour_spread_m", e.contour_spread_m)?;
         if e.enabled && self.radar.report == RadarReport::Centre {
@@ -357,6 +345,80 @@ impl ScenarioConfig {
         }
         Ok(())
     }
+
+    /// `point_cloud.*`: counts, probabilities, and walls between the sidewalks and the blocks'
+    /// centres; the model replaces the extended objects and the object-list report.
+    fn validate_point_cloud(&self) -> Result<(), ConfigError> {
+        let p = &self.point_cloud;
+        non_negative("point_cloud.car_extra_detections_at_reference", p.car_extra_detections_at_reference)?;
+        positive("point_cloud.reference_range_m", p.reference_range_m)?;
+        if !(1..=MAX_POINT_CLOUD_DETECTIONS).contains(&p.max_detections_per_car) {
+            return Err(ConfigError::new(
+                "point_cloud.max_detections_per_car",
+                format!("must lie between 1 and {MAX_POINT_CLOUD_DETECTIONS}"),
+            ));
+        }
+        probability("point_cloud.wheel_probability", p.wheel_probability)?;
+        if !(p.wheelbase_fraction > 0.0 && p.wheelbase_fraction <= 1.0) {
+            return Err(ConfigError::new("point_cloud.wheelbase_fraction", "must lie in (0, 1]"));
+        }
+        count_distribution(
+            "point_cloud.pedestrian_detection_count_probabilities",
+            &p.pedestrian_detection_count_probabilities,
+        )?;
+        let sidewalk_edge =
+            self.half_road_width_m() + self.road.sidewalk_offset_m + self.road.sidewalk_width_m / 2.0;
+        if !(p.wall_offset_m > sidewalk_edge && p.wall_offset_m < self.road.block_length_m / 2.0) {
+            return Err(ConfigError::new(
+                "point_cloud.wall_offset_m",
+                format!(
+                    "must lie beyond the sidewalks ({} m) and within half a block ({} m)",
+                    readable(sidewalk_edge),
+                    readable(self.road.block_length_m / 2.0)
+                ),
+            ));
+        }
+        probability("point_cloud.ghost_probability", p.ghost_probability)?;
+        if p.max_ghost_detections > MAX_POINT_CLOUD_DETECTIONS {
+            return Err(ConfigError::new(
+                "point_cloud.max_ghost_detections",
+                format!("must be at most {MAX_POINT_CLOUD_DETECTIONS}"),
+            ));
+        }
+        non_negative("point_cloud.ghost_rcs_drop_db", p.ghost_rcs_drop_db)?;
+        probability("point_cloud.class_flip_probability", p.class_flip_probability)?;
+        if p.enabled && (self.extended_objects.enabled || self.radar.report == RadarReport::Centre) {
+            return Err(ConfigError::new(
+                "point_cloud.enabled",
+                "replaces the extended objects and the object list; it needs extended_objects.enabled = false \
+                 and radar.report = \"echo\"",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Largest number of detections of one car, or of one ghost, in one scan of the point-cloud
+/// model.
+const MAX_POINT_CLOUD_DETECTIONS: u32 = 64;
+
+/// A count distribution `field`: between 1 and [`MAX_DETECTIONS_PER_OBJECT`] probabilities
+/// that sum to 1.
+fn count_distribution(field: &str, counts: &[f64]) -> Result<(), ConfigError> {
+    if counts.is_empty() || counts.len() > MAX_DETECTIONS_PER_OBJECT {
+        return Err(ConfigError::new(
+            field,
+            format!("must list between 1 and {MAX_DETECTIONS_PER_OBJECT} probabilities"),
+        ));
+    }
+    for (k, &p) in counts.iter().enumerate() {
+        probability(&format!("{field}[{k}]"), p)?;
+    }
+    let total: f64 = counts.iter().sum();
+    if (total - 1.0).abs() > 1e-9 {
+        return Err(ConfigError::new(field, format!("must sum to 1 (got {})", readable(total))));
+    }
+    Ok(())
 }
 
 /// `radar.sensors`: at least one, unique ids, finite mounts, fields of view within (0, 90)°.
@@ -531,6 +593,36 @@ fn interval(field: &str, value: Interval, strictly_positive: bool) -> Result<(),
 mod tests {
     use super::*;
     use crate::scenario::{ClutterConfig, ExtendedObjectConfig, Preset};
+
+    #[test]
+    fn point_cloud_validation_names_the_offending_field() {
+        /// Makes one field of the valid point-cloud preset invalid.
+        type Spoil = fn(&mut ScenarioConfig);
+        let cases: [(&str, Spoil); 12] = [
+            ("point_cloud.car_extra_detections_at_reference", |c| {
+                c.point_cloud.car_extra_detections_at_reference = -1.0
+            }),
+            ("point_cloud.reference_range_m", |c| c.point_cloud.reference_range_m = 0.0),
+            ("point_cloud.max_detections_per_car", |c| c.point_cloud.max_detections_per_car = 0),
+            ("point_cloud.wheel_probability", |c| c.point_cloud.wheel_probability = f64::NAN),
+            ("point_cloud.wheelbase_fraction", |c| c.point_cloud.wheelbase_fraction = 1.5),
+            ("point_cloud.pedestrian_detection_count_probabilities", |c| {
+                c.point_cloud.pedestrian_detection_count_probabilities = vec![0.5]
+            }),
+            // Inside the sidewalks, or beyond the middle of a block.
+            ("point_cloud.wall_offset_m", |c| c.point_cloud.wall_offset_m = 9.0),
+            ("point_cloud.wall_offset_m", |c| c.point_cloud.wall_offset_m = 50.0),
+            ("point_cloud.ghost_probability", |c| c.point_cloud.ghost_probability = 2.0),
+            ("point_cloud.max_ghost_detections", |c| c.point_cloud.max_ghost_detections = 65),
+            ("point_cloud.class_flip_probability", |c| c.point_cloud.class_flip_probability = -0.1),
+            ("point_cloud.enabled", |c| c.extended_objects = ExtendedObjectConfig::vehicles()),
+        ];
+        for (field, spoil) in cases {
+            let mut config = Preset::PointCloud.config();
+            spoil(&mut config);
+            assert_eq!(config.validate().unwrap_err().field, field);
+        }
+    }
 
     #[test]
     fn extended_object_validation_names_the_offending_field() {

@@ -1,0 +1,230 @@
+//! The grouping of one frame: which detection joins which group, and each group's measurement.
+//! The workspace is sized once for a full frame; [`FrameGroups::form`] allocates nothing.
+
+use super::linkage::{LinkPoint, LinkRule, Linkage, NO_OWNER};
+use super::summary::summarise;
+use crate::limits::MAX_MEASUREMENTS_PER_FRAME;
+use crate::measurement::Measurement;
+use alloc::boxed::Box;
+use alloc::vec;
+use glam::DVec2;
+
+const NONE: u16 = u16::MAX;
+const CAPACITY: usize = MAX_MEASUREMENTS_PER_FRAME;
+
+/// One accepted detection handed to the grouping.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detection {
+    /// The detection, in the tracking frame.
+    pub measurement: Measurement,
+    /// Its index in the frame.
+    pub frame_index: u16,
+    /// Its radar's slot in the sensor set.
+    pub sensor_slot: u8,
+    /// Its radar's position in the tracking frame, m.
+    pub sensor_position_m: DVec2,
+    /// Whether its radar's detections are grouped; a detection that is not is a group of its
+    /// own.
+    pub grouped: bool,
+    /// The table row of the confirmed track whose object holds it, if any.
+    pub owner: Option<u16>,
+}
+
+/// The groups of one frame.
+#[derive(Debug, Clone)]
+pub struct FrameGroups {
+    detections: Box<[Option<Detection>]>,
+    /// The detections' measurements, aligned with `detections`.
+    measurements: Box<[Measurement]>,
+    count: usize,
+    group_of: Box<[u16]>,
+    /// The group of each linkage label.
+    label_group: Box<[u16]>,
+    /// Members of each group in frame order: `members[member_start[g]..member_start[g + 1]]`.
+    members: Box<[u16]>,
+    member_start: Box<[u16]>,
+    /// Where the next member of each group goes while the members are sorted.
+    next_member: Box<[u16]>,
+    points: Box<[LinkPoint]>,
+    scratch: Box<[f64]>,
+    linkage: Box<Linkage>,
+    groups: usize,
+}
+
+impl Default for FrameGroups {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl FrameGroups {
+    /// An empty workspace.
+    pub fn new() -> Self {
+        const NO_MEASUREMENT: Measurement = Measurement {
+            x_m: 0.0,
+            y_m: 0.0,
+            radial_velocity_mps: 0.0,
+            rcs_dbsm: 0.0,
+            class: crate::measurement::ObjectClass::Car,
+            sensor_id: None,
+            ground_truth_id: None,
+        };
+        const NO_POINT: LinkPoint = LinkPoint {
+            position_m: DVec2::ZERO,
+            range_m: 0.0,
+            radial_velocity_mps: 0.0,
+            sensor_slot: 0,
+            owner: NO_OWNER,
+        };
+        FrameGroups {
+            detections: vec![None; CAPACITY].into_boxed_slice(),
+            measurements: vec![NO_MEASUREMENT; CAPACITY].into_boxed_slice(),
+            count: 0,
+            group_of: vec![NONE; CAPACITY].into_boxed_slice(),
+            label_group: vec![NONE; CAPACITY].into_boxed_slice(),
+            members: vec![0; CAPACITY].into_boxed_slice(),
+            member_start: vec![0; CAPACITY + 1].into_boxed_slice(),
+            next_member: vec![0; CAPACITY + 1].into_boxed_slice(),
+            points: vec![NO_POINT; CAPACITY].into_boxed_slice(),
+            scratch: vec![0.0; CAPACITY].into_boxed_slice(),
+            linkage: Box::new(Linkage::new()),
+            groups: 0,
+        }
+    }
+
+    /// Forgets the previous frame.
+    pub fn clear(&mut self) {
+        self.count = 0;
+        self.groups = 0;
+    }
+
+    /// Adds a detection; `false` (and nothing added) when the workspace is full.
+    pub fn push(&mut self, detection: Detection) -> bool {
+        if self.count == CAPACITY {
+            return false;
+        }
+        self.detections[self.count] = Some(detection);
+        self.measurements[self.count] = detection.measurement;
+        self.count += 1;
+        true
+    }
+
+    /// The detections added since [`clear`](Self::clear).
+    pub fn detections(&self) -> impl Iterator<Item = &Detection> {
+        self.detections[..self.count].iter().flatten()
+    }
+
+    /// Groups the detections: the grouped ones by [`Linkage::cluster`] with their owners (the
+    /// detections of one owner and radar are one group, and groups of two owners never join),
+    /// and each detection that is not grouped is a group of its own. Groups are numbered in the
+    /// order of their first detection. Returns the number of groups.
+    pub fn form(&mut self, rule: &LinkRule) -> usize {
+        self.link(rule);
+        self.groups = 0;
+        for index in 0..self.count {
+            let Some(detection) = self.detections[index] else { continue };
+            let group = if detection.grouped {
+                let label = self.linkage.label_of(self.group_of[index] as usize);
+                if self.label_group[label] == NONE {
+                    self.label_group[label] = self.open_group();
+                }
+                self.label_group[label]
+            } else {
+                self.open_group()
+            };
+            self.group_of[index] = group;
+        }
+        self.sort_members();
+        self.groups
+    }
+
+    /// Links the grouped detections; `group_of` holds each one's linkage point until
+    /// [`form`](Self::form) overwrites it with its group.
+    fn link(&mut self, rule: &LinkRule) {
+        let mut points = 0;
+        for index in 0..self.count {
+            let Some(detection) = self.detections[index] else { continue };
+            if detection.grouped {
+                let position_m = detection.measurement.position();
+                self.points[points] = LinkPoint {
+                    position_m,
+                    range_m: position_m.distance(detection.sensor_position_m),
+                    radial_velocity_mps: detection.measurement.radial_velocity_mps,
+                    sensor_slot: detection.sensor_slot,
+                    owner: detection.owner.unwrap_or(NO_OWNER),
+                };
+                self.group_of[index] = points as u16;
+                points += 1;
+            }
+        }
+        let labels = self.linkage.cluster(&self.points[..points], rule);
+        self.label_group[..labels].fill(NONE);
+    }
+
+    fn open_group(&mut self) -> u16 {
+        self.groups += 1;
+        (self.groups - 1) as u16
+    }
+
+    /// Lists each group's members in frame order (a counting sort by group).
+    fn sort_members(&mut self) {
+        self.member_start[..=self.groups].fill(0);
+        for index in 0..self.count {
+            if self.detections[index].is_some() {
+                self.member_start[self.group_of[index] as usize + 1] += 1;
+            }
+        }
+        for group in 0..self.groups {
+            self.member_start[group + 1] += self.member_start[group];
+        }
+        self.next_member[..=self.groups].copy_from_slice(&self.member_start[..=self.groups]);
+        for index in 0..self.count {
+            if self.detections[index].is_some() {
+                let group = self.group_of[index] as usize;
+                self.members[self.next_member[group] as usize] = index as u16;
+                self.next_member[group] += 1;
+            }
+        }
+    }
+
+    /// The number of groups of the latest [`form`](Self::form).
+    pub fn groups(&self) -> usize {
+        self.groups
+    }
+
+    /// Group `group`'s members: indices of [`detections`](Self::detections) in frame order.
+    pub fn members(&self, group: usize) -> &[u16] {
+        &self.members[self.member_start[group] as usize..self.member_start[group + 1] as usize]
+    }
+
+    /// The owner of group `group` (the confirmed track whose object holds one of its
+    /// detections; a group has at most one), if any.
+    pub fn owner(&self, group: usize) -> Option<u16> {
+        self.members(group).iter().find_map(|&member| self.detections[member as usize].and_then(|d| d.owner))
+    }
+
+    /// The frame index of group `group`'s representative: its detection nearest to the mean
+    /// of its detections (the first of them on a tie), which the outputs name.
+    pub fn representative_frame_index(&self, group: usize) -> u16 {
+        let members = self.members(group);
+        let mean_m = members
+            .iter()
+            .map(|&member| self.measurements[member as usize].position())
+            .fold(DVec2::ZERO, |sum, position| sum + position)
+            / members.len() as f64;
+        let mut best = (members[0], f64::INFINITY);
+        for &member in members {
+            let distance_m2 = self.measurements[member as usize].position().distance_squared(mean_m);
+            if distance_m2 < best.1 {
+                best = (member, distance_m2);
+            }
+        }
+        self.detections[best.0 as usize].map_or(0, |detection| detection.frame_index)
+    }
+
+    /// Group `group`'s measurement ([`summarise`]).
+    pub fn measurement(&mut self, group: usize) -> Measurement {
+        let (start, end) = (self.member_start[group] as usize, self.member_start[group + 1] as usize);
+        summarise(&self.measurements[..self.count], &self.members[start..end], &mut self.scratch)
+    }
+}

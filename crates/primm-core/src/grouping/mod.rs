@@ -1,0 +1,133 @@
+//! The detection-level front end: a radar that reports several detections per object per scan
+//! (a point cloud) has each scan's detections grouped into object measurements before
+//! association, so that the tracker sees one measurement per object, as from an object-list
+//! radar (ARCHITECTURE.md, "Point clouds").
+//!
+//! Grouping runs after the prediction, in two passes over the detections of the radars that
+//! deliver points ([`DetectionModel`]):
+//!
+//! 1. **Guided by the tracks.** A detection on the object of a confirmed track (inside its box
+//!    at the prior, grown by the class's `extent.absorb_margin_m`; the nearest track's when
+//!    several boxes hold it) joins that track's group of its radar. Two cars side by side stay
+//!    two groups however close their faces are, and wheel returns with odd radial velocities
+//!    stay with their car.
+//! 2. **Clustered.** The remaining detections are grouped by single linkage ([`linkage`]) in
+//!    position, with a link distance that grows with the range as the radar's azimuth noise
+//!    does, and in radial velocity; these groups start tracks.
+//!
+//! Each group becomes one measurement ([`summary`]). Detections of radars that deliver
+//! objects pass through unchanged.
+
+pub mod contour;
+pub mod frame_groups;
+pub mod linkage;
+pub mod summary;
+
+/// What one detection of a radar is (`[[frame.sensors]] detections`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum DetectionModel {
+    /// One point of a point cloud: an object gives several per scan, which are grouped.
+    Points,
+    /// One object: a detection is a measurement of its own (an object-list radar, a clustering
+    /// stack, a radar that averages its echoes per object).
+    Objects,
+    /// Decided from the data ([`crate::sensor::points::PointsEstimate`]): points when confirmed
+    /// tracks repeatedly hold several of the radar's detections in one scan. The default.
+    #[default]
+    Auto,
+}
+
+impl DetectionModel {
+    /// The short name used in configuration and output.
+    pub fn name(self) -> &'static str {
+        match self {
+            DetectionModel::Points => "points",
+            DetectionModel::Objects => "objects",
+            DetectionModel::Auto => "auto",
+        }
+    }
+}
+
+/// The section `frame.grouping`: how detections of point-cloud radars are grouped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, default))]
+pub struct GroupingConfig {
+    /// Largest distance between two linked detections at zero range, m (absent: 2.0).
+    pub link_distance_m: f64,
+    /// Growth of the link distance with range, m per m of range (absent: 0.02, twice a
+    /// 0.6° azimuth noise).
+    pub link_distance_per_range: f64,
+    /// Largest difference of radial velocity between two linked detections, m/s (absent: 2.0).
+    pub link_radial_velocity_gap_mps: f64,
+    /// How far beyond its box (the class's extent at the track's prior) a detection still lies
+    /// on a confirmed track's object and joins its group, m (absent: 2.0). Wider than the
+    /// extent's `absorb_margin_m`: the prior's position error and the spread of a point cloud
+    /// over the faces both reach beyond the box.
+    pub owner_margin_m: f64,
+    /// With `detections = "auto"`: the share of a radar's confirmed-track scans with several
+    /// detections on the track's object above which the radar delivers points, in (0, 1)
+    /// (absent: 0.5). It falls back to objects below this share less 0.1.
+    pub points_share_threshold: f64,
+    /// Weight of the prior share 0 (objects), in track scans (absent: 20).
+    pub points_prior_scans: f64,
+    /// Memory of the share, in track scans (absent: 2000).
+    pub points_window_scans: f64,
+}
+
+impl Default for GroupingConfig {
+    fn default() -> Self {
+        GroupingConfig {
+            link_distance_m: 2.0,
+            link_distance_per_range: 0.02,
+            link_radial_velocity_gap_mps: 2.0,
+            owner_margin_m: 2.0,
+            points_share_threshold: 0.5,
+            points_prior_scans: 20.0,
+            points_window_scans: 2000.0,
+        }
+    }
+}
+
+/// The hysteresis of the points decision under `points_share_threshold`.
+pub const POINTS_SHARE_HYSTERESIS: f64 = 0.1;
+
+impl GroupingConfig {
+    /// The rule two detections link by.
+    pub fn link_rule(&self) -> linkage::LinkRule {
+        linkage::LinkRule {
+            distance_m: self.link_distance_m,
+            distance_per_range: self.link_distance_per_range,
+            radial_velocity_gap_mps: self.link_radial_velocity_gap_mps,
+        }
+    }
+
+    /// The first problem of the section, as (key, reason).
+    pub(crate) fn problem(&self) -> Option<(&'static str, &'static str)> {
+        let within = |value: f64, low: f64, high: f64| value >= low && value <= high;
+        if !within(self.link_distance_m, 0.0, 20.0) {
+            return Some(("frame.grouping.link_distance_m", "must lie in [0, 20] m"));
+        }
+        if !within(self.link_distance_per_range, 0.0, 1.0) {
+            return Some(("frame.grouping.link_distance_per_range", "must lie in [0, 1]"));
+        }
+        if !within(self.link_radial_velocity_gap_mps, 0.0, 100.0) {
+            return Some(("frame.grouping.link_radial_velocity_gap_mps", "must lie in [0, 100] m/s"));
+        }
+        if !within(self.owner_margin_m, 0.0, 20.0) {
+            return Some(("frame.grouping.owner_margin_m", "must lie in [0, 20] m"));
+        }
+        if !(self.points_share_threshold > POINTS_SHARE_HYSTERESIS && self.points_share_threshold < 1.0) {
+            return Some(("frame.grouping.points_share_threshold", "must lie in (0.1, 1)"));
+        }
+        if !(within(self.points_prior_scans, 1e-9, 1e9) && within(self.points_window_scans, 1e-9, 1e9)) {
+            return Some((
+                "frame.grouping",
+                "points_prior_scans and points_window_scans must lie in (0, 1e9]",
+            ));
+        }
+        None
+    }
+}

@@ -1,0 +1,136 @@
+//! Whether a radar delivers a point cloud or objects (`detections = "auto"`), from its data.
+//!
+//! A confirmed track in a scan of the radar is one *track scan* when at least one of the scan's
+//! detections lies on the track's object (`crate::grouping`); it is a *multiple* when several
+//! do. An object-list radar gives one detection per object, so its multiples are the rare scans
+//! in which another object's detection falls inside a track's box; a point-cloud radar gives
+//! several per vehicle in most scans. The share of multiples is estimated like the detection
+//! probability (`crate::sensor::estimates::DetectionEstimate`): the prior share 0 (objects, the
+//! behaviour of a tracker without a front end) enters as `points_prior_scans` pseudo-scans, and
+//! beyond `points_window_scans` counts and prior are scaled down together. The radar is taken to
+//! deliver points once the share passes `points_share_threshold`, and objects again once it
+//! falls below that less [`POINTS_SHARE_HYSTERESIS`], so that a share near the threshold does
+//! not switch the front end from scan to scan. The share is counted in either state from the
+//! raw detections, so the decision does not feed back into its own evidence.
+
+use crate::grouping::{GroupingConfig, POINTS_SHARE_HYSTERESIS};
+
+/// A radar's running share of multiple detections per confirmed track and its decision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointsEstimate {
+    /// Track scans within the window, the prior's pseudo-scans included (0 before the first).
+    pub track_scans: f64,
+    /// Multiples among them.
+    pub multiples: f64,
+    /// Track scans taken in all.
+    pub samples: u64,
+    /// Whether the radar is taken to deliver points.
+    pub points: bool,
+    /// Times the decision changed.
+    pub switches: u64,
+}
+
+impl Default for PointsEstimate {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl PointsEstimate {
+    /// The estimate at its prior: objects, share 0.
+    pub const fn new() -> Self {
+        PointsEstimate { track_scans: 0.0, multiples: 0.0, samples: 0, points: false, switches: 0 }
+    }
+
+    /// The share of multiples, in [0, 1] (0 before the first track scan).
+    pub fn share(&self) -> f64 {
+        if self.track_scans > 0.0 {
+            (self.multiples / self.track_scans).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Takes one track scan with `detections` (at least one) of the radar on the track's object.
+    pub fn observe(&mut self, config: &GroupingConfig, detections: usize) {
+        if self.samples == 0 {
+            self.track_scans = config.points_prior_scans;
+            self.multiples = 0.0;
+        }
+        self.track_scans += 1.0;
+        self.multiples += f64::from(u8::from(detections >= 2));
+        self.samples += 1;
+        let window = config.points_window_scans.max(config.points_prior_scans);
+        if self.track_scans > window {
+            let scale = window / self.track_scans;
+            self.track_scans = window;
+            self.multiples *= scale;
+        }
+        let share = self.share();
+        let decided = if self.points {
+            share >= config.points_share_threshold - POINTS_SHARE_HYSTERESIS
+        } else {
+            share > config.points_share_threshold
+        };
+        if decided != self.points {
+            self.points = decided;
+            self.switches += 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_radar_without_evidence_delivers_objects() {
+        let estimate = PointsEstimate::new();
+        assert!(!estimate.points);
+        assert_eq!(estimate.share(), 0.0);
+    }
+
+    #[test]
+    fn several_detections_per_track_scan_switch_to_points_after_the_prior_weighs_less() {
+        let config = GroupingConfig::default();
+        let mut estimate = PointsEstimate::new();
+        // 20 pseudo-scans at share 0: the share passes 0.5 after the 21st multiple.
+        for scan in 1..=20 {
+            estimate.observe(&config, 4);
+            assert!(!estimate.points, "switched after {scan} scans");
+        }
+        estimate.observe(&config, 3);
+        assert!(estimate.points);
+        assert_eq!(estimate.switches, 1);
+    }
+
+    #[test]
+    fn a_radar_that_turns_out_to_deliver_objects_falls_back_with_hysteresis() {
+        let config = GroupingConfig { points_window_scans: 100.0, ..GroupingConfig::default() };
+        let mut estimate = PointsEstimate::new();
+        for _ in 0..200 {
+            estimate.observe(&config, 4);
+        }
+        assert!(estimate.points);
+        let mut scans_to_fall_back = 0;
+        while estimate.points {
+            estimate.observe(&config, 1);
+            scans_to_fall_back += 1;
+            assert!(scans_to_fall_back < 1000);
+        }
+        // It falls back below 0.4, not at 0.5.
+        assert!(estimate.share() < 0.4 && estimate.share() > 0.35, "{}", estimate.share());
+        assert_eq!(estimate.switches, 2);
+    }
+
+    #[test]
+    fn the_occasional_second_detection_of_an_object_list_keeps_objects() {
+        let config = GroupingConfig::default();
+        let mut estimate = PointsEstimate::new();
+        for scan in 0..5000 {
+            estimate.observe(&config, if scan % 5 == 0 { 2 } else { 1 });
+        }
+        assert!(!estimate.points);
+        assert!((estimate.share() - 0.2).abs() < 0.02);
+    }
+}

@@ -1,0 +1,252 @@
+//! Group the detections of point-cloud radars into object measurements (`crate::grouping`),
+//! after the prediction and before the association: the validated frame then holds one
+//! measurement per group, and the outputs name each group by its representative detection's
+//! index (the one nearest to the group's mean).
+
+use super::{MeasurementFate, Tracker};
+use crate::grouping::frame_groups::Detection;
+use crate::grouping::DetectionModel;
+use crate::measurement::{FrameView, Measurement};
+use crate::predictor::DisplacementPredictor;
+
+impl<P: DisplacementPredictor> Tracker<P> {
+    /// Hands the frame's accepted detections of radars that deliver points (or may: `auto`)
+    /// to the grouping with the confirmed track whose object holds each, counts what the
+    /// `auto` radars' data say, and, when a radar of the frame delivers points, replaces the
+    /// validated frame's measurements by the groups'. A frame of object radars only is left as
+    /// it is.
+    pub(super) fn group_detections(&mut self) {
+        self.frame_groups.clear();
+        self.grouped_frame = false;
+        self.shadowed.fill(false);
+        let mut any_points = false;
+        let mut any_candidates = false;
+        for index in 0..self.validated.len() {
+            let Some(measurement) = self.validated.accepted(index) else { continue };
+            let slot = self.sensors.slot(measurement.sensor_id);
+            let sensor = self.sensors.get(slot);
+            let candidate = sensor.detections != DetectionModel::Objects;
+            let grouped = sensor.groups_detections();
+            let (owner, shadowed) = if candidate { self.owner_of(&measurement) } else { (None, None) };
+            if let Some(row) = shadowed.filter(|_| grouped) {
+                self.shadowed[usize::from(row)] = true;
+            }
+            let detection = Detection {
+                measurement,
+                frame_index: index as u16,
+                sensor_slot: slot as u8,
+                sensor_position_m: sensor.position_m(self.step_pose),
+                grouped,
+                owner,
+            };
+            // The workspace holds a full frame, so this never refuses.
+            let _ = self.frame_groups.push(detection);
+            any_points |= grouped;
+            any_candidates |= candidate;
+        }
+        if any_candidates {
+            self.learn_points();
+        }
+        if any_points {
+            self.replace_by_groups();
+        }
+    }
+
+    /// The table row of the confirmed track (of any class: labels flip) whose object at its
+    /// prior holds `measurement` (its class's box grown by [`Self::owner_margin_m`]). When
+    /// several do, the nearest one's; but of two tracks that are likely one object followed
+    /// twice ([`Self::duplicates`]), the older one's. The younger one is returned second: it is
+    /// *shadowed*, and ends with the step when it took no measurement
+    /// ([`Self::end_shadowed_tracks`]).
+    fn owner_of(&self, measurement: &Measurement) -> (Option<u16>, Option<u16>) {
+        let position_m = measurement.position();
+        let tracks = self.table.tracks();
+        let mut best: Option<(usize, f64)> = None;
+        let mut shadowed = None;
+        for row in 0..tracks.len() {
+            if !tracks[row].status.is_confirmed() {
+                continue;
+            }
+            let Some(distance_m2) = self.holds(row, position_m, self.owner_margin_m(row)) else { continue };
+            let better = match best {
+                None => true,
+                Some((best_row, best_m2)) => {
+                    let (older, younger) =
+                        if tracks[row].id < tracks[best_row].id { (row, best_row) } else { (best_row, row) };
+                    if self.duplicates(older, younger) {
+                        shadowed = Some(younger as u16);
+                        older == row
+                    } else {
+                        distance_m2 < best_m2
+                    }
+                }
+            };
+            if better {
+                best = Some((row, distance_m2));
+            }
+        }
+        (best.map(|(row, _)| row as u16), shadowed)
+    }
+
+    /// How far beyond its box a detection still joins the group of the track in `row`: the
+    /// grouping's `owner_margin_m` for an extended class, whose point cloud spreads over its
+    /// faces, the class's `extent.absorb_margin_m` for a point-like one (pedestrians walking
+    /// side by side stay apart).
+    fn owner_margin_m(&self, row: usize) -> f64 {
+        let extent = &self.config.classes.get(self.table.tracks()[row].class).extent;
+        if extent.enabled {
+            self.config.frame.grouping.owner_margin_m
+        } else {
+            extent.absorb_margin_m
+        }
+    }
+
+    /// Whether the tracks in rows `older` and `younger` follow one object: of one class with
+    /// centres within its `duplicate_distance_m`, or the younger one's centre on the older
+    /// one's object (its class's box grown by `extent.absorb_margin_m`; a pedestrian track
+    /// started on a car by a wrong label).
+    fn duplicates(&self, older: usize, younger: usize) -> bool {
+        let tracks = self.table.tracks();
+        let younger_m = self.priors[younger].fused.mean;
+        let apart_m = self.priors[older].fused.mean.distance(younger_m);
+        let section = self.config.classes.get(tracks[older].class);
+        (tracks[older].class == tracks[younger].class && apart_m <= section.duplicate_distance_m)
+            || self.holds(older, younger_m, section.extent.absorb_margin_m).is_some()
+    }
+
+    /// Before the deletion: marks for ending (counted as deleted) every shadowed track that took
+    /// no measurement in this step, a duplicate of the older track that took its object's
+    /// detections, and every tentative track whose measurement of this step was a ghost of a
+    /// confirmed track (`ghosts`); returns how many.
+    pub(super) fn end_shadowed_and_ghost_tracks(&mut self) -> usize {
+        let tracks = self.table.len();
+        let mut ended = 0;
+        for row in 0..tracks {
+            self.ending[row] = self.shadowed[row] && self.rows[row].measurement_index.is_none();
+            if !self.ending[row] && self.follows_a_ghost(row) {
+                self.ending[row] = true;
+                self.last_step.counts.tentative_tracks_ended_as_ghost += 1;
+            }
+            ended += usize::from(self.ending[row]);
+        }
+        self.ending[tracks..].fill(false);
+        ended
+    }
+
+    /// When the track in `row` holds `position_m` on its object at its prior (its class's box
+    /// grown by `margin_m`): the squared distance from its centre, m².
+    fn holds(&self, row: usize, position_m: glam::DVec2, margin_m: f64) -> Option<f64> {
+        let track = &self.table.tracks()[row];
+        let prior = &self.priors[row];
+        let section = &self.config.classes.get(track.class).extent;
+        // Beyond the circle through the grown box's corners (the disc lies within it too).
+        let reach_m2 = crate::math::square(0.5 * section.length_m + margin_m)
+            + crate::math::square(0.5 * section.width_m + margin_m);
+        if prior.fused.mean.distance_squared(position_m) > reach_m2 {
+            return None;
+        }
+        let extent = crate::extent::ExtentConfig { absorb_margin_m: margin_m, ..*section };
+        let centre_m = prior.fused.mean;
+        crate::extent::lies_on_object(&extent, centre_m, prior.fused_velocity_mps(), position_m)
+            .then(|| centre_m.distance_squared(position_m))
+    }
+
+    /// Each confirmed track's count of the frame's detections of an `auto` radar on its object
+    /// (every detection its box grown by the class's `extent.absorb_margin_m` holds, whichever
+    /// track owns it: a radar's point cloud tracked one detection at a time gives an object
+    /// several tracks, each holding the object's detections) into that radar's
+    /// [`PointsEstimate`](crate::sensor::points::PointsEstimate), one radar at a time.
+    fn learn_points(&mut self) {
+        let config = self.config.frame.grouping;
+        let mut slots = arrayvec::ArrayVec::<u8, { crate::limits::MAX_SENSORS + 1 }>::new();
+        for detection in self.frame_groups.detections() {
+            let auto =
+                self.sensors.get(usize::from(detection.sensor_slot)).detections == DetectionModel::Auto;
+            if auto && detection.owner.is_some() && !slots.contains(&detection.sensor_slot) {
+                // There are at most MAX_SENSORS + 1 slots, so this never overflows.
+                let _ = slots.try_push(detection.sensor_slot);
+            }
+        }
+        let tracks = self.table.len();
+        for slot in slots {
+            self.owned_counts[..tracks].fill(0);
+            for detection in self.frame_groups.detections() {
+                if detection.sensor_slot != slot || detection.owner.is_none() {
+                    continue;
+                }
+                let position_m = detection.measurement.position();
+                for row in 0..tracks {
+                    let track = &self.table.tracks()[row];
+                    let margin_m = self.config.classes.get(track.class).extent.absorb_margin_m;
+                    if track.status.is_confirmed() && self.holds(row, position_m, margin_m).is_some() {
+                        self.owned_counts[row] += 1;
+                    }
+                }
+            }
+            let estimate = &mut self.sensors.get_mut(usize::from(slot)).points;
+            for &count in self.owned_counts[..tracks].iter().filter(|&&count| count > 0) {
+                estimate.observe(&config, usize::from(count));
+            }
+        }
+    }
+
+    /// Forms the groups and makes them the validated frame's measurements.
+    fn replace_by_groups(&mut self) {
+        let rule = self.config.frame.grouping.link_rule();
+        let groups = self.frame_groups.form(&rule);
+        let detections = self.frame_groups.detections().count();
+        self.validated.set_len(groups);
+        for group in 0..groups {
+            let mut measurement = self.frame_groups.measurement(group);
+            self.group_is_centre[group] = self.move_to_centre(group, &mut measurement);
+            self.validated.set(group, Some(measurement));
+            self.accepted[group] = true;
+            self.fates[group] = MeasurementFate::Unassigned;
+            self.group_first_index[group] = self.frame_groups.representative_frame_index(group);
+        }
+        self.last_step.counts.detections_grouped += (detections - groups) as u64;
+        self.grouped_frame = true;
+    }
+
+    /// Moves the measurement of `group` from the mean of its detections to the centre of its
+    /// object when the group holds several detections and a confirmed track of an extended
+    /// class owns it: by the offset of the visible contour's centroid of the track's box at its
+    /// prior (`crate::grouping::contour`). Returns whether it did; such a measurement is then a
+    /// measurement of the centre (reflection scale 0).
+    fn move_to_centre(&self, group: usize, measurement: &mut Measurement) -> bool {
+        let Some(owner) = self.frame_groups.owner(group) else { return false };
+        if self.frame_groups.members(group).len() < 2 {
+            return false;
+        }
+        let row = usize::from(owner);
+        let class = self.table.tracks()[row].class;
+        let extent = &self.config.classes.get(class).extent;
+        if !extent.enabled {
+            return false;
+        }
+        let prior = &self.priors[row];
+        let sensor_m = self.sensors.of(measurement.sensor_id).position_m(self.step_pose);
+        let offset_m = crate::grouping::contour::visible_contour_offset(
+            extent,
+            prior.fused.mean,
+            prior.fused_velocity_mps(),
+            sensor_m,
+        );
+        measurement.x_m -= offset_m.x;
+        measurement.y_m -= offset_m.y;
+        true
+    }
+
+    /// After a grouped frame: the measurement index of every row names its group's
+    /// representative detection in the frame, as the outputs report it.
+    pub(super) fn name_groups_by_representative(&mut self) {
+        if !self.grouped_frame {
+            return;
+        }
+        for row in self.rows[..self.table.len()].iter_mut() {
+            if let Some(group) = row.measurement_index {
+                row.measurement_index = Some(self.group_first_index[usize::from(group)]);
+            }
+        }
+    }
+}

@@ -1,0 +1,73 @@
+//! Multipath ghosts (`tracker/ghosts.rs`, ARCHITECTURE.md "Point clouds"): a measurement at the
+//! mirror image of a confirmed moving track in a wall along its heading, moving as that image,
+//! starts no track; a real object at the same place that moves otherwise is tracked.
+
+use glam::DVec2;
+use primm_core::config::Config;
+use primm_core::measurement::{Frame, Measurement, ObjectClass};
+use primm_core::pose::EgoPose;
+use primm_core::tracker::Tracker;
+
+/// A car driving along x at 12 m/s at y = 2 m past a standing ego, seen by the front-left radar
+/// (id 3) every 50 ms, and from frame 40 (2 s) on a second object at the position and
+/// velocity `second(t, centre, velocity)` gives from the time and the car's.
+fn frames(second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2)) -> Vec<Frame> {
+    let sensor_m = DVec2::new(3.86, 0.70);
+    (0..120)
+        .map(|k| {
+            let t = 0.05 * k as f64;
+            let mut frame = Frame::new(t);
+            frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
+            let (centre, velocity) = (DVec2::new(15.0 + 12.0 * t, 2.0), DVec2::new(12.0, 0.0));
+            let mut push = |position: DVec2, velocity: DVec2, id: u64| {
+                frame.measurements.push(Measurement {
+                    x_m: position.x,
+                    y_m: position.y,
+                    radial_velocity_mps: velocity.dot((position - sensor_m).normalize()),
+                    rcs_dbsm: 5.0,
+                    class: ObjectClass::Car,
+                    sensor_id: Some(3),
+                    ground_truth_id: Some(id),
+                })
+            };
+            push(centre, velocity, 1);
+            if k >= 40 {
+                let (position, velocity) = second(t, centre, velocity);
+                push(position, velocity, 2);
+            }
+            frame
+        })
+        .collect()
+}
+
+/// The ids of the tracks confirmed at the end, and the tracker.
+fn confirmed(frames: &[Frame]) -> (usize, Tracker) {
+    let mut tracker = Tracker::new(Config::default()).unwrap();
+    let mut count = 0;
+    for frame in frames {
+        count = tracker.step(frame).unwrap().iter().filter(|o| o.status.is_confirmed()).count();
+    }
+    (count, tracker)
+}
+
+#[test]
+fn the_image_of_a_car_in_a_wall_along_the_road_starts_no_track() {
+    // A wall at y = 10 m: the image at y = 18 m moves with the mirrored velocity (the same, the
+    // wall being parallel to it).
+    let mirror = |_, centre: DVec2, velocity: DVec2| {
+        (DVec2::new(centre.x, 20.0 - centre.y), DVec2::new(velocity.x, -velocity.y))
+    };
+    let (count, tracker) = confirmed(&frames(mirror));
+    assert_eq!(count, 1);
+    let stats = tracker.stats();
+    assert!(stats.initiations_refused_as_ghost > 50, "{stats:?}");
+}
+
+#[test]
+fn a_car_where_the_image_would_be_that_drives_the_other_way_is_tracked() {
+    // At the image's place when it appears, then driving towards the ego.
+    let oncoming = |t: f64, _, _| (DVec2::new(39.0 - 12.0 * (t - 2.0), 18.0), DVec2::new(-12.0, 0.0));
+    let (count, tracker) = confirmed(&frames(oncoming));
+    assert_eq!(count, 2);
+    assert_eq!(tracker.stats().initiations_refused_as_ghost, 0);
+}

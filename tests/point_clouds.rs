@@ -1,0 +1,285 @@
+//! Radars that report several detections per object (`crate::grouping`, ARCHITECTURE.md "Point
+//! clouds"): a point-cloud radar's detections become one track per object, `detections =
+//! "auto"` finds out which kind of radar it has, object radars are left as they are, a frame
+//! above capacity is refused and counted, and late frames give what in-order arrival gives.
+
+use glam::DVec2;
+use primm_core::config::Config;
+use primm_core::grouping::DetectionModel;
+use primm_core::limits::MAX_MEASUREMENTS_PER_FRAME;
+use primm_core::measurement::{Frame, FrameView, Measurement, ObjectClass, UnknownClass};
+use primm_core::pose::EgoPose;
+use primm_core::tracker::{StepError, Tracker};
+use primm_core::validation::FrameError;
+
+/// A deterministic noise source in [−0.5, 0.5).
+struct Noise(u64);
+
+impl Noise {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+}
+
+/// The default configuration with every radar (and the radars without a mount) set to
+/// `detections`.
+fn config(detections: DetectionModel) -> Config {
+    let mut config = Config::default();
+    for sensor in config.frame.sensors.iter_mut() {
+        sensor.detections = detections;
+    }
+    config.frame.unmounted_detections = detections;
+    config
+}
+
+/// Two cars driving side by side along x at 12 m/s, 3.5 m apart, ahead of a standing ego, seen
+/// by the front-left radar (id 3) every 50 ms: `points` detections per car per scan on its rear
+/// face and the near side, with ±0.1 m of noise, and one wheel return at twice the body's
+/// radial velocity. With `points = 1` each car gives one detection at its centre.
+fn cars(frames: usize, points: usize) -> Vec<Frame> {
+    let mut noise = Noise(11);
+    let sensor_m = DVec2::new(3.86, 0.70);
+    (0..frames)
+        .map(|k| {
+            let t = 0.05 * k as f64;
+            let mut frame = Frame::new(t);
+            frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
+            for (id, lane_m) in [(1u64, 2.0), (2, 5.5)] {
+                let centre = DVec2::new(20.0 + 12.0 * t, lane_m);
+                let velocity = DVec2::new(12.0, 0.0);
+                let radial = |point: DVec2| velocity.dot((point - sensor_m).normalize());
+                let mut push = |point: DVec2, radial_velocity_mps: f64| {
+                    frame.measurements.push(Measurement {
+                        x_m: point.x + 0.2 * noise.next(),
+                        y_m: point.y + 0.2 * noise.next(),
+                        radial_velocity_mps,
+                        rcs_dbsm: 5.0,
+                        class: ObjectClass::Car,
+                        sensor_id: Some(3),
+                        ground_truth_id: Some(id),
+                    })
+                };
+                if points == 1 {
+                    push(centre, radial(centre));
+                    continue;
+                }
+                for p in 0..points - 1 {
+                    // Along the rear face (x = centre − 2.25 m), then the side facing the radar.
+                    let share = p as f64 / (points - 1) as f64;
+                    let point = if p % 2 == 0 {
+                        centre + DVec2::new(-2.25, -0.9 + 1.8 * share)
+                    } else {
+                        centre + DVec2::new(-2.25 + 4.5 * share, -0.9)
+                    };
+                    push(point, radial(point));
+                }
+                let wheel = centre + DVec2::new(-1.4, -0.9);
+                push(wheel, 2.0 * radial(wheel));
+            }
+            frame
+        })
+        .collect()
+}
+
+/// Confirmed tracks per frame over the last half of `frames`, and the tracker.
+fn confirmed_per_frame(config: Config, frames: &[Frame]) -> (f64, Tracker) {
+    let mut tracker = Tracker::new(config).unwrap();
+    let mut confirmed = 0usize;
+    for (k, frame) in frames.iter().enumerate() {
+        let outputs = tracker.step(frame).unwrap();
+        if k >= frames.len() / 2 {
+            confirmed += outputs.iter().filter(|output| output.status.is_confirmed()).count();
+        }
+    }
+    (confirmed as f64 / (frames.len() - frames.len() / 2) as f64, tracker)
+}
+
+#[test]
+fn a_point_cloud_radar_gives_one_track_per_car_where_each_detection_as_an_object_gives_more() {
+    let frames = cars(200, 5);
+    let (grouped, tracker) = confirmed_per_frame(config(DetectionModel::Points), &frames);
+    assert!((grouped - 2.0).abs() < 0.05, "{grouped} confirmed tracks per frame");
+    assert!(tracker.stats().detections_grouped > 200 * 2 * 3, "{:?}", tracker.stats().detections_grouped);
+    let (ungrouped, _) = confirmed_per_frame(config(DetectionModel::Objects), &frames);
+    assert!(ungrouped > 2.5, "{ungrouped} confirmed tracks per frame without grouping");
+}
+
+#[test]
+fn a_track_of_a_group_names_one_of_its_detections() {
+    let frames = cars(60, 5);
+    let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();
+    for frame in &frames {
+        let outputs = tracker.step(frame).unwrap();
+        for output in outputs {
+            if let Some(index) = output.measurement_index {
+                let measurement = frame.measurements[usize::from(index)];
+                assert!(measurement.position().distance(output.position_m) < 4.0, "{output:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn an_auto_radar_turns_to_points_on_a_point_cloud_and_stays_with_objects_otherwise() {
+    let (grouped, tracker) = confirmed_per_frame(config(DetectionModel::Auto), &cars(300, 5));
+    let sensor = tracker.sensors().of(Some(3));
+    assert!(sensor.groups_detections(), "{:?}", sensor.points);
+    assert!(sensor.points.share() > 0.6, "{:?}", sensor.points);
+    assert!(grouped < 2.2, "{grouped} confirmed tracks per frame");
+
+    let (single, tracker) = confirmed_per_frame(config(DetectionModel::Auto), &cars(300, 1));
+    let sensor = tracker.sensors().of(Some(3));
+    assert!(!sensor.groups_detections(), "{:?}", sensor.points);
+    assert!(sensor.points.samples > 100, "{:?}", sensor.points);
+    assert!((single - 2.0).abs() < 0.05, "{single}");
+}
+
+#[test]
+fn object_radars_are_tracked_exactly_as_without_a_front_end() {
+    let frames = cars(120, 1);
+    let mut auto = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    let mut objects = Tracker::new(config(DetectionModel::Objects)).unwrap();
+    for frame in &frames {
+        let a = auto.step(frame).unwrap().to_vec();
+        let b = objects.step(frame).unwrap().to_vec();
+        assert_eq!(a, b);
+    }
+    assert_eq!(auto.stats().detections_grouped, 0);
+}
+
+/// A frame that claims one measurement more than the capacity, repeating `frame`'s.
+struct Flood {
+    frame: Frame,
+    timestamp_s: f64,
+}
+
+impl FrameView for Flood {
+    fn timestamp_s(&self) -> f64 {
+        self.timestamp_s
+    }
+    fn len(&self) -> usize {
+        MAX_MEASUREMENTS_PER_FRAME + 1
+    }
+    fn measurement(&self, index: usize) -> Result<Measurement, UnknownClass> {
+        Ok(self.frame.measurements[index % self.frame.measurements.len()])
+    }
+    fn ego_pose(&self) -> Option<EgoPose> {
+        self.frame.ego_pose
+    }
+}
+
+#[test]
+fn a_frame_above_capacity_is_refused_and_counted_and_the_tracks_stay() {
+    let frames = cars(40, 5);
+    let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();
+    for frame in &frames {
+        tracker.step(frame).unwrap();
+    }
+    let before = format!("{:?}", tracker.tracks());
+    let flood = Flood { frame: frames[39].clone(), timestamp_s: frames[39].timestamp_s + 0.05 };
+    let error = tracker.step(&flood).unwrap_err();
+    assert!(matches!(error, StepError::InvalidFrame(FrameError::TooManyMeasurements { .. })), "{error}");
+    assert_eq!(tracker.stats().frames_rejected_too_many_measurements, 1);
+    assert_eq!(format!("{:?}", tracker.tracks()), before);
+}
+
+#[test]
+fn a_full_frame_of_point_cloud_detections_is_grouped() {
+    // 1,024 detections: 256 cars of four points each, on a grid 8 m apart.
+    let mut frame = Frame::new(0.0);
+    for car in 0..MAX_MEASUREMENTS_PER_FRAME / 4 {
+        let centre = DVec2::new(10.0 + 8.0 * (car % 16) as f64, -60.0 + 8.0 * (car / 16) as f64);
+        for corner in
+            [DVec2::new(-1.0, -0.5), DVec2::new(-1.0, 0.5), DVec2::new(1.0, -0.5), DVec2::new(1.0, 0.5)]
+        {
+            let point = centre + corner;
+            frame.measurements.push(Measurement {
+                x_m: point.x,
+                y_m: point.y,
+                radial_velocity_mps: 0.0,
+                rcs_dbsm: 0.0,
+                class: ObjectClass::Car,
+                sensor_id: None,
+                ground_truth_id: None,
+            });
+        }
+    }
+    let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();
+    let outputs = tracker.step(&frame).unwrap().len();
+    assert_eq!(outputs, MAX_MEASUREMENTS_PER_FRAME / 4);
+    assert_eq!(tracker.last_step().counts.detections_grouped, 3 * MAX_MEASUREMENTS_PER_FRAME as u64 / 4);
+}
+
+#[test]
+fn late_point_cloud_frames_give_the_tracks_and_the_estimates_of_in_order_arrival() {
+    let frames = cars(160, 5);
+    let mut in_order = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    for frame in &frames {
+        in_order.step(frame).unwrap();
+    }
+    // Every third pair of frames swapped: each of those frames arrives 50 ms late.
+    let mut shuffled = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    let mut order: Vec<usize> = (0..frames.len()).collect();
+    for pair in order.chunks_mut(6) {
+        pair.swap(0, 1);
+    }
+    for &index in &order {
+        shuffled.step(&frames[index]).unwrap();
+    }
+    assert!(shuffled.stats().late_frames_tracked > 20, "{:?}", shuffled.stats());
+    assert_eq!(shuffled.last_outputs(), in_order.last_outputs());
+    let (a, b) = (shuffled.sensors().of(Some(3)), in_order.sensors().of(Some(3)));
+    assert!(b.groups_detections());
+    assert_eq!(a.points, b.points);
+    assert_eq!(shuffled.stats().detections_grouped, in_order.stats().detections_grouped);
+}
+
+#[test]
+fn the_tracks_started_on_one_car_before_an_auto_radar_turned_to_points_end_but_one_per_car() {
+    // Objects first: every detection of the two cars starts a track, several are confirmed per
+    // car; once the radar turns to points the younger ones are shadowed and end.
+    let frames = cars(300, 5);
+    let mut tracker = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    let mut most_confirmed = 0;
+    for frame in &frames {
+        let confirmed = tracker.step(frame).unwrap().iter().filter(|o| o.status.is_confirmed()).count();
+        most_confirmed = most_confirmed.max(confirmed);
+    }
+    assert!(most_confirmed > 2, "{most_confirmed}");
+    let survivors: Vec<_> = tracker.tracks().iter().filter(|t| t.status.is_confirmed()).collect();
+    assert_eq!(survivors.len(), 2, "{survivors:?}");
+    assert!(tracker.sensors().of(Some(3)).groups_detections());
+}
+
+#[test]
+fn the_point_cloud_sensor_file_is_the_shipped_configuration_with_every_radar_delivering_points() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/sensors/point_cloud.toml");
+    assert_eq!(primm_config::from_file(&path).unwrap(), config(DetectionModel::Points));
+}
+
+#[test]
+fn bad_point_cloud_keys_are_refused_by_name() {
+    let text = primm_config::DEFAULT_CONFIG_TOML.replacen(
+        "range_std_m = 0.12",
+        "range_std_m = 0.12\ndetections = \"cloud\"",
+        1,
+    );
+    let error = primm_config::from_toml_str(&text).unwrap_err().to_string();
+    assert!(error.contains("cloud") && error.contains("points"), "{error}");
+    let refused = |change: fn(&mut Config)| {
+        let mut config = Config::default();
+        change(&mut config);
+        match Tracker::new(config) {
+            Err(primm_core::config::ConfigError::Invalid { key, .. }) => key,
+            other => panic!("expected an invalid key, got {other:?}"),
+        }
+    };
+    assert_eq!(refused(|c| c.frame.grouping.link_distance_m = -1.0), "frame.grouping.link_distance_m");
+    assert_eq!(refused(|c| c.frame.grouping.owner_margin_m = f64::NAN), "frame.grouping.owner_margin_m");
+    assert_eq!(
+        refused(|c| c.frame.grouping.points_share_threshold = 1.0),
+        "frame.grouping.points_share_threshold"
+    );
+    assert_eq!(refused(|c| c.frame.grouping.points_prior_scans = 0.0), "frame.grouping");
+}
