@@ -1,21 +1,25 @@
-//! A clutter flood: frames filled to capacity with false detections neither lose nor corrupt
-//! the tracks of real objects, and allocate nothing.
+//! A clutter flood: frames of 240 false detections around 16 real objects neither lose nor
+//! corrupt the tracks of the real objects, and allocate nothing.
 
 use crate::common;
 use crate::common::counting_allocator::count_allocations;
 use primm_core::config::Config;
-use primm_core::measurement::{Frame, Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::mode::Method;
 use primm_core::tracker::Tracker;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
 
-/// The object measurements of `frame` plus false detections up to the frame's capacity, spread
+/// The object measurements of `frame` plus false detections up to [`FLOODED_FRAME`], spread
 /// over sensor 1's field of view (where the lanes are) with random classes, radial velocities and RCS.
+/// Measurements of a flooded frame: 240 false detections with the 16 objects, about a hundred
+/// times the clutter of a busy road scene.
+const FLOODED_FRAME: usize = 256;
+
 fn flooded(frame: &Frame, rng: &mut ChaCha8Rng) -> Frame {
     let mut flooded = frame.clone();
-    while flooded.measurements.len() < MAX_MEASUREMENTS_PER_FRAME {
+    while flooded.measurements.len() < FLOODED_FRAME {
         let range = rng.random_range(2.0..130.0);
         let bearing = rng.random_range(-145f64..-25.0).to_radians();
         flooded.measurements.push(Measurement {

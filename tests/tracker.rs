@@ -345,11 +345,12 @@ fn a_bad_measurement_is_rejected_alone_and_the_rest_of_the_frame_is_tracked() {
 fn a_full_table_refuses_new_tracks_and_keeps_the_old_ones() {
     use primm_core::track_table::MAX_TRACKS;
     let mut tracker = Tracker::new(imm_config()).unwrap();
-    // Frames of 256 far-apart measurements, shifted each frame so nothing associates: the table
-    // fills up, then refuses.
+    // Frames of 256 far-apart measurements (half the table), shifted each frame so nothing
+    // associates: the table fills up in two frames, then refuses.
+    const PER_FRAME: usize = MAX_TRACKS / 2;
     let frame_at = |k: usize| {
         let mut frame = Frame::new(k as f64 * 0.05);
-        for j in 0..MAX_MEASUREMENTS_PER_FRAME {
+        for j in 0..PER_FRAME {
             frame.measurements.push(common::measurement(
                 1000.0 * k as f64 + 20.0 * (j % 16) as f64,
                 20.0 * (j / 16) as f64,
@@ -363,8 +364,8 @@ fn a_full_table_refuses_new_tracks_and_keeps_the_old_ones() {
     let full: Vec<u64> = tracker.tracks().iter().map(|t| t.id).collect();
     assert_eq!(full.len(), MAX_TRACKS);
     tracker.step(&frame_at(2)).unwrap();
-    assert_eq!(tracker.stats().initiations_refused_table_full, MAX_MEASUREMENTS_PER_FRAME as u64);
-    assert_eq!(tracker.last_step().counts.initiations_refused_table_full, MAX_MEASUREMENTS_PER_FRAME as u64);
+    assert_eq!(tracker.stats().initiations_refused_table_full, PER_FRAME as u64);
+    assert_eq!(tracker.last_step().counts.initiations_refused_table_full, PER_FRAME as u64);
     // Nothing was evicted to make room: the surviving tracks are old ones.
     assert!(tracker.tracks().iter().all(|t| full.contains(&t.id)));
 }

@@ -47,6 +47,16 @@ fn ten_thousand_frames_of_sixty_four_objects_allocate_nothing_with_an_oracle_pre
     assert_eq!(updates, 640_000);
 }
 
+/// `config` with every radar delivering objects. The crossing scene packs eight cars closer than
+/// their own size, so confirmed tracks hold several detections each, as under a point cloud,
+/// and `detections = "auto"` would group them; the scene is here to load the assignment solver.
+fn object_radars(mut config: Config) -> Config {
+    use primm_core::grouping::DetectionModel;
+    config.frame.unmounted_detections = DetectionModel::Objects;
+    config.frame.sensors.iter_mut().for_each(|sensor| sensor.detections = DetectionModel::Objects);
+    config
+}
+
 /// Clusters and cars per cluster of the crossing scene: 72 cars in groups of 8.
 const CLUSTERS: usize = 9;
 const CARS_PER_CLUSTER: usize = 8;
@@ -124,7 +134,7 @@ fn assert_the_solver_ran_on_every_cluster(work: &SolverWork) {
 
 #[test]
 fn dense_crossing_clusters_reach_the_assignment_solver_and_allocate_nothing_without_the_learned_mode() {
-    let tracker = Tracker::new(Config::default().with_modes(Method::Imm.modes())).unwrap();
+    let tracker = Tracker::new(object_radars(Config::default().with_modes(Method::Imm.modes()))).unwrap();
     let (allocations, work) = run_crossing_counted(tracker);
     assert_eq!(allocations, 0);
     assert_the_solver_ran_on_every_cluster(&work);
@@ -133,7 +143,7 @@ fn dense_crossing_clusters_reach_the_assignment_solver_and_allocate_nothing_with
 #[test]
 fn dense_crossing_clusters_reach_the_assignment_solver_and_allocate_nothing_with_an_oracle_predictor() {
     let oracle = common::LaneOracle { objects: common::crossing_clusters(CLUSTERS, CARS_PER_CLUSTER, 4.0) };
-    let tracker = Tracker::with_predictor(Config::default(), oracle).unwrap();
+    let tracker = Tracker::with_predictor(object_radars(Config::default()), oracle).unwrap();
     let (allocations, work) = run_crossing_counted(tracker);
     assert_eq!(allocations, 0);
     assert_the_solver_ran_on_every_cluster(&work);

@@ -152,8 +152,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// Each confirmed track's count of the frame's detections of an `auto` radar on its object
-    /// (every detection its box grown by the class's `extent.absorb_margin_m` holds, whichever
-    /// track owns it: a radar's point cloud tracked one detection at a time gives an object
+    /// and moving as it (every detection inside its box, not grown, whose radial velocity is the track's along the detection's line of sight within
+    /// `link_radial_velocity_gap_mps`, so that clutter and crossing objects in the box do not
+    /// count; whichever track owns it: a radar's point cloud tracked one detection at a time gives an object
     /// several tracks, each holding the object's detections) into that radar's
     /// [`PointsEstimate`](crate::sensor::points::PointsEstimate), one radar at a time.
     fn learn_points(&mut self) {
@@ -175,10 +176,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     continue;
                 }
                 let position_m = detection.measurement.position();
+                let line_of_sight = (position_m - detection.sensor_position_m).normalize_or_zero();
                 for row in 0..tracks {
                     let track = &self.table.tracks()[row];
-                    let margin_m = self.config.classes.get(track.class).extent.absorb_margin_m;
-                    if track.status.is_confirmed() && self.holds(row, position_m, margin_m).is_some() {
+                    // On the box itself: a point cloud lies on it, a neighbour's detection rarely.
+                    let margin_m = 0.0;
+                    // Moving as the object: clutter and crossing objects in the box do not.
+                    let expected_mps = self.priors[row].fused_velocity_mps().dot(line_of_sight);
+                    let moving_as_object = (detection.measurement.radial_velocity_mps - expected_mps).abs()
+                        <= config.link_radial_velocity_gap_mps;
+                    if track.status.is_confirmed()
+                        && moving_as_object
+                        && self.holds(row, position_m, margin_m).is_some()
+                    {
                         self.owned_counts[row] += 1;
                     }
                 }
