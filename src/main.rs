@@ -23,6 +23,10 @@ enum Command {
     Publish(primm_publisher::Args),
     /// Show or record the tracks of the service (same as `primm-subscriber`).
     Subscribe(primm_subscriber::Args),
+    /// Record the service's streams into an MCAP file (Foxglove's format).
+    Record(cli::record::Args),
+    /// Publish the measurement frames of an MCAP recording onto the service.
+    Replay(cli::replay::Args),
     /// Generate simulated radar sequences as measurement CSV files.
     Generate(cli::generate::Args),
     /// The true reflection offset, detection probability and clutter density of simulated sensors.
@@ -65,6 +69,12 @@ enum CommandError {
     /// `primm subscribe` failed.
     #[error(transparent)]
     Subscribe(#[from] primm_subscriber::SubscribeError),
+    /// `primm record` failed.
+    #[error(transparent)]
+    Record(#[from] cli::record::RecordCommandError),
+    /// `primm replay` failed.
+    #[error(transparent)]
+    Replay(#[from] cli::replay::ReplayCommandError),
     /// `primm generate` failed.
     #[error(transparent)]
     Generate(#[from] cli::generate::GenerateError),
@@ -112,6 +122,8 @@ fn main() -> ExitCode {
         Command::Serve(args) => cli::serve::run(args).map_err(Into::into),
         Command::Publish(args) => primm_publisher::run(args).map_err(Into::into),
         Command::Subscribe(args) => primm_subscriber::run(args).map_err(Into::into),
+        Command::Record(args) => cli::record::run(&args).map_err(Into::into),
+        Command::Replay(args) => cli::replay::run(&args).map_err(Into::into),
         Command::Generate(args) => cli::generate::run(&args).map_err(Into::into),
         Command::SensorTruth(args) => cli::sensor_truth::run(&args).map_err(Into::into),
         Command::Track(args) => cli::track::run(&args).map_err(Into::into),

@@ -3,8 +3,8 @@
 //! `ARCHITECTURE.md` draws it (core ← config ← predictor, core ← wire ← ipc ← service,
 //! core ← sim), with
 //! the fuzz targets' crate on top of them and nothing depending on it; the publisher, the
-//! subscriber and the tunnel use the shared-memory plumbing (`primm-ipc`), not the tracking
-//! service.
+//! subscriber, the tunnel and the recorder use the shared-memory plumbing (`primm-ipc`), not the
+//! tracking service, and the Foxglove SDK and MCAP crates stay in the recorder.
 
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -33,7 +33,10 @@ fn dependency_names(package: &str, extra: &[&str]) -> BTreeSet<String> {
 
 #[test]
 fn primm_core_names_no_runtime_io_or_command_line_crate() {
-    const FORBIDDEN: [&str; 11] = [
+    const FORBIDDEN: [&str; 14] = [
+        "foxglove",
+        "mcap",
+        "tokio",
         "tract-onnx",
         "tract-core",
         "iceoryx2",
@@ -72,13 +75,15 @@ fn dependencies_between_primm_crates_point_one_way() {
     assert_eq!(primm("primm-sim"), set(&["primm-sim", "primm-core"]));
     assert_eq!(primm("primm-ffi"), set(&["primm-ffi", "primm-config", "primm-predictor", "primm-core"]));
     assert_eq!(primm("primm-tunnel"), set(&["primm-tunnel", "primm-ipc", "primm-wire", "primm-core"]));
-    for program in ["primm-publisher", "primm-subscriber"] {
-        assert_eq!(
-            primm(program),
-            set(&[program, "primm-ipc", "primm-sim", "primm-wire", "primm-core"]),
-            "{program}"
-        );
-    }
+    assert_eq!(primm("primm-record"), set(&["primm-record", "primm-ipc", "primm-wire", "primm-core"]));
+    assert_eq!(
+        primm("primm-publisher"),
+        set(&["primm-publisher", "primm-ipc", "primm-sim", "primm-wire", "primm-core"])
+    );
+    assert_eq!(
+        primm("primm-subscriber"),
+        set(&["primm-subscriber", "primm-record", "primm-ipc", "primm-sim", "primm-wire", "primm-core"])
+    );
     assert_eq!(
         primm("primm-fuzz-targets"),
         set(&[
@@ -96,8 +101,8 @@ fn dependencies_between_primm_crates_point_one_way() {
 }
 
 #[test]
-fn the_publisher_subscriber_and_tunnel_do_not_build_the_tracking_service() {
-    for package in ["primm-publisher", "primm-subscriber", "primm-tunnel"] {
+fn the_publisher_subscriber_tunnel_and_recorder_do_not_build_the_tracking_service() {
+    for package in ["primm-publisher", "primm-subscriber", "primm-tunnel", "primm-record"] {
         let names = dependency_names(package, &[]);
         assert!(names.contains("primm-ipc"), "{package}: {names:?}");
         assert!(!names.contains("primm-service"), "{package} depends on primm-service");
@@ -116,6 +121,7 @@ fn no_library_crate_depends_on_the_fuzz_targets_or_a_fuzzing_crate() {
         "primm-sim",
         "primm-ffi",
         "primm-tunnel",
+        "primm-record",
     ];
     for package in packages {
         let names = dependency_names(package, &[]);
@@ -135,6 +141,7 @@ fn zenoh_is_built_into_primm_only_with_the_tunnel_feature() {
         "primm-ffi",
         "primm-publisher",
         "primm-subscriber",
+        "primm-record",
     ] {
         assert!(!dependency_names(package, &[]).contains("zenoh"), "{package} depends on zenoh");
     }

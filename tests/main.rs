@@ -54,6 +54,7 @@ mod predictor_threaded;
 mod predictor_usefulness;
 mod process_noise;
 mod radial_velocity_update;
+mod recording;
 mod scenario;
 mod sensor_layout;
 mod sensor_models;

@@ -179,6 +179,11 @@ impl Replayer {
         }
     }
 
+    /// Subscribers of the track stream now (the tracker's answers are read by each).
+    pub fn track_subscribers(&self) -> usize {
+        self.tracks.subscriber_count()
+    }
+
     /// The sequence number the next frame will carry.
     pub fn next_sequence(&self) -> u64 {
         self.next_sequence
@@ -245,6 +250,41 @@ impl Replayer {
         Ok(SentFrame { sequence, receivers })
     }
 
+    /// Sends a frame recorded from the wire again (`primm replay`): its source frame, sensor
+    /// time, flags, ego pose and measurements as recorded (at most [`MEASUREMENT_CAPACITY`]),
+    /// with this replayer's next sequence number, the current publish time and
+    /// `scheduled_time_ns` (0: no schedule). Never waits, as [`send`](Self::send).
+    pub fn send_recorded(
+        &mut self,
+        recorded: &MeasurementFrame,
+        scheduled_time_ns: u64,
+    ) -> Result<SentFrame, ReplayError> {
+        let mut loan = self.publisher.loan_uninit().map_err(ReplayError::Loan)?;
+        let mut writer = MeasurementFrameWriter::new(loan.payload_mut());
+        let count = (recorded.count as usize).min(MEASUREMENT_CAPACITY);
+        for measurement in &recorded.measurements[..count] {
+            // Cannot fail: at most the capacity.
+            let _ = writer.push(*measurement);
+        }
+        let sequence = self.next_sequence;
+        writer.finish(&MeasurementFrameHeader {
+            sequence,
+            source_frame: recorded.source_frame,
+            sensor_timestamp_s: recorded.sensor_timestamp_s,
+            publish_time_ns: monotonic_ns(),
+            scheduled_time_ns,
+            flags: recorded.flags,
+            ego: recorded.ego_pose(),
+        });
+        // SAFETY: as in `send_scheduled`: the header and the first `count` measurements are
+        // written, and every other slot holds plain integers and floats.
+        let sample = unsafe { loan.assume_init() };
+        let receivers = sample.send().map_err(ReplayError::Send)?;
+        let _ = self.notifier.notify();
+        self.next_sequence += 1;
+        Ok(SentFrame { sequence, receivers })
+    }
+
     /// Reads the tracker's answers that arrived so far.
     fn collect_answers(&mut self) -> Result<(), ReplayError> {
         self.receive_answers(|_| {}).map(|_| ())
@@ -274,8 +314,9 @@ impl Replayer {
         }
     }
 
-    /// Waits until at most `max` frames are unanswered.
-    fn wait_in_flight(
+    /// Waits until at most `max` frames are unanswered (flow control only; without it, returns
+    /// at once).
+    pub fn wait_in_flight(
         &mut self,
         max: u64,
         timeout: Duration,

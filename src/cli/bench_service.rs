@@ -12,6 +12,9 @@
 //!   and with `--find-max-rate` the highest rate sustained without losing a frame (doubling,
 //!   then bisection, a fresh tracker per trial; `primm_publisher::load`).
 
+mod recorder_process;
+mod viewer_client;
+
 use super::latency_out::parse_positive_seconds;
 use super::TrackerArgs;
 use primm_core::mode::Method;
@@ -21,6 +24,7 @@ use primm_publisher::load::{
     RateTrial, RateTrialError, RateTrialOptions, LANE_SCENE_FRAMES, LANE_SCENE_FRAME_INTERVAL_S,
 };
 use primm_publisher::replay::Replayer;
+use primm_record::live::FoxgloveArgs;
 use primm_service::clock::monotonic_ns;
 use primm_service::latency::summarise;
 use primm_service::latency_files::{
@@ -29,11 +33,13 @@ use primm_service::latency_files::{
 use primm_service::realtime::TrackerRealtimeArgs;
 use primm_service::{ConnectError, ServiceNames, ShutdownFlag};
 use primm_sim::io::Sequence;
+use recorder_process::RecorderProcess;
 use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
+use viewer_client::ViewerClient;
 
 /// How the tracker under test runs: the options passed on to `primm serve`. Settings of the
 /// tracking process (methods, engines, wait modes, scheduling) belong here.
@@ -59,6 +65,9 @@ pub struct TrackerSettings {
     /// threads stay unpinned.
     #[command(flatten)]
     pub realtime: TrackerRealtimeArgs,
+    /// The tracker's live Foxglove view (`--foxglove [ADDRESS]`).
+    #[command(flatten)]
+    pub view: FoxgloveArgs,
 }
 
 impl TrackerSettings {
@@ -76,6 +85,9 @@ impl TrackerSettings {
             arguments.push("--no-speculation".into());
         }
         arguments.extend(self.realtime.to_arguments().into_iter().map(OsString::from));
+        if let Some(address) = self.view.foxglove {
+            arguments.extend(["--foxglove".into(), address.to_string().into()]);
+        }
         arguments
     }
 
@@ -123,6 +135,14 @@ pub struct Args {
     /// Bisection steps of the search after the first rate with loss.
     #[arg(long, default_value_t = 4, value_name = "N")]
     pub steps: usize,
+    /// Connect a Foxglove WebSocket client to the tracker's live view (`--foxglove`) for each
+    /// trial, subscribed to every topic: the cost of a watching viewer (docs/recording.md).
+    #[arg(long, requires = "foxglove")]
+    pub foxglove_client: bool,
+    /// Run `primm record` into this MCAP file beside the tracker during the main trial (what
+    /// recording costs; its summary says whether it missed a frame).
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
     /// Highest rate the search tries, Hz.
     #[arg(long, default_value_t = 50_000.0, value_name = "HZ", value_parser = parse_rate)]
     pub max_hz: f64,
@@ -178,6 +198,9 @@ pub enum BenchServiceError {
     /// The tracker's latency files could not be read back.
     #[error(transparent)]
     ReadLog(#[from] ReadLogError),
+    /// The Foxglove client or the recorder failed.
+    #[error("{0}")]
+    Watcher(String),
     /// The summary could not be written.
     #[error("cannot write {path}: {source}")]
     Summary {
@@ -323,6 +346,17 @@ fn run_trial(
         files.map(|directory| (directory, args.latency_interval_s)),
     )?;
     tracker.wait_until_serving(&replayer, shutdown)?;
+    let recorder = match args.record.as_deref().filter(|_| files.is_some()) {
+        Some(path) => Some(
+            RecorderProcess::start(exe, &prefix, path, || replayer.track_subscribers())
+                .map_err(BenchServiceError::Watcher)?,
+        ),
+        None => None,
+    };
+    let viewer = match args.tracker.view.foxglove.filter(|_| args.foxglove_client) {
+        Some(address) => Some(ViewerClient::start(address).map_err(BenchServiceError::Watcher)?),
+        None => None,
+    };
     let interval = Duration::from_secs_f64(args.latency_interval_s);
     let mut client_files = match files {
         Some(directory) => {
@@ -351,6 +385,13 @@ fn run_trial(
             }
         }
     })?;
+    if let Some(viewer) = viewer {
+        let received = viewer.finish().map_err(BenchServiceError::Watcher)?;
+        println!("Foxglove client received {received} messages");
+    }
+    if let Some(recorder) = recorder {
+        print!("{}", recorder.finish().map_err(BenchServiceError::Watcher)?);
+    }
     let tracker_output = tracker.stop()?;
     if let Some(error) = file_error {
         return Err(error.into());
@@ -549,6 +590,7 @@ mod tests {
             busy_poll: true,
             no_speculation: true,
             realtime: TrackerRealtimeArgs::default(),
+            view: FoxgloveArgs::default(),
         };
         let arguments: Vec<String> = settings
             .serve_arguments()
@@ -587,6 +629,7 @@ mod tests {
                 },
                 inference_cpu_affinity: Some("0-1".parse().unwrap()),
             },
+            view: FoxgloveArgs { foxglove: Some("127.0.0.1:8765".parse().unwrap()) },
         };
         let arguments: Vec<String> = settings
             .serve_arguments()
@@ -605,7 +648,9 @@ mod tests {
                 "--realtime-priority",
                 "50",
                 "--lock-memory",
-                "--require-realtime"
+                "--require-realtime",
+                "--foxglove",
+                "127.0.0.1:8765"
             ]
         );
     }

@@ -9,6 +9,7 @@
 use super::latency_out::LatencyOutArgs;
 use primm_core::mode::Method;
 use primm_publisher::DEFAULT_SCENARIO_SEED;
+use primm_record::live::FoxgloveArgs;
 use primm_service::catalog;
 use primm_service::{ConnectError, ServiceNames};
 use std::path::{Path, PathBuf};
@@ -58,6 +59,13 @@ pub struct Args {
     /// per stage, `tracker.svg` and `subscriber.svg`.
     #[command(flatten)]
     pub latency_files: LatencyOutArgs,
+    /// A live Foxglove view from the subscriber (`--foxglove [ADDRESS]`, default
+    /// 127.0.0.1:8765; docs/recording.md).
+    #[command(flatten)]
+    pub view: FoxgloveArgs,
+    /// Also record the three streams into this MCAP file (`primm record`).
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
 }
 
 /// Why the demo failed.
@@ -264,9 +272,18 @@ pub fn run(args: Args) -> Result<(), DemoError> {
         &args,
         files.join(format!("{prefix}-subscriber.log")),
     )?;
-    // Start the publisher once the tracker serves and the subscriber listens, so that no frame
-    // and no answer is missed.
+    let mut recorder = match &args.record {
+        Some(path) => {
+            Some(spawn_recorder(&exe, &prefix, path, files.join(format!("{prefix}-recorder.log")))?)
+        }
+        None => None,
+    };
+    // Start the publisher once the tracker serves and the subscriber (and the recorder) listen,
+    // so that no frame and no answer is missed.
     wait_until_connected(&names, &mut tracker, &mut subscriber)?;
+    if let Some(recorder) = recorder.as_mut() {
+        wait_for_recorder(&names, recorder)?;
+    }
     let publisher =
         spawn_publisher(&exe, &prefix, None, &args, files.join(format!("{prefix}-publisher.log")))?;
     let replay_s = args.duration_s / args.speed.max(1e-3);
@@ -275,6 +292,9 @@ pub fn run(args: Args) -> Result<(), DemoError> {
     let _ = std::fs::remove_file(&summary_path);
     let outputs = outputs?;
 
+    if let Some(recorder) = recorder.as_mut() {
+        println!("\n== recorder (primm record) ==\n{}", finish_recorder(recorder)?);
+    }
     println!("\n== subscriber (primm-subscriber) ==\n{}", outputs.subscriber);
     println!("== tracker (primm serve) ==\n{}", outputs.tracker);
     if !outputs.logs.is_empty() {
@@ -366,9 +386,56 @@ fn spawn_subscriber(
     if args.busy_poll {
         command.arg("--busy-poll");
     }
+    if let Some(address) = args.view.foxglove {
+        command.arg("--foxglove").arg(address.to_string());
+    }
     pass_latency_files(&mut command, args);
     quiet_logs(&mut command);
     Managed::spawn("the subscriber", &mut command, stderr_path)
+}
+
+/// Starts `primm record` under `prefix` until the end of the replay, into `path`.
+fn spawn_recorder(exe: &Path, prefix: &str, path: &Path, stderr_path: PathBuf) -> Result<Managed, DemoError> {
+    let mut command = Command::new(exe);
+    command
+        .args(["record", "--service-prefix", prefix, "--until-end", "--output"])
+        .arg(path)
+        .stdout(Stdio::piped());
+    quiet_logs(&mut command);
+    Managed::spawn("the recorder (primm record)", &mut command, stderr_path)
+}
+
+/// Waits up to [`READY_TIMEOUT`] until the recorder subscribes too (a second subscriber of the
+/// tracks besides the subscriber).
+fn wait_for_recorder(names: &ServiceNames, recorder: &mut Managed) -> Result<(), DemoError> {
+    let node = catalog::create_node("primm-demo")?;
+    let tracks = catalog::tracks(&node, names)?;
+    let deadline = Instant::now() + READY_TIMEOUT;
+    while tracks.subscriber_count() < 2 {
+        if let Some(status) = recorder.exited()? {
+            return Err(recorder.exited_error(status));
+        }
+        if Instant::now() >= deadline {
+            return Err(DemoError::Timeout {
+                what: recorder.what,
+                event: "come up",
+                seconds: READY_TIMEOUT.as_secs(),
+            });
+        }
+        std::thread::sleep(POLL_INTERVAL);
+    }
+    Ok(())
+}
+
+/// Waits for the recorder to write the end of the replay and close its file; its summary.
+fn finish_recorder(recorder: &mut Managed) -> Result<String, DemoError> {
+    match recorder.wait(STOP_GRACE)? {
+        Some(status) if status.success() => Ok(recorder.output().0),
+        Some(status) => Err(recorder.exited_error(status)),
+        None => {
+            Err(DemoError::Timeout { what: recorder.what, event: "finish", seconds: STOP_GRACE.as_secs() })
+        }
+    }
 }
 
 /// Starts the publisher replaying the built-in scenario under `prefix`.

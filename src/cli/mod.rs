@@ -11,11 +11,14 @@ pub mod generate;
 pub mod latency_out;
 pub mod latency_plot;
 pub mod man;
+pub mod record;
+pub mod replay;
 pub mod score;
 pub mod sensor_truth;
 pub mod serve;
 pub mod soak;
 pub mod track;
+pub mod track_mcap;
 pub mod tracker_args;
 #[cfg(feature = "tunnel")]
 pub mod tunnel;

@@ -11,6 +11,9 @@ use primm_predictor::load_predictor;
 use primm_predictor::onnx::ModelError;
 use primm_predictor::split::{on_inference_threads, InferenceThreadsError, SplitPredictor};
 use primm_predictor::threaded::ThreadedPredictor;
+use primm_record::live::FoxgloveArgs;
+use primm_record::transforms::RadarPose;
+use primm_record::{LiveServerError, LiveView};
 use primm_service::catalog::SERVICE_PREFIX_ENV;
 use primm_service::latency_files::LatencyFilesError;
 use primm_service::realtime::{RealtimeRefused, RealtimeReport, RealtimeSettings, TrackerRealtimeArgs};
@@ -69,6 +72,10 @@ pub struct Args {
     /// Real-time settings of the tracking and inference threads (docs/realtime-tuning.md).
     #[command(flatten)]
     pub realtime: TrackerRealtimeArgs,
+    /// A live Foxglove view of the service's streams (`--foxglove [ADDRESS]`), served from a
+    /// subscriber on a thread of its own (docs/recording.md).
+    #[command(flatten)]
+    pub view: FoxgloveArgs,
 }
 
 /// `--publish-time`.
@@ -123,6 +130,9 @@ pub enum ServeError {
     /// A real-time setting could not be applied and `--require-realtime` was given.
     #[error(transparent)]
     Realtime(#[from] RealtimeRefused),
+    /// The live Foxglove view could not start.
+    #[error(transparent)]
+    Foxglove(#[from] LiveServerError),
 }
 
 /// Runs the service until SIGINT or SIGTERM, then prints the counters and the latency table.
@@ -138,6 +148,7 @@ pub fn run(args: Args) -> Result<(), ServeError> {
     // Checked before the model and its threads are set up, so a bad value is named, not spawned.
     settings.validate()?;
     let Settings { tracker: config, inference } = settings;
+    let radars: Vec<RadarPose> = config.frame.sensors.iter().map(RadarPose::from).collect();
     let realtime = args.realtime.settings();
     let mut report = RealtimeReport::default();
     if args.method.needs_predictor() {
@@ -147,12 +158,12 @@ pub fn run(args: Args) -> Result<(), ServeError> {
                 realtime.apply_to_inference_thread(thread, index, &mut report);
             }
         }
-        serve(Tracker::with_predictor(config, predictor)?, &args, &realtime, report)
+        serve(Tracker::with_predictor(config, predictor)?, &args, &realtime, report, radars)
     } else {
         if realtime.inference_cpu_affinity.is_some() {
             tracing::warn!(method = %args.method, "--inference-cpu-affinity ignored: the method runs no inference thread");
         }
-        serve(Tracker::with_predictor(config, NoPredictor)?, &args, &realtime, report)
+        serve(Tracker::with_predictor(config, NoPredictor)?, &args, &realtime, report, radars)
     }
 }
 
@@ -177,12 +188,14 @@ fn learned_predictor(
 }
 
 /// Serves with `tracker` until SIGINT or SIGTERM. The tracking thread's real-time settings
-/// and the memory lock are applied once the service is built (its allocations made).
+/// and the memory lock are applied once the service is built (its allocations made); the live
+/// view's thread, if asked for, starts before and is left out of them.
 fn serve<P: DisplacementPredictor>(
     tracker: Tracker<P>,
     args: &Args,
     realtime: &RealtimeSettings,
     mut report: RealtimeReport,
+    radars: Vec<RadarPose>,
 ) -> Result<(), ServeError> {
     let shutdown = ShutdownFlag::on_signals().map_err(ServeError::Signals)?;
     let options = TrackingOptions {
@@ -201,6 +214,13 @@ fn serve<P: DisplacementPredictor>(
     if let Some(directory) = args.latency_files.directory() {
         service.write_latency_files(directory, args.latency_files.interval())?;
     }
+    let view = match args.view.foxglove {
+        Some(address) => Some(LiveView::start(address, &names, radars)?),
+        None => None,
+    };
+    if let Some(view) = &view {
+        println!("Foxglove live view on ws://{}", view.local_address());
+    }
     realtime.apply_to_current_thread("tracking thread", &mut report);
     realtime.lock_memory_now(&mut report);
     report.finish(realtime.require_realtime)?;
@@ -213,6 +233,7 @@ fn serve<P: DisplacementPredictor>(
         "tracker serving"
     );
     let result = service.run(&shutdown);
+    drop(view);
     println!("{}", service.summary());
     let files = service.finish_latency_files();
     result?;

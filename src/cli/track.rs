@@ -1,5 +1,6 @@
 //! `primm track`: offline tracking of a measurement CSV file into a track CSV file.
 
+use super::track_mcap::OfflineRecording;
 use super::TrackerArgs;
 use clap::Args as ClapArgs;
 use primm_core::mode::Method;
@@ -9,6 +10,7 @@ use primm_core::validation::FrameError;
 use primm_predictor::onnx::ModelError;
 use primm_predictor::split::{on_inference_threads, InferenceThreadsError};
 use primm_predictor::{load_predictor, predictor_for};
+use primm_record::transforms::RadarPose;
 use primm_sim::io::association_csv::AssociationCsvWriter;
 use primm_sim::io::track_csv::TrackCsvWriter;
 use primm_sim::io::{read_sequence_file, CsvError, TooManyMeasurements};
@@ -47,6 +49,10 @@ pub struct Args {
     /// per second, percentiles) on stdout.
     #[arg(long, value_name = "FILE")]
     pub timing: Option<PathBuf>,
+    /// Also write the run as an MCAP recording (the topics of `primm record`, the ground truth
+    /// included; docs/recording.md), to open in Foxglove or replay with `primm replay`.
+    #[arg(long, value_name = "FILE")]
+    pub mcap: Option<PathBuf>,
     /// Run the PR model on COUNT inference threads (1 to 8) instead of on the tracking thread,
     /// each step handing them the next frame's requests ahead for its guessed time
     /// (speculation); the threads spin briefly before parking, so give each one a core of its
@@ -112,6 +118,12 @@ pub enum TrackError {
     /// Writing an output file failed.
     #[error(transparent)]
     Write(#[from] std::io::Error),
+    /// The MCAP file could not be written.
+    #[error(transparent)]
+    Mcap(#[from] primm_record::McapFileError),
+    /// A message could not be written into the MCAP file.
+    #[error(transparent)]
+    McapMessage(#[from] primm_record::SinkError),
     /// The tracker rejected a frame.
     #[error("frame {frame}: {source}")]
     Step {
@@ -145,6 +157,17 @@ fn track_predictor(
     Ok(Box::new(split))
 }
 
+/// `--mcap`'s recording of `frames` frames, drawing the tracker's configured radars.
+fn offline_recording<P: DisplacementPredictor>(
+    path: Option<&Path>,
+    tracker: &Tracker<P>,
+    frames: usize,
+) -> Result<Option<OfflineRecording>, TrackError> {
+    let Some(path) = path else { return Ok(None) };
+    let radars = tracker.config().frame.sensors.iter().map(RadarPose::from).collect();
+    Ok(Some(OfflineRecording::create(path, radars, frames)?))
+}
+
 /// Runs `primm track`.
 pub fn run(args: &Args) -> Result<(), TrackError> {
     let settings = args.tracker.load_settings()?;
@@ -164,6 +187,7 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         None => None,
     };
     let frames = sequence.to_frames()?;
+    let mut recording = offline_recording(args.mcap.as_deref(), &tracker, frames.len())?;
     let mut step_ns: Vec<u64> = Vec::with_capacity(frames.len());
     tracker.reset();
     // Frames in file order, which is arrival order: a late frame (within
@@ -174,8 +198,11 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         let start = std::time::Instant::now();
         match tracker.step(frame) {
             Ok(_) => {}
-            Err(StepError::InvalidFrame(FrameError::TooLate { .. })) => {
+            Err(StepError::InvalidFrame(error @ FrameError::TooLate { .. })) => {
                 eprintln!("frame {}: older than the late-frame window reaches; skipped", recorded.index);
+                if let Some(recording) = recording.as_mut() {
+                    recording.write_rejected(recorded, &StepError::InvalidFrame(error))?;
+                }
                 continue;
             }
             Err(source) => return Err(TrackError::Step { frame: recorded.index, source }),
@@ -184,6 +211,9 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
             tracker.speculate();
         }
         step_ns.push(start.elapsed().as_nanos() as u64);
+        if let Some(recording) = recording.as_mut() {
+            recording.write_tracked(recorded, &tracker)?;
+        }
         let outputs =
             if tracker.last_step().late() { tracker.late_frame_outputs() } else { tracker.last_outputs() };
         writer.write_frame(recorded.index, recorded.timestamp_s, outputs)?;
@@ -192,22 +222,14 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
         }
     }
     writer.finish()?;
+    if let Some(recording) = recording {
+        recording.finish()?;
+    }
     if let Some(associations) = associations {
         associations.finish()?;
     }
     if let Some(path) = &args.timing {
-        use std::io::Write as _;
-        let file = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .map_err(|source| TrackError::Open { path: path.clone(), source })?;
-        let mut out = std::io::BufWriter::new(file);
-        for ns in &step_ns {
-            writeln!(out, "{ns}")?;
-        }
-        out.flush()?;
-        println!("{}", timing_json(args.method, &mut step_ns));
+        write_timing(path, args.method, &mut step_ns)?;
     }
     let stats = tracker.stats();
     eprintln!(
@@ -223,6 +245,27 @@ pub fn run(args: &Args) -> Result<(), TrackError> {
     if !sensors.is_empty() {
         eprintln!("sensors (estimated from the data):\n{sensors}");
     }
+    Ok(())
+}
+
+/// Appends the step times to `path`, one per line in ns, and prints their summary.
+fn write_timing(
+    path: &Path,
+    method: primm_core::mode::Method,
+    step_ns: &mut [u64],
+) -> Result<(), TrackError> {
+    use std::io::Write as _;
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .map_err(|source| TrackError::Open { path: path.to_owned(), source })?;
+    let mut out = std::io::BufWriter::new(file);
+    for ns in step_ns.iter() {
+        writeln!(out, "{ns}")?;
+    }
+    out.flush()?;
+    println!("{}", timing_json(method, step_ns));
     Ok(())
 }
 

@@ -41,6 +41,8 @@ use primm_ipc::clock::monotonic_ns;
 use primm_ipc::latency_files::{LatencyFiles, LatencyFilesError, StageDescription};
 use primm_ipc::realtime::{RealtimeArgs, RealtimeRefused, RealtimeReport};
 use primm_ipc::{ConnectError, ServiceNames, ShutdownFlag};
+use primm_record::live::FoxgloveArgs;
+use primm_record::{LiveServerError, LiveView};
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -87,6 +89,10 @@ pub struct Args {
     /// Real-time settings of the receiving thread (docs/realtime-tuning.md).
     #[command(flatten)]
     pub realtime: RealtimeArgs,
+    /// A live Foxglove view of the streams (`--foxglove [ADDRESS]`), served from a subscriber on
+    /// a thread of its own.
+    #[command(flatten)]
+    pub view: FoxgloveArgs,
 }
 
 /// Parses a positive, finite number of seconds (at most a day).
@@ -134,6 +140,9 @@ pub enum SubscribeError {
     /// A real-time setting could not be applied and `--require-realtime` was given.
     #[error(transparent)]
     Realtime(#[from] RealtimeRefused),
+    /// The live Foxglove view could not start.
+    #[error(transparent)]
+    Foxglove(#[from] LiveServerError),
 }
 /// Runs the subscriber until a stop condition or SIGINT/SIGTERM; prints the summary.
 pub fn run(args: Args) -> Result<(), SubscribeError> {
@@ -158,6 +167,13 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
     let names = ServiceNames::new(&args.service_prefix);
     let node = catalog::create_node("primm-subscriber")?;
     let ports = Ports::open(&node, &names, !args.no_truth)?;
+    let view = match args.view.foxglove {
+        Some(address) => Some(LiveView::start(address, &names, Vec::new())?),
+        None => None,
+    };
+    if let Some(view) = &view {
+        eprintln!("Foxglove live view on ws://{}", view.local_address());
+    }
     tracing::info!(service = %names.tracks(), "subscribed");
     let mut viewer = Viewer::new(args, ports.truth.is_some(), open_csv(args)?);
     if let Some(directory) = &args.latency_out {
@@ -210,5 +226,6 @@ pub fn subscribe(args: &Args) -> Result<SubscriberSummary, SubscribeError> {
     ports.take_late_latency_report(&mut viewer)?;
     drop(tick);
     drop(guards);
+    drop(view);
     viewer.finish()
 }
