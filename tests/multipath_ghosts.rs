@@ -1,9 +1,11 @@
 //! Multipath ghosts (`tracker/ghosts.rs`, ARCHITECTURE.md "Point clouds"): a measurement at the
 //! mirror image of a confirmed moving track in a wall along its heading, moving as that image,
-//! starts no track; a real object at the same place that moves otherwise is tracked.
+//! starts no track on a point-cloud radar; a real object at the same place that moves otherwise
+//! is tracked, and an object radar's frames are not checked.
 
 use glam::DVec2;
 use primm_core::config::Config;
+use primm_core::grouping::DetectionModel;
 use primm_core::measurement::{Frame, Measurement, ObjectClass};
 use primm_core::pose::EgoPose;
 use primm_core::tracker::Tracker;
@@ -42,7 +44,10 @@ fn frames(second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2)) -> Vec<Frame> {
 
 /// The ids of the tracks confirmed at the end, and the tracker.
 fn confirmed(frames: &[Frame]) -> (usize, Tracker) {
-    let mut tracker = Tracker::new(Config::default()).unwrap();
+    // The check runs on point-cloud radars' frames.
+    let mut config = Config::default();
+    config.frame.sensors.iter_mut().for_each(|sensor| sensor.detections = DetectionModel::Points);
+    let mut tracker = Tracker::new(config).unwrap();
     let mut count = 0;
     for frame in frames {
         count = tracker.step(frame).unwrap().iter().filter(|o| o.status.is_confirmed()).count();
@@ -70,4 +75,17 @@ fn a_car_where_the_image_would_be_that_drives_the_other_way_is_tracked() {
     let (count, tracker) = confirmed(&frames(oncoming));
     assert_eq!(count, 2);
     assert_eq!(tracker.stats().initiations_refused_as_ghost, 0);
+}
+
+#[test]
+fn an_object_radars_frames_are_not_checked() {
+    let mirror = |_, centre: DVec2, velocity: DVec2| {
+        (DVec2::new(centre.x, 20.0 - centre.y), DVec2::new(velocity.x, -velocity.y))
+    };
+    let mut tracker = Tracker::new(Config::default()).unwrap();
+    for frame in &frames(mirror) {
+        tracker.step(frame).unwrap();
+    }
+    assert_eq!(tracker.stats().initiations_refused_as_ghost, 0);
+    assert_eq!(tracker.tracks().iter().filter(|t| t.status.is_confirmed()).count(), 2);
 }

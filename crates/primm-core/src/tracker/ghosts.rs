@@ -17,6 +17,11 @@
 //! * the track moves at least twice its class's `extent.min_heading_speed_mps`, so that the
 //!   velocity test says something (a standing object's image stands like any standing thing).
 //!
+//! The check runs on the frames of radars whose detections are grouped (`crate::grouping`):
+//! on the generator's object-list presets with clutter it refused or ended more real objects'
+//! tracks than ghosts (IMM IDF1 of confirmed tracks 0.950 → 0.932 on the `clutter` evaluation
+//! split), so object radars are left to the existence model as before.
+//!
 //! Such a measurement starts no track (counted as `initiations_refused_as_ghost`), and a
 //! tentative track that it updated ends (`tentative_tracks_ended_as_ghost`): a ghost and its
 //! object often appear together, before the object's track is confirmed. A confirmed track is
@@ -50,8 +55,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// Whether `measurement`, seen by a radar at `sensor_m`, is the mirror image of one of the
     /// first `tracks` tracks (those with a prior this frame) in a wall along its heading.
     pub(super) fn mirrors_a_track(&self, measurement: &Measurement, sensor_m: DVec2, tracks: usize) -> bool {
-        if self.step_pose.is_none() {
-            // Radial velocities are over ground; vehicle-frame velocities are not.
+        if self.step_pose.is_none() || !self.grouped_frame {
+            // Radial velocities are over ground; vehicle-frame velocities are not. Only the
+            // frames of point-cloud radars are checked: on object radars' frames the check
+            // cost more real objects than it removed ghosts (docs/EVALUATION.md).
             return false;
         }
         let position_m = measurement.position();
