@@ -21,13 +21,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.shadowed.fill(false);
         let mut any_points = false;
         let mut any_candidates = false;
+        if self.sensors.iter().any(|sensor| sensor.detections != DetectionModel::Objects) {
+            self.index_confirmed_tracks();
+        }
         for index in 0..self.validated.len() {
             let Some(measurement) = self.validated.accepted(index) else { continue };
             let slot = self.sensors.slot(measurement.sensor_id);
             let sensor = self.sensors.get(slot);
             let candidate = sensor.detections != DetectionModel::Objects;
             let grouped = sensor.groups_detections();
-            let (owner, shadowed) = if candidate { self.owner_of(&measurement) } else { (None, None) };
+            // Only grouped detections need their owner; an `auto` radar's count looks itself.
+            let (owner, shadowed) = if grouped { self.owner_of(&measurement) } else { (None, None) };
             if let Some(row) = shadowed.filter(|_| grouped) {
                 self.shadowed[usize::from(row)] = true;
             }
@@ -63,10 +67,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let tracks = self.table.tracks();
         let mut best: Option<(usize, f64)> = None;
         let mut shadowed = None;
-        for row in 0..tracks.len() {
-            if !tracks[row].status.is_confirmed() {
-                continue;
-            }
+        for row in self.confirmed_near(position_m.x) {
             let Some(distance_m2) = self.holds(row, position_m, self.owner_margin_m(row)) else { continue };
             let better = match best {
                 None => true,
@@ -133,6 +134,48 @@ impl<P: DisplacementPredictor> Tracker<P> {
         ended
     }
 
+    /// Sorts the confirmed tracks by the x of their priors (`confirmed_by_x`), and finds how far
+    /// from its centre any of them can hold a detection (`confirmed_reach_m`): the circle through
+    /// the corners of the largest class box grown by the largest margin.
+    fn index_confirmed_tracks(&mut self) {
+        self.confirmed_by_x.clear();
+        let tracks = self.table.tracks();
+        for (row, (track, prior)) in tracks.iter().zip(self.priors.iter()).enumerate() {
+            if track.status.is_confirmed() {
+                // At most MAX_TRACKS rows, so this never overflows.
+                let _ = self.confirmed_by_x.try_push((prior.fused.mean.x, row as u16));
+            }
+        }
+        self.confirmed_by_x.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let margin_m = self.config.frame.grouping.owner_margin_m;
+        self.confirmed_reach_m = crate::measurement::ObjectClass::ALL
+            .iter()
+            .map(|&class| {
+                let extent = &self.config.classes.get(class).extent;
+                let grown = margin_m.max(extent.absorb_margin_m);
+                crate::math::sqrt(
+                    crate::math::square(0.5 * extent.length_m + grown)
+                        + crate::math::square(0.5 * extent.width_m + grown),
+                )
+            })
+            .fold(0.0, f64::max);
+    }
+
+    /// The window of `confirmed_by_x` whose priors' x lie within the reach of `x_m`.
+    fn confirmed_window(&self, x_m: f64) -> (usize, usize) {
+        let reach_m = self.confirmed_reach_m;
+        let start = self.confirmed_by_x.partition_point(|&(x, _)| x < x_m - reach_m);
+        let end = self.confirmed_by_x.partition_point(|&(x, _)| x <= x_m + reach_m);
+        (start, end.max(start))
+    }
+
+    /// The rows of the confirmed tracks whose prior's x lies within the reach of `x_m`, in the
+    /// order of their x.
+    fn confirmed_near(&self, x_m: f64) -> impl Iterator<Item = usize> + '_ {
+        let (start, end) = self.confirmed_window(x_m);
+        self.confirmed_by_x[start..end].iter().map(|&(_, row)| usize::from(row))
+    }
+
     /// When the track in `row` holds `position_m` on its object at its prior (its class's box
     /// grown by `margin_m`): the squared distance from its centre, m².
     fn holds(&self, row: usize, position_m: glam::DVec2, margin_m: f64) -> Option<f64> {
@@ -163,7 +206,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         for detection in self.frame_groups.detections() {
             let auto =
                 self.sensors.get(usize::from(detection.sensor_slot)).detections == DetectionModel::Auto;
-            if auto && detection.owner.is_some() && !slots.contains(&detection.sensor_slot) {
+            if auto && !slots.contains(&detection.sensor_slot) {
                 // There are at most MAX_SENSORS + 1 slots, so this never overflows.
                 let _ = slots.try_push(detection.sensor_slot);
             }
@@ -172,22 +215,22 @@ impl<P: DisplacementPredictor> Tracker<P> {
         for slot in slots {
             self.owned_counts[..tracks].fill(0);
             for detection in self.frame_groups.detections() {
-                if detection.sensor_slot != slot || detection.owner.is_none() {
+                if detection.sensor_slot != slot {
                     continue;
                 }
                 let position_m = detection.measurement.position();
                 let line_of_sight = (position_m - detection.sensor_position_m).normalize_or_zero();
-                for row in 0..tracks {
-                    let track = &self.table.tracks()[row];
+                let (start, end) = self.confirmed_window(position_m.x);
+                for k in start..end {
+                    let row = usize::from(self.confirmed_by_x[k].1);
                     // On the box itself: a point cloud lies on it, a neighbour's detection rarely.
-                    let margin_m = 0.0;
+                    if self.holds(row, position_m, 0.0).is_none() {
+                        continue;
+                    }
                     // Moving as the object: clutter and crossing objects in the box do not.
                     let expected_mps = self.priors[row].fused_velocity_mps().dot(line_of_sight);
-                    let moving_as_object = (detection.measurement.radial_velocity_mps - expected_mps).abs()
-                        <= config.link_radial_velocity_gap_mps;
-                    if track.status.is_confirmed()
-                        && moving_as_object
-                        && self.holds(row, position_m, margin_m).is_some()
+                    if (detection.measurement.radial_velocity_mps - expected_mps).abs()
+                        <= config.link_radial_velocity_gap_mps
                     {
                         self.owned_counts[row] += 1;
                     }
