@@ -33,7 +33,7 @@ pub struct Detection {
 /// The groups of one frame.
 #[derive(Debug, Clone)]
 pub struct FrameGroups {
-    detections: Box<[Option<Detection>]>,
+    detections: Box<[Detection]>,
     /// The detections' measurements, aligned with `detections`.
     measurements: Box<[Measurement]>,
     count: usize,
@@ -69,6 +69,14 @@ impl FrameGroups {
             sensor_id: None,
             ground_truth_id: None,
         };
+        const NO_DETECTION: Detection = Detection {
+            measurement: NO_MEASUREMENT,
+            frame_index: 0,
+            sensor_slot: 0,
+            sensor_position_m: DVec2::ZERO,
+            grouped: false,
+            owner: None,
+        };
         const NO_POINT: LinkPoint = LinkPoint {
             position_m: DVec2::ZERO,
             range_m: 0.0,
@@ -77,7 +85,7 @@ impl FrameGroups {
             owner: NO_OWNER,
         };
         FrameGroups {
-            detections: vec![None; CAPACITY].into_boxed_slice(),
+            detections: vec![NO_DETECTION; CAPACITY].into_boxed_slice(),
             measurements: vec![NO_MEASUREMENT; CAPACITY].into_boxed_slice(),
             count: 0,
             group_of: vec![NONE; CAPACITY].into_boxed_slice(),
@@ -103,7 +111,7 @@ impl FrameGroups {
         if self.count == CAPACITY {
             return false;
         }
-        self.detections[self.count] = Some(detection);
+        self.detections[self.count] = detection;
         self.measurements[self.count] = detection.measurement;
         self.count += 1;
         true
@@ -111,7 +119,7 @@ impl FrameGroups {
 
     /// The detections added since [`clear`](Self::clear).
     pub fn detections(&self) -> impl Iterator<Item = &Detection> {
-        self.detections[..self.count].iter().flatten()
+        self.detections[..self.count].iter()
     }
 
     /// Groups the detections: the grouped ones by [`Linkage::cluster`] with their owners (the
@@ -122,7 +130,7 @@ impl FrameGroups {
         self.link(rule);
         self.groups = 0;
         for index in 0..self.count {
-            let Some(detection) = self.detections[index] else { continue };
+            let detection = self.detections[index];
             let group = if detection.grouped {
                 let label = self.linkage.label_of(self.group_of[index] as usize);
                 if self.label_group[label] == NONE {
@@ -143,7 +151,7 @@ impl FrameGroups {
     fn link(&mut self, rule: &LinkRule) {
         let mut points = 0;
         for index in 0..self.count {
-            let Some(detection) = self.detections[index] else { continue };
+            let detection = self.detections[index];
             if detection.grouped {
                 let position_m = detection.measurement.position();
                 self.points[points] = LinkPoint {
@@ -170,20 +178,16 @@ impl FrameGroups {
     fn sort_members(&mut self) {
         self.member_start[..=self.groups].fill(0);
         for index in 0..self.count {
-            if self.detections[index].is_some() {
-                self.member_start[self.group_of[index] as usize + 1] += 1;
-            }
+            self.member_start[self.group_of[index] as usize + 1] += 1;
         }
         for group in 0..self.groups {
             self.member_start[group + 1] += self.member_start[group];
         }
         self.next_member[..=self.groups].copy_from_slice(&self.member_start[..=self.groups]);
         for index in 0..self.count {
-            if self.detections[index].is_some() {
-                let group = self.group_of[index] as usize;
-                self.members[self.next_member[group] as usize] = index as u16;
-                self.next_member[group] += 1;
-            }
+            let group = self.group_of[index] as usize;
+            self.members[self.next_member[group] as usize] = index as u16;
+            self.next_member[group] += 1;
         }
     }
 
@@ -200,7 +204,7 @@ impl FrameGroups {
     /// The owner of group `group` (the confirmed track whose object holds one of its
     /// detections; a group has at most one), if any.
     pub fn owner(&self, group: usize) -> Option<u16> {
-        self.members(group).iter().find_map(|&member| self.detections[member as usize].and_then(|d| d.owner))
+        self.members(group).iter().find_map(|&member| self.detections[member as usize].owner)
     }
 
     /// The frame index of group `group`'s representative: its detection nearest to the mean
@@ -219,7 +223,7 @@ impl FrameGroups {
                 best = (member, distance_m2);
             }
         }
-        self.detections[best.0 as usize].map_or(0, |detection| detection.frame_index)
+        self.detections[best.0 as usize].frame_index
     }
 
     /// Group `group`'s measurement ([`summarise`]).

@@ -255,14 +255,7 @@ impl core::fmt::Display for SensorReport<'_> {
                 {
                     continue;
                 }
-                if !first {
-                    f.write_str("\n")?;
-                }
-                first = false;
-                match sensor.id() {
-                    Some(id) => write!(f, "sensor {id}")?,
-                    None => f.write_str("sensor without mount")?,
-                }
+                start_line(f, sensor, &mut first)?;
                 let extent = &self.config.classes.get(class).extent;
                 write!(f, " {}: ", class.name())?;
                 if extent.enabled {
@@ -286,14 +279,7 @@ impl core::fmt::Display for SensorReport<'_> {
                 )?;
             }
             if sensor.points.samples > 0 {
-                if !first {
-                    f.write_str("\n")?;
-                }
-                first = false;
-                match sensor.id() {
-                    Some(id) => write!(f, "sensor {id}")?,
-                    None => f.write_str("sensor without mount")?,
-                }
+                start_line(f, sensor, &mut first)?;
                 write!(
                     f,
                     " detections: {} ({}; several per track in {:.3} of {} track scans)",
@@ -305,5 +291,18 @@ impl core::fmt::Display for SensorReport<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// Starts a line of the report for `sensor`: a line break unless it is the `first`, then the
+/// sensor's name.
+fn start_line(f: &mut core::fmt::Formatter<'_>, sensor: &Sensor, first: &mut bool) -> core::fmt::Result {
+    if !*first {
+        f.write_str("\n")?;
+    }
+    *first = false;
+    match sensor.id() {
+        Some(id) => write!(f, "sensor {id}"),
+        None => f.write_str("sensor without mount"),
     }
 }
