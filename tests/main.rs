@@ -30,6 +30,7 @@ mod eval_metrics;
 mod eval_plots;
 mod existence;
 mod extended_objects;
+mod gate_distance;
 mod imm_allocation;
 mod imm_behaviour;
 mod imm_properties;

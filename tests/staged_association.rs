@@ -137,7 +137,10 @@ fn pair_cost(scene: &Scene, config: &Config, track: usize, measurement: usize) -
             let dv = m.radial_velocity_mps - scene.tracks[track].last_radial_velocity_mps;
             let distance =
                 nu.dot(s.inverse() * nu) + (dv / section.likelihood_radial_velocity_std_mps).powi(2);
-            (distance <= config.association.likelihood_gate_chi2).then(|| distance + s.determinant().ln())
+            // Point objects: the gate in metres has no reflection offset to add.
+            let within = distance <= config.association.likelihood_gate_chi2
+                && nu.length() <= config.association.likelihood_gate_distance_m;
+            within.then(|| distance + s.determinant().ln())
         }
     }
 }
@@ -332,6 +335,8 @@ fn the_prepared_likelihood_prior_agrees_with_the_dense_reference_cost() {
     let mut rng = ChaCha8Rng::seed_from_u64(99);
     let mut likelihood = config.clone();
     likelihood.association.cost = AssociationCost::Likelihood;
+    // The prepared prior holds the χ² gate; the gate in metres is the associator's.
+    likelihood.association.likelihood_gate_distance_m = f64::INFINITY;
     for _ in 0..50 {
         let scene = scene(&mut rng, &config);
         for (i, track) in scene.tracks.iter().enumerate() {

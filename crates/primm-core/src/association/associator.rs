@@ -387,6 +387,9 @@ impl Associator {
                     None => prepared.x_half_window_with_spread_m(sensor_spread_m2),
                 },
             );
+            let reach_m =
+                config.association.likelihood_gate_distance_m + extent.map_or(0.0, |e| e.max_offset_m());
+            let half = half.min(reach_m);
             let first = self.sorted_x.partition_point(|&(mx, _)| mx < x - half);
             for &(mx, column) in &self.sorted_x[first..] {
                 if mx > x + half {
@@ -396,6 +399,9 @@ impl Associator {
                 let Ok(measurement) = frame.measurement(index) else {
                     continue;
                 };
+                if measurement.position().distance_squared(prepared.mean_m()) > reach_m * reach_m {
+                    continue;
+                }
                 let extended = extent.zip(object.as_ref());
                 let cost = likelihood_pair_cost(
                     &prepared,

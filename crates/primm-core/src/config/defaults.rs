@@ -7,6 +7,9 @@ use super::*;
 /// The transition probability between two different modes (off the diagonal) where no class
 /// overrides it.
 const OFF: f64 = 0.01;
+
+/// `association.likelihood_gate_distance_m`, m (chosen on validation data; `config/primm.toml`).
+const GATE_DISTANCE_M: f64 = 10.0;
 /// The probability of staying in a mode (the diagonal) where no class overrides it.
 const STAY: f64 = 0.97;
 
@@ -51,6 +54,7 @@ fn association() -> AssociationConfig {
         cost: AssociationCost::Likelihood,
         stages: AssociationStages::ConfirmedFirst,
         likelihood_gate_chi2: 112.0,
+        likelihood_gate_distance_m: GATE_DISTANCE_M,
     }
 }
 

@@ -41,6 +41,17 @@ pub struct AssociationConfig {
     /// true pairs), dimensionless (absent: 16.27).
     #[cfg_attr(feature = "serde", serde(default = "default_likelihood_gate_chi2"))]
     pub likelihood_gate_chi2: f64,
+    /// Second gate of the `likelihood` cost, in metres: the largest distance of a measurement
+    /// from a track's predicted centre, beyond the largest offset of a reflection on its
+    /// extent, m (absent: no such gate). The χ² gate widens with the track's covariance, so a
+    /// track whose velocity ran away would otherwise reach any measurement.
+    #[cfg_attr(feature = "serde", serde(default = "default_likelihood_gate_distance_m"))]
+    pub likelihood_gate_distance_m: f64,
+}
+
+#[cfg(feature = "serde")]
+fn default_likelihood_gate_distance_m() -> f64 {
+    f64::INFINITY
 }
 
 /// The default of `association.likelihood_gate_chi2`: the 99.9 % quantile of χ² with 3 degrees

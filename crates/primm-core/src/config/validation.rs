@@ -152,6 +152,9 @@ pub(super) fn validate_association(association: &AssociationConfig) -> Result<()
         return Err(invalid("association.velocity_cap_mps", "must be a finite number >= 0"));
     }
     positive("association.likelihood_gate_chi2", association.likelihood_gate_chi2)?;
+    if !(association.likelihood_gate_distance_m > 0.0) {
+        return Err(invalid("association.likelihood_gate_distance_m", "must be a number > 0"));
+    }
     Ok(())
 }
 

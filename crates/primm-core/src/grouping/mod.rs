@@ -69,9 +69,9 @@ pub struct GroupingConfig {
     pub owner_margin_m: f64,
     /// With `detections = "auto"`: the share of a radar's confirmed-track scans with several
     /// detections on the track's object above which the radar delivers points, in (0, 1)
-    /// (absent: 0.35). It falls back to objects below this share less 0.1.
+    /// (absent: 0.3). It falls back to objects below this share less 0.1.
     pub points_share_threshold: f64,
-    /// Weight of the prior share 0 (objects), in track scans (absent: 10).
+    /// Weight of the prior share 0 (objects), in track scans (absent: 1).
     pub points_prior_scans: f64,
     /// Memory of the share, in track scans (absent: 2000).
     pub points_window_scans: f64,
@@ -84,8 +84,8 @@ impl Default for GroupingConfig {
             link_distance_per_range: 0.02,
             link_radial_velocity_gap_mps: 2.0,
             owner_margin_m: 2.0,
-            points_share_threshold: 0.35,
-            points_prior_scans: 10.0,
+            points_share_threshold: 0.3,
+            points_prior_scans: 1.0,
             points_window_scans: 2000.0,
         }
     }

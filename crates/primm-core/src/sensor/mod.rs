@@ -282,11 +282,12 @@ impl core::fmt::Display for SensorReport<'_> {
                 start_line(f, sensor, &mut first)?;
                 write!(
                     f,
-                    " detections: {} ({}; several per track in {:.3} of {} track scans)",
+                    " detections: {} ({}; several per track in {:.3} of {} vehicle track scans; decision changed {} times)",
                     sensor.detections.name(),
                     if sensor.groups_detections() { "grouped as points" } else { "objects" },
                     sensor.points.share(),
                     sensor.points.samples,
+                    sensor.points.switches,
                 )?;
             }
         }

@@ -1,8 +1,10 @@
 //! Whether a radar delivers a point cloud or objects (`detections = "auto"`), from its data.
 //!
-//! A confirmed track in a scan of the radar is one *track scan* when at least one of the scan's
-//! detections lies on the track's object (`crate::grouping`); it is a *multiple* when several
-//! do. An object-list radar gives one detection per object, so its multiples are the rare scans
+//! A confirmed track of a class with an extent (a vehicle) in a scan of the radar is one *track
+//! scan* when at least one of the scan's detections lies on the track's object
+//! (`crate::grouping`); it is a *multiple* when several do. Pedestrians do not count: a point
+//! cloud gives one of them one or two detections, an object list one, so their scans say
+//! little about the radar and dilute what the vehicles say. An object-list radar gives one detection per object, so its multiples are the rare scans
 //! in which another object's detection falls inside a track's box; a point-cloud radar gives
 //! several per vehicle in most scans. The share of multiples is estimated like the detection
 //! probability (`crate::sensor::estimates::DetectionEstimate`): the prior share 0 (objects, the

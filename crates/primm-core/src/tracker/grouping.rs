@@ -237,8 +237,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }
             }
             let estimate = &mut self.sensors.get_mut(usize::from(slot)).points;
-            for &count in self.owned_counts[..tracks].iter().filter(|&&count| count > 0) {
-                estimate.observe(&config, usize::from(count));
+            let table = self.table.tracks();
+            for (row, &count) in
+                self.owned_counts[..tracks].iter().enumerate().filter(|(_, &count)| count > 0)
+            {
+                if self.config.classes.get(table[row].class).extent.enabled {
+                    estimate.observe(&config, usize::from(count));
+                }
             }
         }
     }
