@@ -70,6 +70,7 @@ mod shm_hygiene;
 mod speculation;
 mod speed_bound;
 mod staged_association;
+mod stationary_sensors;
 mod track_loops;
 mod tracker;
 mod tracker_allocation;

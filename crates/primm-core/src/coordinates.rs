@@ -90,6 +90,12 @@ pub struct CoordinatesConfig {
     /// `"auto"` (absent: auto; `crate::grouping`).
     #[cfg_attr(feature = "serde", serde(default))]
     pub unmounted_detections: crate::grouping::DetectionModel,
+    /// The sensors do not move (a roadside or intersection installation): a frame without an
+    /// ego pose is taken at the world origin, so its tracks are kept in the world frame, where
+    /// radial velocities are over ground and speeds are bounded (absent: false; a frame without
+    /// a pose is then tracked in the vehicle frame).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub stationary: bool,
     /// How the detections of point-cloud radars are grouped (absent: the defaults of
     /// [`GroupingConfig`](crate::grouping::GroupingConfig)).
     #[cfg_attr(feature = "serde", serde(default))]
@@ -148,6 +154,7 @@ impl Default for CoordinatesConfig {
             unknown_sensor_margin_m: DEFAULT_UNKNOWN_SENSOR_MARGIN_M,
             unmounted_reflection: crate::sensor::ReflectionModel::Outline,
             unmounted_detections: crate::grouping::DetectionModel::Auto,
+            stationary: false,
             grouping: crate::grouping::GroupingConfig::default(),
             estimation: crate::sensor::estimates::EstimationConfig::default(),
         }

@@ -9,7 +9,7 @@ use super::*;
 const OFF: f64 = 0.01;
 
 /// `association.likelihood_gate_distance_m`, m (chosen on validation data; `config/primm.toml`).
-const GATE_DISTANCE_M: f64 = 10.0;
+const GATE_DISTANCE_M: f64 = f64::INFINITY;
 /// The probability of staying in a mode (the diagonal) where no class overrides it.
 const STAY: f64 = 0.97;
 

@@ -313,7 +313,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
         observer.stage_finished(Stage::Validate);
         // From here on only the validated copy is read.
         let t = self.validated.timestamp_s();
-        self.enter_tracking_frame(self.validated.ego_pose(), dt_s, t);
+        // Stationary sensors: a frame without a pose is at the world origin.
+        let pose = self.validated.ego_pose().or(self.config.frame.stationary.then(EgoPose::default));
+        self.enter_tracking_frame(pose, dt_s, t);
         if let Some(vehicle_to_world) = self.step_pose.map(|pose| pose.vehicle_to_world()) {
             self.validated.move_positions(&vehicle_to_world);
         }
