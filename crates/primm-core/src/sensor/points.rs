@@ -94,7 +94,11 @@ mod tests {
 
     #[test]
     fn several_detections_per_track_scan_switch_to_points_after_the_prior_weighs_less() {
-        let config = GroupingConfig::default();
+        let config = GroupingConfig {
+            points_prior_scans: 10.0,
+            points_share_threshold: 0.35,
+            ..GroupingConfig::default()
+        };
         let mut estimate = PointsEstimate::new();
         // 10 pseudo-scans at share 0: the share passes 0.35 at the 6th multiple (6 / 16).
         for scan in 1..=5 {
@@ -104,6 +108,17 @@ mod tests {
         estimate.observe(&config, 3);
         assert!(estimate.points);
         assert_eq!(estimate.switches, 1);
+    }
+
+    #[test]
+    fn with_the_default_prior_of_one_track_scan_the_first_multiple_decides() {
+        let config = GroupingConfig::default();
+        let mut estimate = PointsEstimate::new();
+        estimate.observe(&config, 1);
+        assert!(!estimate.points, "{}", estimate.share());
+        // (0 + 0 + 1) / (1 + 2) = 0.33 passes 0.3.
+        estimate.observe(&config, 2);
+        assert!(estimate.points, "{}", estimate.share());
     }
 
     #[test]
@@ -120,8 +135,9 @@ mod tests {
             scans_to_fall_back += 1;
             assert!(scans_to_fall_back < 1000);
         }
-        // It falls back below 0.25, not at 0.35.
-        assert!(estimate.share() < 0.25 && estimate.share() > 0.2, "{}", estimate.share());
+        // It falls back below 0.2 (the threshold 0.3 less the hysteresis), not at 0.3.
+        let share = estimate.share();
+        assert!(share < config.points_share_threshold - POINTS_SHARE_HYSTERESIS && share > 0.15, "{share}");
         assert_eq!(estimate.switches, 2);
     }
 
