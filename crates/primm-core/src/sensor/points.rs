@@ -4,7 +4,9 @@
 //! scan* when at least one of the scan's detections lies on the track's object
 //! (`crate::grouping`); it is a *multiple* when several do. Pedestrians do not count: a point
 //! cloud gives one of them one or two detections, an object list one, so their scans say
-//! little about the radar and dilute what the vehicles say. An object-list radar gives one detection per object, so its multiples are the rare scans
+//! little about the radar and dilute what the vehicles say. Only detections with a vehicle
+//! class's label count (`crate::tracker`'s grouping stage): a pedestrian passing a slow car lies
+//! in its box and moves much as the car does. An object-list radar gives one detection per object, so its multiples are the rare scans
 //! in which another object's detection falls inside a track's box; a point-cloud radar gives
 //! several per vehicle in most scans. The share of multiples is estimated like the detection
 //! probability (`crate::sensor::estimates::DetectionEstimate`): the prior share 0 (objects, the

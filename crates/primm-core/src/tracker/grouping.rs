@@ -215,7 +215,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
         for slot in slots {
             self.owned_counts[..tracks].fill(0);
             for detection in self.frame_groups.detections() {
-                if detection.sensor_slot != slot {
+                // A vehicle's points, by their labels (a tenth may be wrong): a pedestrian
+                // passing a slow car stands in its box moving much as the car does.
+                if detection.sensor_slot != slot
+                    || !self.config.classes.get(detection.measurement.class).extent.enabled
+                {
                     continue;
                 }
                 let position_m = detection.measurement.position();
