@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Scores the IMM's gate in metres (`association.likelihood_gate_distance_m`) and the stationary
-# sensor (`frame.stationary`) on validation splits (docs/EVALUATION.md, "Dense scenes from a
-# roadside radar"): dense_static (16 sequences) with every setting, the other presets (8 each)
-# with the gates. Writes OUT_DIR/dense_scenes.csv (a row per preset and setting) and
+# Scores the IMM's gate in metres (`association.likelihood_gate_distance_m`) and the platform
+# model (`frame.platform`) on validation splits (docs/EVALUATION.md, "Dense scenes from a
+# roadside radar"): the shipped configuration and the gates on every preset (dense_static 16
+# sequences, the others 8), the platform models on dense_static. Writes OUT_DIR/dense_scenes.csv (a row per preset and setting) and
 # OUT_DIR/dense_scenes_table.csv (a row per setting, RMSE_xy m / IDF1 of confirmed tracks per
 # preset) and, with --results, the latter to docs/results/evaluation_dense_scenes_validation.csv.
 #   tools/dense_scenes.sh [OUT_DIR] [--results]
@@ -19,8 +19,9 @@ for setting in "${settings[@]}"; do
     gate=$([ "$setting" = none ] && echo inf || echo "$setting.0")
     printf '[association]\nlikelihood_gate_distance_m = %s\n' "$gate" > "$out/gate_$setting.toml"
 done
-printf '[frame]\nstationary = true\n[association]\nlikelihood_gate_distance_m = inf\n' > "$out/stationary.toml"
-printf '[frame]\nstationary = true\n[association]\nlikelihood_gate_distance_m = 20.0\n' > "$out/stationary_gate_20.toml"
+printf '[frame]\nplatform = "moving"\n' > "$out/moving.toml"
+printf '[frame]\nplatform = "moving"\n[association]\nlikelihood_gate_distance_m = 10.0\n' > "$out/moving_gate_10.toml"
+printf '[frame]\nplatform = "stationary"\n' > "$out/stationary.toml"
 csv="$out/dense_scenes.csv"
 echo "preset,setting,rmse_xy_m,car_rmse_xy_m,idf1_confirmed" > "$csv"
 score() { # preset setting config
@@ -36,12 +37,14 @@ for preset in dense_static default clutter_turning robustness turning extended c
     sequences=$([ "$preset" = dense_static ] && echo 16 || echo 8)
     [ -d "$out/$preset/validation" ] || "$primm" generate --output "$out/$preset" --split validation --preset "$preset" --sequences "$sequences" > /dev/null
     for setting in "${settings[@]}"; do
-        score "$preset" "gate $setting" "$out/gate_$setting.toml"
+        label=$([ "$setting" = none ] && echo "shipped (auto platform; no gate)" || echo "gate $setting")
+        score "$preset" "$label" "$out/gate_$setting.toml"
     done
 done
-score dense_static "stationary" "$out/stationary.toml"
-score dense_static "stationary + gate 20" "$out/stationary_gate_20.toml"
-score dense_static "roadside.toml" config/sensors/roadside.toml
+score dense_static "platform moving (before)" "$out/moving.toml"
+score dense_static "platform moving + gate 10" "$out/moving_gate_10.toml"
+score dense_static "platform stationary" "$out/stationary.toml"
+score dense_static "roadside.toml (stationary + gate 10)" config/sensors/roadside.toml
 # One row per setting, one column per preset: RMSE_xy (m) / IDF1 of confirmed tracks.
 python3 - "$csv" "$out/dense_scenes_table.csv" <<'PY'
 import csv, sys
@@ -59,7 +62,7 @@ column -s, -t < "$out/dense_scenes_table.csv"
 if [ "$results" = "--results" ]; then
     target=docs/results/evaluation_dense_scenes_validation.csv
     {
-        echo "# tools/dense_scenes.sh $out --results: IMM on validation splits (dense_static 16 sequences, the others 8), gates in metres and the stationary sensor"
+        echo "# tools/dense_scenes.sh $out --results: IMM on validation splits (dense_static 16 sequences, the others 8), gates in metres and the platform models"
         echo "# release: $(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)"
         echo "# commit: $(git rev-parse HEAD)"
         echo "# measured: $(date -u +%Y-%m-%d)"

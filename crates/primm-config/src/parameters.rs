@@ -73,7 +73,7 @@ const PARAMETERS: &[Parameter] = &[
     p("frame.estimation.detection_prior_samples", "(0, 1e9]", "Weight of the configured detection probability in the detection estimates."),
     p("frame.estimation.clutter_prior_scans", "(0, 1e9]", "Weight of the configured clutter density in the clutter estimates."),
     p("frame.estimation.existence_window_samples", "(0, 1e9]", "Memory of the detection and clutter estimates."),
-    p("frame.stationary", "true, false", "The sensors stand still: a frame without an ego pose is tracked in the world frame at the origin."),
+    p("frame.platform", "moving, stationary, auto", "Whether the sensors move: frames without an ego pose in the vehicle frame, in the world frame at the origin, or as their radial velocities say."),
     p("frame.unmounted_detections", "points, objects, auto", "What one detection of a radar without a mount is: a point of a point cloud (grouped), an object, or decided from the data."),
     p("frame.grouping.link_distance_m", "[0, 20]", "Point clouds: largest distance between two linked detections at zero range."),
     p("frame.grouping.link_distance_per_range", "[0, 1]", "Growth of the link distance with range, m per m."),

@@ -90,12 +90,13 @@ pub struct CoordinatesConfig {
     /// `"auto"` (absent: auto; `crate::grouping`).
     #[cfg_attr(feature = "serde", serde(default))]
     pub unmounted_detections: crate::grouping::DetectionModel,
-    /// The sensors do not move (a roadside or intersection installation): a frame without an
-    /// ego pose is taken at the world origin, so its tracks are kept in the world frame, where
-    /// radial velocities are over ground and speeds are bounded (absent: false; a frame without
-    /// a pose is then tracked in the vehicle frame).
+    /// Whether the sensors move: `"moving"` (a frame without an ego pose is tracked in the
+    /// vehicle frame), `"stationary"` (a roadside or intersection radar: such a frame is taken
+    /// at the world origin, so its tracks are kept in the world frame, where radial velocities
+    /// are over ground and speeds are bounded) or `"auto"` (as the data say; absent: auto;
+    /// `crate::sensor::platform`).
     #[cfg_attr(feature = "serde", serde(default))]
-    pub stationary: bool,
+    pub platform: crate::sensor::platform::PlatformModel,
     /// How the detections of point-cloud radars are grouped (absent: the defaults of
     /// [`GroupingConfig`](crate::grouping::GroupingConfig)).
     #[cfg_attr(feature = "serde", serde(default))]
@@ -154,7 +155,7 @@ impl Default for CoordinatesConfig {
             unknown_sensor_margin_m: DEFAULT_UNKNOWN_SENSOR_MARGIN_M,
             unmounted_reflection: crate::sensor::ReflectionModel::Outline,
             unmounted_detections: crate::grouping::DetectionModel::Auto,
-            stationary: false,
+            platform: crate::sensor::platform::PlatformModel::Auto,
             grouping: crate::grouping::GroupingConfig::default(),
             estimation: crate::sensor::estimates::EstimationConfig::default(),
         }

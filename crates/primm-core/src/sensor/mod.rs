@@ -15,6 +15,7 @@
 //! [`estimates::ReflectionEstimate`]).
 
 pub mod estimates;
+pub mod platform;
 pub mod points;
 
 use crate::coordinates::CoordinatesConfig;
@@ -184,6 +185,7 @@ pub const UNMOUNTED: usize = MAX_SENSORS;
 pub struct SensorSet {
     sensors: [Sensor; MAX_SENSORS + 1],
     mounted: usize,
+    platform: platform::PlatformEstimate,
 }
 
 impl SensorSet {
@@ -197,7 +199,7 @@ impl SensorSet {
         for (slot, mount) in frame.sensors.iter().enumerate() {
             sensors[slot] = Sensor::new(Some(*mount), (mount.reflection, mount.detections), classes);
         }
-        SensorSet { sensors, mounted: frame.sensors.len() }
+        SensorSet { sensors, mounted: frame.sensors.len(), platform: platform::PlatformEstimate::new() }
     }
 
     /// The slot of the sensor that measured with `sensor_id`: its mount's, or [`UNMOUNTED`].
@@ -220,6 +222,17 @@ impl SensorSet {
     /// The sensor that measured with `sensor_id`.
     pub fn of(&self, sensor_id: Option<u16>) -> &Sensor {
         self.get(self.slot(sensor_id))
+    }
+
+    /// Whether the sensors stand still, as the frames without a pose say (`frame.platform =
+    /// "auto"`).
+    pub fn platform(&self) -> &platform::PlatformEstimate {
+        &self.platform
+    }
+
+    /// The platform estimate, to update it.
+    pub fn platform_mut(&mut self) -> &mut platform::PlatformEstimate {
+        &mut self.platform
     }
 
     /// The mounted sensors, in configuration order, then the unmounted one.
@@ -291,7 +304,34 @@ impl core::fmt::Display for SensorReport<'_> {
                 )?;
             }
         }
+        let platform = &self.sensors.platform;
+        if platform.samples > 0 {
+            if !first {
+                f.write_str("\n")?;
+            }
+            write!(
+                f,
+                "platform: {} ({}; velocity estimate {} from {} updates without a pose; decision changed {} times)",
+                self.config.frame.platform.name(),
+                if platform.stationary { "stationary" } else { "moving" },
+                PlatformVelocity(platform.velocity_mps()),
+                platform.samples,
+                platform.switches,
+            )?;
+        }
         Ok(())
+    }
+}
+
+/// The platform's velocity estimate for the report: `(x, y) m/s`, or that it lacks information.
+struct PlatformVelocity(Option<DVec2>);
+
+impl core::fmt::Display for PlatformVelocity {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self.0 {
+            Some(velocity) => write!(f, "({:.2}, {:.2}) m/s", velocity.x, velocity.y),
+            None => f.write_str("not yet determined"),
+        }
     }
 }
 

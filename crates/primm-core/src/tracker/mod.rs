@@ -24,6 +24,7 @@ use crate::pose::{EgoMotion, EgoPose};
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::recorded_frame::RecordedFrame;
 use crate::replay::ReplayRing;
+use crate::sensor::platform::PlatformModel;
 use crate::sensor::SensorSet;
 use crate::sensor_noise::MeasurementSensor;
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
@@ -313,8 +314,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
         observer.stage_finished(Stage::Validate);
         // From here on only the validated copy is read.
         let t = self.validated.timestamp_s();
-        // Stationary sensors: a frame without a pose is at the world origin.
-        let pose = self.validated.ego_pose().or(self.config.frame.stationary.then(EgoPose::default));
+        // Sensors that stand still: a frame without a pose is at the world origin.
+        let stationary = match self.config.frame.platform {
+            PlatformModel::Moving => false,
+            PlatformModel::Stationary => true,
+            PlatformModel::Auto => self.sensors.platform().stationary,
+        };
+        let pose = self.validated.ego_pose().or(stationary.then(EgoPose::default));
         self.enter_tracking_frame(pose, dt_s, t);
         if let Some(vehicle_to_world) = self.step_pose.map(|pose| pose.vehicle_to_world()) {
             self.validated.move_positions(&vehicle_to_world);

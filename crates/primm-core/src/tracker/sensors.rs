@@ -4,14 +4,45 @@
 //! the deletion of a tentative track adds its detections to its first sensor's clutter.
 
 use super::Tracker;
-use crate::measurement::ObjectClass;
+use crate::measurement::{FrameView, Measurement, ObjectClass};
 use crate::predictor::DisplacementPredictor;
+use crate::sensor::platform::{PlatformModel, PLATFORM_MIN_TRACK_AGE_S};
 use crate::sensor::{ReflectionModel, UNMOUNTED};
 use crate::sensor_noise::MeasurementSensor;
 use crate::track::Track;
 use glam::DVec2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
+    /// Takes the radial velocity of a confirmed track's update in a frame without an ego pose
+    /// into the platform estimate (`crate::sensor::platform`), when `frame.platform = "auto"`:
+    /// its innovation against the track's prior velocity, seen from `sensor`.
+    pub(super) fn learn_platform(&mut self, i: usize, measurement: &Measurement, sensor: &MeasurementSensor) {
+        if self.config.frame.platform != PlatformModel::Auto
+            || self.validated.ego_pose().is_some()
+            || !self.was_confirmed[i]
+        {
+            return;
+        }
+        // A young track's velocity still holds its first radial velocity (initiation), which
+        // agrees with the radial velocities whether the sensors move or not.
+        if self.validated.timestamp_s() - self.table.tracks()[i].started_s < PLATFORM_MIN_TRACK_AGE_S {
+            return;
+        }
+        let line_of_sight = (measurement.position() - sensor.position_m).normalize_or_zero();
+        if line_of_sight == DVec2::ZERO {
+            return;
+        }
+        let object = self.priors[i].object_prior();
+        let noise_std_mps =
+            self.config.classes.get(self.table.tracks()[i].class).radial_velocity_update.std_mps;
+        self.sensors.platform_mut().observe(
+            measurement.radial_velocity_mps,
+            line_of_sight,
+            (object.velocity_mps, object.velocity_covariance_m2),
+            noise_std_mps,
+        );
+    }
+
     /// Takes the update of track `i` with a measurement of `sensor` (its innovation
     /// `innovation_m` under the step's measurement model and the innovation's variance
     /// `variance_m2`) into the reflection estimate of a sensor whose model is `auto`, and

@@ -137,6 +137,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     innovation_m,
                     0.5 * (innovation_covariance_m2.x_axis.x + innovation_covariance_m2.y_axis.y),
                 );
+                self.learn_platform(i, &measurement, &sensor);
                 let tracker = &self.config.tracker;
                 let track = &mut self.table.tracks_mut()[i];
                 track.existence_probability = existence::updated_existence(
