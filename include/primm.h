@@ -90,6 +90,23 @@ typedef struct PrimmTracker PrimmTracker;
 // An object class code, one of the `PRIMM_OBJECT_CLASS_*` constants.
 typedef uint8_t PrimmObjectClass;
 
+// The platform estimate.
+typedef struct PrimmPlatformEstimate {
+  // The estimated velocity of the sensors along x, m/s (0 while `velocity_known` is 0).
+  double velocity_x_mps;
+  // ... along y, m/s.
+  double velocity_y_mps;
+  // Updates without a pose the estimate has taken.
+  uint64_t samples;
+  // Times the decision changed.
+  uint64_t switches;
+  // 1 when frames without a pose are tracked as of sensors that stand still now (the
+  // configuration says "stationary", or "auto" and the data showed it), else 0.
+  uint8_t stationary;
+  // 1 once the estimate has enough information in every direction to give a velocity.
+  uint8_t velocity_known;
+} PrimmPlatformEstimate;
+
 // One sensor's estimates for one class.
 typedef struct PrimmSensorEstimates {
   // Where the sensor's detections lie between the object's centre (0) and the outline (1).
@@ -488,6 +505,13 @@ int32_t primm_object_class_from_name(const char *name);
 // # Safety
 // `buf` is NULL or points to `len` writable bytes.
 size_t primm_format_f64(double value, char *buf, size_t len);
+
+// Writes the platform estimate to `*out`.
+//
+// # Safety
+// `tracker` is NULL or a live handle used by no other thread; `out` is NULL or writable.
+enum PrimmStatus primm_tracker_platform(struct PrimmTracker *tracker,
+                                        struct PrimmPlatformEstimate *out);
 
 // Writes the estimates of sensor `sensor_id` (a configured id, or `PRIMM_UNMOUNTED_SENSOR`)
 // for `class_code` to `*out`. `PRIMM_STATUS_INVALID_ARGUMENT` for an id that is not

@@ -216,8 +216,16 @@ fn the_compensated_keys_govern_the_steps_with_an_ego_pose_and_only_those() {
         let mut tracker = Tracker::new(config.clone()).unwrap();
         frames.iter().map(|frame| tracker.step(frame).unwrap().to_vec()).collect::<Vec<_>>()
     };
-    // Without poses the keys change nothing.
-    assert_eq!(format!("{:?}", run(&config, &frames)), format!("{:?}", run(&without_overrides(), &frames)));
+    // Without poses (and sensors that may move: vehicle-frame steps) the keys change nothing.
+    let moving = |config: &Config| {
+        let mut config = config.clone();
+        config.frame.platform = primm_core::sensor::platform::PlatformModel::Moving;
+        config
+    };
+    assert_eq!(
+        format!("{:?}", run(&moving(&config), &frames)),
+        format!("{:?}", run(&moving(&without_overrides()), &frames))
+    );
     // With poses they reach the cars only: CA stays at the floor, from the first step on.
     let (with_keys, without_keys) = (run(&config, &posed), run(&without_overrides(), &posed));
     assert_eq!(

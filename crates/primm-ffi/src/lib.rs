@@ -134,6 +134,7 @@
 //! ```
 
 mod helpers;
+mod platform;
 mod sensor_estimates;
 mod status;
 mod text;
@@ -145,6 +146,7 @@ pub use helpers::{
     primm_format_f64, primm_last_error_message, primm_object_class_from_name, primm_object_class_name,
     primm_status_message,
 };
+pub use platform::{primm_tracker_platform, PrimmPlatformEstimate};
 pub use sensor_estimates::{primm_tracker_sensor_estimates, PrimmSensorEstimates, PRIMM_UNMOUNTED_SENSOR};
 pub use status::PrimmStatus;
 pub use tracker::{

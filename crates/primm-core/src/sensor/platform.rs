@@ -112,7 +112,7 @@ impl PlatformEstimate {
         let a = self.information;
         let (xx, xy, yy) = (a.x_axis.x, a.x_axis.y, a.y_axis.y);
         let half_trace = 0.5 * (xx + yy);
-        let root = (0.25 * (xx - yy) * (xx - yy) + xy * xy).sqrt();
+        let root = crate::math::sqrt(0.25 * (xx - yy) * (xx - yy) + xy * xy);
         half_trace - root
     }
 
@@ -137,7 +137,7 @@ impl PlatformEstimate {
         let innovation_mps = radial_velocity_mps - velocity_mps.dot(line_of_sight);
         let variance =
             noise_std_mps * noise_std_mps + line_of_sight.dot(velocity_covariance_m2 * line_of_sight);
-        let std_mps = variance.sqrt();
+        let std_mps = crate::math::sqrt(variance);
         if !(innovation_mps.is_finite() && std_mps > 0.0 && std_mps.is_finite() && line_of_sight.is_finite())
         {
             return;
