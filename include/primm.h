@@ -337,8 +337,8 @@ typedef struct PrimmStats {
   // Unassigned measurements that started no track as the mirror image of a confirmed
   // track in a wall along its heading (multipath ghosts).
   uint64_t initiations_refused_as_ghost;
-  // Tentative tracks ended because their measurement was the mirror image of a confirmed
-  // track (multipath ghosts).
+  // Tentative tracks ended as multipath ghosts: their measurement, or their fused state,
+  // was the mirror image of a confirmed track.
   uint64_t tentative_tracks_ended_as_ghost;
   // Measurements tracked (accepted by validation).
   uint64_t measurements_accepted;

@@ -421,8 +421,8 @@ pub struct PrimmStats {
     /// Unassigned measurements that started no track as the mirror image of a confirmed
     /// track in a wall along its heading (multipath ghosts).
     pub initiations_refused_as_ghost: u64,
-    /// Tentative tracks ended because their measurement was the mirror image of a confirmed
-    /// track (multipath ghosts).
+    /// Tentative tracks ended as multipath ghosts: their measurement, or their fused state,
+    /// was the mirror image of a confirmed track.
     pub tentative_tracks_ended_as_ghost: u64,
     /// Measurements tracked (accepted by validation).
     pub measurements_accepted: u64,

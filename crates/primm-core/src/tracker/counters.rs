@@ -63,8 +63,9 @@ macro_rules! tracker_counters {
             /// along a confirmed track's heading would mirror it, moving as its image
             /// (multipath ghosts; ARCHITECTURE.md, "Point clouds").
             initiations_refused_as_ghost: tracked,
-            /// Tentative tracks ended because their measurement of the step was the mirror image
-            /// of a confirmed track (multipath ghosts, as `initiations_refused_as_ghost`).
+            /// Tentative tracks ended as multipath ghosts: their measurement of the step was the
+            /// mirror image of a confirmed track (as `initiations_refused_as_ghost`), or their
+            /// fused state was, weaker than it (`tracker/ghosts.rs`).
             tentative_tracks_ended_as_ghost: tracked,
             /// Measurements tracked (accepted by validation).
             measurements_accepted: tracked,

@@ -124,7 +124,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let mut ended = 0;
         for row in 0..tracks {
             self.ending[row] = self.shadowed[row] && self.rows[row].measurement_index.is_none();
-            if !self.ending[row] && self.follows_a_ghost(row) {
+            if !self.ending[row] && (self.follows_a_ghost(row) || self.images_a_track(row)) {
                 self.ending[row] = true;
                 self.last_step.counts.tentative_tracks_ended_as_ghost += 1;
             }
