@@ -13,31 +13,45 @@ use primm_core::pose::EgoPose;
 use primm_core::tracker::Tracker;
 
 /// A car driving along x at 12 m/s at y = 2 m past a standing ego, seen by the front-left radar
-/// (id 3) every 50 ms, and from frame 40 (2 s) on a second object at the position and
-/// velocity `second(t, centre, velocity)` gives from the time and the car's.
+/// (id 3) every 50 ms, and from frame 40 (2 s) on a second object, as strong as the car, at the
+/// position and velocity `second(t, centre, velocity)` gives from the time and the car's.
 fn frames(second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2)) -> Vec<Frame> {
+    car_and_second(12.0, 40, move |t, centre, velocity| {
+        let (position, velocity) = second(t, centre, velocity);
+        (position, velocity, 5.0)
+    })
+}
+
+/// A car (RCS 5 dBsm) driving along x at `speed_mps` from x = 15 m at y = 2 m past a standing
+/// ego, seen by the front-left radar (id 3) every 50 ms for 6 s, and from frame `from_frame` on
+/// a second object at the position, velocity and RCS `second(t, centre, velocity)` gives.
+fn car_and_second(
+    speed_mps: f64,
+    from_frame: usize,
+    second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2, f64),
+) -> Vec<Frame> {
     let sensor_m = DVec2::new(3.86, 0.70);
     (0..120)
         .map(|k| {
             let t = 0.05 * k as f64;
             let mut frame = Frame::new(t);
             frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
-            let (centre, velocity) = (DVec2::new(15.0 + 12.0 * t, 2.0), DVec2::new(12.0, 0.0));
-            let mut push = |position: DVec2, velocity: DVec2, id: u64| {
+            let (centre, velocity) = (DVec2::new(15.0 + speed_mps * t, 2.0), DVec2::new(speed_mps, 0.0));
+            let mut push = |position: DVec2, velocity: DVec2, rcs_dbsm: f64, id: u64| {
                 frame.measurements.push(Measurement {
                     x_m: position.x,
                     y_m: position.y,
                     radial_velocity_mps: velocity.dot((position - sensor_m).normalize()),
-                    rcs_dbsm: 5.0,
+                    rcs_dbsm,
                     class: ObjectClass::Car,
                     sensor_id: Some(3),
                     ground_truth_id: Some(id),
                 })
             };
-            push(centre, velocity, 1);
-            if k >= 40 {
-                let (position, velocity) = second(t, centre, velocity);
-                push(position, velocity, 2);
+            push(centre, velocity, 5.0, 1);
+            if k >= from_frame {
+                let (position, velocity, rcs_dbsm) = second(t, centre, velocity);
+                push(position, velocity, rcs_dbsm, 2);
             }
             frame
         })
@@ -96,32 +110,7 @@ fn an_object_radars_frames_are_not_checked() {
 /// road at x = 65 m, seen by the front-left radar (id 3) every 50 ms; from frame 60 (3 s) on a
 /// second object at the position, velocity and RCS `second(t, centre, velocity)` gives.
 fn junction_frames(second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2, f64)) -> Vec<Frame> {
-    let sensor_m = DVec2::new(3.86, 0.70);
-    (0..120)
-        .map(|k| {
-            let t = 0.05 * k as f64;
-            let mut frame = Frame::new(t);
-            frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
-            let (centre, velocity) = (DVec2::new(15.0 + 8.0 * t, 2.0), DVec2::new(8.0, 0.0));
-            let mut push = |position: DVec2, velocity: DVec2, rcs_dbsm: f64, id: u64| {
-                frame.measurements.push(Measurement {
-                    x_m: position.x,
-                    y_m: position.y,
-                    radial_velocity_mps: velocity.dot((position - sensor_m).normalize()),
-                    rcs_dbsm,
-                    class: ObjectClass::Car,
-                    sensor_id: Some(3),
-                    ground_truth_id: Some(id),
-                })
-            };
-            push(centre, velocity, 5.0, 1);
-            if k >= 60 {
-                let (position, velocity, rcs_dbsm) = second(t, centre, velocity);
-                push(position, velocity, rcs_dbsm, 2);
-            }
-            frame
-        })
-        .collect()
+    car_and_second(8.0, 60, second)
 }
 
 /// The image of the car in the building front at x = 65 m, with RCS `rcs_dbsm`.

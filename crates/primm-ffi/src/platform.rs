@@ -39,11 +39,7 @@ pub unsafe extern "C" fn primm_tracker_platform(
         let tracker = &handle.tracker;
         let estimate = tracker.sensors().platform();
         let velocity = estimate.velocity_mps();
-        let stationary = match tracker.config().frame.platform {
-            primm_core::sensor::platform::PlatformModel::Moving => false,
-            primm_core::sensor::platform::PlatformModel::Stationary => true,
-            primm_core::sensor::platform::PlatformModel::Auto => estimate.stationary,
-        };
+        let stationary = tracker.config().frame.platform.stationary(estimate);
         let value = PrimmPlatformEstimate {
             velocity_x_mps: velocity.map_or(0.0, |v| v.x),
             velocity_y_mps: velocity.map_or(0.0, |v| v.y),

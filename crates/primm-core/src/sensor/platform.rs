@@ -47,6 +47,16 @@ pub enum PlatformModel {
 }
 
 impl PlatformModel {
+    /// Whether frames without a pose are tracked as of sensors that stand still now: as the
+    /// model says, or, under `Auto`, as `estimate` decided.
+    pub fn stationary(self, estimate: &PlatformEstimate) -> bool {
+        match self {
+            PlatformModel::Moving => false,
+            PlatformModel::Stationary => true,
+            PlatformModel::Auto => estimate.stationary,
+        }
+    }
+
     /// The short name used in configuration and output.
     pub fn name(self) -> &'static str {
         match self {

@@ -24,7 +24,6 @@ use crate::pose::{EgoMotion, EgoPose};
 use crate::predictor::{Displacement, DisplacementPredictor, NoPredictor, PredictionRequest};
 use crate::recorded_frame::RecordedFrame;
 use crate::replay::ReplayRing;
-use crate::sensor::platform::PlatformModel;
 use crate::sensor::SensorSet;
 use crate::sensor_noise::MeasurementSensor;
 use crate::stage_timing::{NoObserver, Stage, StageObserver};
@@ -315,11 +314,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         // From here on only the validated copy is read.
         let t = self.validated.timestamp_s();
         // Sensors that stand still: a frame without a pose is at the world origin.
-        let stationary = match self.config.frame.platform {
-            PlatformModel::Moving => false,
-            PlatformModel::Stationary => true,
-            PlatformModel::Auto => self.sensors.platform().stationary,
-        };
+        let stationary = self.config.frame.platform.stationary(self.sensors.platform());
         let pose = self.validated.ego_pose().or(stationary.then(EgoPose::default));
         self.enter_tracking_frame(pose, dt_s, t);
         if let Some(vehicle_to_world) = self.step_pose.map(|pose| pose.vehicle_to_world()) {
