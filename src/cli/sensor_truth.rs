@@ -1,13 +1,18 @@
 //! `primm sensor-truth`: the true reflection offset fraction, detection probability and clutter
 //! density of each simulated sensor and class ([`primm_sim::eval::sensor_truth`]), from a
-//! preset's or a scenario file's sequences generated in memory with their ground truth.
+//! preset's or a scenario file's sequences generated in memory with their ground truth; with
+//! `--estimates`, also how close an IMM tracker's online estimates of its sensors come to it
+//! ([`primm_sim::eval::sensor_estimates`]).
 
 use std::path::PathBuf;
 
 use clap::Args as ClapArgs;
 
 use super::generate::{read_scenario_file, GenerateError, PresetChoice};
-use primm_sim::eval::{format_sensor_truth, sensor_truth_of_split, UnknownSensor};
+use primm_sim::eval::{
+    compare_estimates_of_split, format_estimate_comparison, format_sensor_truth, sensor_truth_of_split,
+    EstimateComparisonError, UnknownSensor,
+};
 use primm_sim::scenario::{ConfigError, Preset, ScenarioGenerator, Split};
 
 /// `--split`: `train`, `validation` or `evaluation`.
@@ -43,6 +48,13 @@ pub struct Args {
     /// Write the table as JSON to this file.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
+    /// Also track every sequence with the IMM (the configuration of `--config`) and compare the
+    /// tracker's estimates of its sensors with the truth.
+    #[arg(long)]
+    pub estimates: bool,
+    /// Write the comparison of `--estimates` as CSV to this file.
+    #[arg(long, value_name = "FILE", requires = "estimates")]
+    pub estimates_csv: Option<PathBuf>,
 }
 
 /// Why `primm sensor-truth` failed.
@@ -60,6 +72,12 @@ pub enum SensorTruthError {
     /// A frame came from a sensor without a mount.
     #[error(transparent)]
     UnknownSensor(#[from] UnknownSensor),
+    /// The estimates could not be compared.
+    #[error(transparent)]
+    Estimates(#[from] EstimateComparisonError),
+    /// The CSV file could not be written.
+    #[error("cannot write CSV: {0}")]
+    Csv(#[from] csv::Error),
     /// The JSON file could not be made.
     #[error("cannot encode the table as JSON: {0}")]
     Json(#[from] serde_json::Error),
@@ -91,6 +109,18 @@ pub fn run(args: &Args) -> Result<(), SensorTruthError> {
         std::fs::write(path, text)
             .map_err(|source| SensorTruthError::Write { path: path.clone(), source })?;
         eprintln!("wrote {}", path.display());
+    }
+    if args.estimates {
+        let comparison = compare_estimates_of_split(&generator, args.split, args.sequences, &tracker)?;
+        print!("{}", format_estimate_comparison(&comparison));
+        if let Some(path) = &args.estimates_csv {
+            let mut writer = csv::Writer::from_path(path)?;
+            for row in &comparison {
+                writer.serialize(row)?;
+            }
+            writer.flush().map_err(|source| SensorTruthError::Write { path: path.clone(), source })?;
+            eprintln!("wrote {}", path.display());
+        }
     }
     Ok(())
 }

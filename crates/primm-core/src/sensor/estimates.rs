@@ -40,10 +40,11 @@ pub struct EstimationConfig {
     #[cfg_attr(feature = "serde", serde(default = "default_reflection_window_samples"))]
     pub reflection_window_samples: f64,
     /// Weight of the configured detection probability, in opportunities: confirmed tracks in
-    /// the field of view of a scanning sensor (absent: 200).
+    /// the field of view of a scanning sensor (absent: 2; the configured value is the existence
+    /// model's, not the radar's rate, so the data take over at once).
     #[cfg_attr(feature = "serde", serde(default = "default_existence_prior_samples"))]
     pub detection_prior_samples: f64,
-    /// Weight of the configured clutter density, in scans of the sensor (absent: 200).
+    /// Weight of the configured clutter density, in scans of the sensor (absent: 2).
     #[cfg_attr(feature = "serde", serde(default = "default_existence_prior_samples"))]
     pub clutter_prior_scans: f64,
     /// Memory of the detection-probability and clutter estimates, opportunities and scans
@@ -74,8 +75,8 @@ impl Default for EstimationConfig {
         EstimationConfig {
             reflection_prior_samples: 50.0,
             reflection_window_samples: 400.0,
-            detection_prior_samples: 200.0,
-            clutter_prior_scans: 200.0,
+            detection_prior_samples: 2.0,
+            clutter_prior_scans: 2.0,
             existence_window_samples: 2000.0,
         }
     }

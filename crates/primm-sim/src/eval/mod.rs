@@ -40,6 +40,7 @@ pub mod record;
 pub mod report;
 pub mod rmse;
 pub mod scenario;
+pub mod sensor_estimates;
 pub mod sensor_truth;
 pub mod velocity;
 
@@ -66,6 +67,10 @@ pub use record::{
 pub use report::{EvaluationReport, MethodEvaluator, MethodResult};
 pub use rmse::RmseAccumulator;
 pub use scenario::{classify_sequence, MotionCategory, MotionFeatures, MotionScenario, ScenarioRules};
+pub use sensor_estimates::{
+    compare_estimates_of_split, format_estimate_comparison, EstimateComparison, EstimateComparisonError,
+    EstimatedQuantity,
+};
 pub use sensor_truth::{
     format_sensor_truth, sensor_truth_of_split, SensorClassTruth, SensorTruthAccumulator, UnknownSensor,
 };
