@@ -2,8 +2,9 @@
 //! mirror image of a confirmed moving track in a wall along its heading, moving as that image,
 //! starts no track on a point-cloud radar; a real object at the same place that moves otherwise
 //! is tracked, and an object radar's frames are not checked. A tentative track that a weaker
-//! echo at the mirror image in a wall at any angle started ends; one as strong as the object,
-//! or moving otherwise, is tracked.
+//! echo at the mirror image in a wall at any angle started ends, a standing car's image too; one
+//! as strong as the object, moving otherwise, or of another class behind a standing object, is
+//! tracked.
 
 use glam::DVec2;
 use primm_core::config::Config;
@@ -16,7 +17,7 @@ use primm_core::tracker::Tracker;
 /// (id 3) every 50 ms, and from frame 40 (2 s) on a second object, as strong as the car, at the
 /// position and velocity `second(t, centre, velocity)` gives from the time and the car's.
 fn frames(second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2)) -> Vec<Frame> {
-    car_and_second(12.0, 40, move |t, centre, velocity| {
+    car_and_second(12.0, 40, ObjectClass::Car, move |t, centre, velocity| {
         let (position, velocity) = second(t, centre, velocity);
         (position, velocity, 5.0)
     })
@@ -24,10 +25,12 @@ fn frames(second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2)) -> Vec<Frame> {
 
 /// A car (RCS 5 dBsm) driving along x at `speed_mps` from x = 15 m at y = 2 m past a standing
 /// ego, seen by the front-left radar (id 3) every 50 ms for 6 s, and from frame `from_frame` on
-/// a second object at the position, velocity and RCS `second(t, centre, velocity)` gives.
+/// a second object of `second_class` at the position, velocity and RCS `second(t, centre,
+/// velocity)` gives.
 fn car_and_second(
     speed_mps: f64,
     from_frame: usize,
+    second_class: ObjectClass,
     second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2, f64),
 ) -> Vec<Frame> {
     let sensor_m = DVec2::new(3.86, 0.70);
@@ -37,21 +40,21 @@ fn car_and_second(
             let mut frame = Frame::new(t);
             frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
             let (centre, velocity) = (DVec2::new(15.0 + speed_mps * t, 2.0), DVec2::new(speed_mps, 0.0));
-            let mut push = |position: DVec2, velocity: DVec2, rcs_dbsm: f64, id: u64| {
+            let mut push = |position: DVec2, velocity: DVec2, rcs_dbsm: f64, class: ObjectClass, id: u64| {
                 frame.measurements.push(Measurement {
                     x_m: position.x,
                     y_m: position.y,
                     radial_velocity_mps: velocity.dot((position - sensor_m).normalize()),
                     rcs_dbsm,
-                    class: ObjectClass::Car,
+                    class,
                     sensor_id: Some(3),
                     ground_truth_id: Some(id),
                 })
             };
-            push(centre, velocity, 5.0, 1);
+            push(centre, velocity, 5.0, ObjectClass::Car, 1);
             if k >= from_frame {
                 let (position, velocity, rcs_dbsm) = second(t, centre, velocity);
-                push(position, velocity, rcs_dbsm, 2);
+                push(position, velocity, rcs_dbsm, second_class, 2);
             }
             frame
         })
@@ -110,7 +113,7 @@ fn an_object_radars_frames_are_not_checked() {
 /// road at x = 65 m, seen by the front-left radar (id 3) every 50 ms; from frame 60 (3 s) on a
 /// second object at the position, velocity and RCS `second(t, centre, velocity)` gives.
 fn junction_frames(second: impl Fn(f64, DVec2, DVec2) -> (DVec2, DVec2, f64)) -> Vec<Frame> {
-    car_and_second(8.0, 60, second)
+    car_and_second(8.0, 60, ObjectClass::Car, second)
 }
 
 /// The image of the car in the building front at x = 65 m, with RCS `rcs_dbsm`.
@@ -143,6 +146,34 @@ fn a_weak_object_where_the_image_would_be_that_moves_otherwise_is_tracked() {
     // As weak as the image, at its place, but driving away from the wall, not mirroring the car.
     let away = |t: f64, _, _| (DVec2::new(91.0 + 8.0 * (t - 3.0), 2.0), DVec2::new(8.0, 0.0), -3.0);
     let (count, tracker) = confirmed(&junction_frames(away));
+    assert_eq!(count, 2);
+    assert_eq!(tracker.stats().tentative_tracks_ended_as_ghost, 0);
+}
+
+#[test]
+fn the_weaker_image_of_a_standing_car_ends_as_a_tentative_track() {
+    // A car standing at (15, 2), its image in a wall at y = 10 m, standing too, 8 dB weaker.
+    let image = |_, centre: DVec2, _| (DVec2::new(centre.x, 20.0 - centre.y), DVec2::ZERO, -3.0);
+    let (count, tracker) = confirmed(&car_and_second(0.0, 40, ObjectClass::Car, image));
+    assert_eq!(count, 1);
+    let stats = tracker.stats();
+    assert!(stats.tentative_tracks_ended_as_ghost > 10, "{stats:?}");
+}
+
+#[test]
+fn a_pedestrian_standing_behind_a_standing_car_is_tracked() {
+    // 10 dB weaker than the car, farther from the radar, waiting on the pavement 8 m behind it
+    // and seen in every third scan only: where a standing car's image could be, but of another
+    // class.
+    let mut frames = car_and_second(0.0, 40, ObjectClass::Pedestrian, |_, _, _| {
+        (DVec2::new(15.0, 10.0), DVec2::ZERO, -5.0)
+    });
+    for (k, frame) in frames.iter_mut().enumerate() {
+        if k % 3 != 0 {
+            frame.measurements.retain(|m| m.class == ObjectClass::Car);
+        }
+    }
+    let (count, tracker) = confirmed(&frames);
     assert_eq!(count, 2);
     assert_eq!(tracker.stats().tentative_tracks_ended_as_ghost, 0);
 }

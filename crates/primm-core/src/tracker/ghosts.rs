@@ -39,7 +39,10 @@
 //! any orientation. The tentative track is the image, and ends (counted in
 //! `tentative_tracks_ended_as_ghost` as well), when all of these hold:
 //!
-//! * the confirmed track moves at least its class's `extent.min_heading_speed_mps`;
+//! * the confirmed track moves at least its class's `extent.min_heading_speed_mps`, or it is
+//!   of the tentative track's class (a standing object's image stands like any standing
+//!   thing, so the velocity test says little there, and a parked car would otherwise end the
+//!   tracks of pedestrians walking behind it);
 //! * the two centres are farther apart than the confirmed track's class is wide (the object
 //!   stands on the road side of the wall, so its image lies at least its own width away);
 //! * every radar of the tentative track's remembered measurements stood on the confirmed
@@ -156,7 +159,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let object = self.priors[other].object_prior();
             let offset_m = image_prior.centre_m - object.centre_m;
             let apart_m = offset_m.length();
-            if !(object.velocity_mps.length() >= section.extent.min_heading_speed_mps
+            // A standing object's image stands like any standing thing, so only one of its own
+            // class is held against it: a parked car would otherwise end the tracks of
+            // pedestrians walking behind it.
+            let moving = object.velocity_mps.length() >= section.extent.min_heading_speed_mps;
+            if !((moving || track.class == image.class)
                 && apart_m > section.extent.width_m
                 && image_rcs_dbsm + GHOST_RCS_LOSS_DB <= mean_rcs_dbsm(track))
             {
