@@ -6,12 +6,22 @@
 //! A point may carry an owner (a confirmed track whose object holds it): the points of one
 //! owner and radar are one group from the start, and two groups of different owners never
 //! join, so a chain of points between two tracked objects stops at the first link that would
-//! join them. The groups then depend on the order of the links, which is the sweep's, fixed by
-//! the points' positions and indices.
+//! join them. The groups then depend on the order of the links, which is fixed: the points
+//! sorted by x (the indices `0..n` by an unstable sort on x, so points of equal x keep the
+//! order that sort gives them, which depends on the frame alone), and each point's links to
+//! the points after it in that order, taken in that order.
 //!
-//! The pairs are found by a sweep over the detections sorted by x, so a frame of `n`
-//! detections costs `O(n log n)` plus the pairs within one link distance along x; the groups
-//! are the components of a union-find forest with path halving. Nothing allocates after
+//! A link's distance is at most the reach at the nearer point's range, so at most the reach at
+//! either point's: each point's partners lie within its own reach along x and along y. Where
+//! the points spread wider in x than in y, a sweep over the x order finds them (each point's
+//! walk stops at its reach along x). Where they spread wider in y, as lanes side by side along
+//! x do, seen from beside the road, most points within one reach along x lie on other lanes;
+//! the partners are then found in a second list sorted by y, within the point's reach along y
+//! and along x, and joined in the x order (a partner already in the point's group is skipped,
+//! since its link would change nothing). Both walks take the same links in the same order, so
+//! the groups do not depend on which one ran (tested). A frame of `n` detections costs two
+//! sorts, `O(n log n)`, plus the pairs within one reach along the wider axis; the groups are
+//! the components of a union-find forest with path halving. Nothing allocates after
 //! [`Linkage::new`].
 
 use crate::limits::MAX_MEASUREMENTS_PER_FRAME;
@@ -71,6 +81,16 @@ pub struct Linkage {
     first_owned: [u16; crate::limits::MAX_TRACKS],
     /// Point indices sorted by x.
     order: [u16; MAX_MEASUREMENTS_PER_FRAME],
+    /// Each point's position in `order`.
+    rank_x: [u16; MAX_MEASUREMENTS_PER_FRAME],
+    /// Point indices sorted by y, then their positions in `order`.
+    by_y: [u16; MAX_MEASUREMENTS_PER_FRAME],
+    /// The positions of the points in the order of `by_y`, m.
+    by_y_m: [DVec2; MAX_MEASUREMENTS_PER_FRAME],
+    /// Each point's position in `by_y`.
+    at_y: [u16; MAX_MEASUREMENTS_PER_FRAME],
+    /// The `order` positions of one point's partners later in `order`.
+    later: [u16; MAX_MEASUREMENTS_PER_FRAME],
     /// The group of each point after [`Linkage::cluster`]: `0..groups`, numbered in the order
     /// of each group's first point.
     labels: [u16; MAX_MEASUREMENTS_PER_FRAME],
@@ -91,6 +111,11 @@ impl Linkage {
             owner: [NO_OWNER; MAX_MEASUREMENTS_PER_FRAME],
             first_owned: [u16::MAX; crate::limits::MAX_TRACKS],
             order: [0; MAX_MEASUREMENTS_PER_FRAME],
+            rank_x: [0; MAX_MEASUREMENTS_PER_FRAME],
+            by_y: [0; MAX_MEASUREMENTS_PER_FRAME],
+            by_y_m: [DVec2::ZERO; MAX_MEASUREMENTS_PER_FRAME],
+            at_y: [0; MAX_MEASUREMENTS_PER_FRAME],
+            later: [0; MAX_MEASUREMENTS_PER_FRAME],
             labels: [0; MAX_MEASUREMENTS_PER_FRAME],
             groups: 0,
         }
@@ -101,38 +126,117 @@ impl Linkage {
     /// range links to nothing.
     pub fn cluster(&mut self, points: &[LinkPoint], rule: &LinkRule) -> usize {
         let n = points.len().min(MAX_MEASUREMENTS_PER_FRAME);
+        let points = &points[..n];
         for index in 0..n {
             self.parent[index] = index as u16;
             self.owner[index] = points[index].owner;
             self.order[index] = index as u16;
         }
-        self.join_owned(&points[..n]);
-        let order = &mut self.order[..n];
-        order.sort_unstable_by(|&a, &b| {
+        self.join_owned(points);
+        self.order[..n].sort_unstable_by(|&a, &b| {
             points[a as usize].position_m.x.total_cmp(&points[b as usize].position_m.x)
         });
-        let largest_range_m = points[..n]
+        let span_m = points
             .iter()
-            .map(|point| point.range_m)
-            .filter(|range| range.is_finite())
-            .fold(0.0, f64::max);
-        let window_m = rule.reach_m(largest_range_m);
+            .filter(|point| linkable(point))
+            .fold(None, |span: Option<(DVec2, DVec2)>, point| {
+                let (low, high) = span.unwrap_or((point.position_m, point.position_m));
+                Some((low.min(point.position_m), high.max(point.position_m)))
+            })
+            .map_or(DVec2::ZERO, |(low, high)| high - low);
+        if span_m.y > span_m.x {
+            self.link_through_y(points, rule);
+        } else {
+            self.link_along_x(points, rule);
+        }
+        self.label(n)
+    }
+
+    /// Takes the links in the sweep's order (see the module documentation) by walking the
+    /// points sorted by x: each point's partners later in that order lie within its reach along
+    /// x. The cheaper walk when the points spread wider in x than in y.
+    fn link_along_x(&mut self, points: &[LinkPoint], rule: &LinkRule) {
+        let order = &self.order[..points.len()];
         for (position, &a) in order.iter().enumerate() {
             let point_a = &points[a as usize];
-            if !(point_a.position_m.is_finite() && point_a.range_m.is_finite()) {
+            if !linkable(point_a) {
                 continue;
             }
+            // A link's distance is at most the reach at the nearer point's range, so at most
+            // the reach at `a`'s.
+            let reach_m = rule.reach_m(point_a.range_m);
             for &b in &order[position + 1..] {
                 let point_b = &points[b as usize];
-                if !(point_b.position_m.x - point_a.position_m.x <= window_m) {
+                if !(point_b.position_m.x - point_a.position_m.x <= reach_m) {
                     break;
                 }
-                if rule.links(point_a, point_b) {
+                if linkable(point_b) && rule.links(point_a, point_b) {
                     union(&mut self.parent, &mut self.owner, a, b);
                 }
             }
         }
-        self.label(n)
+    }
+
+    /// Takes the links in the same order as [`link_along_x`](Self::link_along_x), but finds
+    /// each point's partners among the points sorted by y, within its reach along y (and along
+    /// x), and joins them in the order of their x. The cheaper walk when the points spread wider
+    /// in y (lanes side by side along x, seen from beside the road).
+    fn link_through_y(&mut self, points: &[LinkPoint], rule: &LinkRule) {
+        let n = points.len();
+        let Linkage { parent, owner, order, rank_x, by_y, at_y, by_y_m, later, .. } = self;
+        for (position, &point) in order[..n].iter().enumerate() {
+            rank_x[point as usize] = position as u16;
+        }
+        by_y[..n].copy_from_slice(&order[..n]);
+        by_y[..n].sort_unstable_by(|&a, &b| {
+            points[a as usize].position_m.y.total_cmp(&points[b as usize].position_m.y)
+        });
+        // From here on `by_y` holds each point's position in `order`, and `by_y_m` its
+        // position, so that the walk below reads them in sequence.
+        for (position, slot) in by_y[..n].iter_mut().enumerate() {
+            let point = *slot as usize;
+            at_y[point] = position as u16;
+            by_y_m[position] = points[point].position_m;
+            *slot = rank_x[point];
+        }
+        for (position, &a) in order[..n].iter().enumerate() {
+            let point_a = &points[a as usize];
+            if !linkable(point_a) {
+                continue;
+            }
+            let (reach_m, a_m) = (rule.reach_m(point_a.range_m), point_a.position_m);
+            let centre = at_y[a as usize] as usize;
+            // A partner already in `a`'s group needs no link: groups only ever merge.
+            let root_a = find(parent, a);
+            let mut count = 0;
+            let mut consider = |k: usize| {
+                let rank = by_y[k];
+                if rank as usize > position && (by_y_m[k].x - a_m.x).abs() <= reach_m {
+                    let b = order[rank as usize];
+                    let point_b = &points[b as usize];
+                    if find(parent, b) != root_a && linkable(point_b) && rule.links(point_a, point_b) {
+                        later[count] = rank;
+                        count += 1;
+                    }
+                }
+            };
+            for k in (0..centre).rev() {
+                if !(a_m.y - by_y_m[k].y <= reach_m) {
+                    break;
+                }
+                consider(k);
+            }
+            for k in centre + 1..n {
+                if !(by_y_m[k].y - a_m.y <= reach_m) {
+                    break;
+                }
+                consider(k);
+            }
+            later[..count].sort_unstable();
+            for &rank in &later[..count] {
+                union(parent, owner, a, order[rank as usize]);
+            }
+        }
     }
 
     /// Joins the points of each owner and radar: each to the owner's first point (of its radar;
@@ -191,6 +295,11 @@ impl Linkage {
     pub fn groups(&self) -> usize {
         self.groups
     }
+}
+
+/// Whether `point` can link at all: a finite position and range.
+fn linkable(point: &LinkPoint) -> bool {
+    point.position_m.is_finite() && point.range_m.is_finite()
 }
 
 fn find(parent: &mut [u16], mut node: u16) -> u16 {
@@ -263,6 +372,63 @@ mod tests {
             .collect()
     }
 
+    /// The groups with owners by the rule the module documentation states, pair by pair: each
+    /// owned point joined to the first earlier point of its owner and radar, then every pair
+    /// in the order of the points sorted by x (the earlier point of the pair first, then the
+    /// later), joined unless that would join two owners. Labels numbered like the linkage's.
+    fn reference_labels_in_sweep_order(points: &[LinkPoint], rule: &LinkRule) -> Vec<usize> {
+        let n = points.len();
+        let mut parent: Vec<u16> = (0..n as u16).collect();
+        let mut owner: Vec<u16> = points.iter().map(|point| point.owner).collect();
+        for later in 0..n {
+            let first = (0..later).find(|&earlier| {
+                points[later].owner != NO_OWNER
+                    && points[earlier].owner == points[later].owner
+                    && points[earlier].sensor_slot == points[later].sensor_slot
+            });
+            if let Some(first) = first {
+                union(&mut parent, &mut owner, first as u16, later as u16);
+            }
+        }
+        let mut order: Vec<u16> = (0..n as u16).collect();
+        order.sort_unstable_by(|&a, &b| {
+            points[a as usize].position_m.x.total_cmp(&points[b as usize].position_m.x)
+        });
+        for (position, &a) in order.iter().enumerate() {
+            for &b in &order[position + 1..] {
+                let (point_a, point_b) = (&points[a as usize], &points[b as usize]);
+                if linkable(point_a) && linkable(point_b) && rule.links(point_a, point_b) {
+                    union(&mut parent, &mut owner, a, b);
+                }
+            }
+        }
+        let mut first_of_root = Vec::new();
+        (0..n)
+            .map(|index| {
+                let root = find(&mut parent, index as u16);
+                match first_of_root.iter().position(|&known| known == root) {
+                    Some(label) => label,
+                    None => {
+                        first_of_root.push(root);
+                        first_of_root.len() - 1
+                    }
+                }
+            })
+            .collect()
+    }
+
+    /// Points on `lanes` lanes 4 m apart in y (so the frame spreads wider in y than in x), each
+    /// within 2.5 m of its lane's line and 20 m of x = 0: cars side by side, seen from beside
+    /// the road.
+    fn lanes_stacked_in_y(raw: &[(usize, f64, f64, f64, u8, u16)], lanes: usize) -> Vec<LinkPoint> {
+        raw.iter()
+            .map(|&(lane, x, dy, v, s, owner)| {
+                let y = -2.0 * lanes as f64 + 4.0 * (lane % lanes) as f64 + dy;
+                LinkPoint { owner: if owner < 6 { owner } else { NO_OWNER }, ..point(x, y, v, s) }
+            })
+            .collect()
+    }
+
     #[test]
     fn a_chain_of_close_detections_is_one_group_and_a_far_one_its_own() {
         let points = [
@@ -322,6 +488,39 @@ mod tests {
             let mut linkage = Box::new(Linkage::new());
             let groups = linkage.cluster(&points, &rule());
             let expected = reference_labels(&points, &rule());
+            let labels: Vec<usize> = (0..points.len()).map(|i| linkage.label_of(i)).collect();
+            prop_assert_eq!(&labels, &expected);
+            prop_assert_eq!(groups, expected.iter().map(|&l| l + 1).max().unwrap_or(0));
+        }
+
+        #[test]
+        fn on_lanes_stacked_in_y_the_groups_are_the_connected_components_of_every_linking_pair(
+            raw in proptest::collection::vec(
+                (0usize..40, -20.0f64..20.0, -2.5f64..2.5, -3.0f64..3.0, 0u8..2, 0u16..1), 0..300),
+        ) {
+            let points: Vec<LinkPoint> = lanes_stacked_in_y(&raw, 40)
+                .into_iter()
+                .map(|point| LinkPoint { owner: NO_OWNER, ..point })
+                .collect();
+            let mut linkage = Box::new(Linkage::new());
+            let groups = linkage.cluster(&points, &rule());
+            let expected = reference_labels(&points, &rule());
+            let labels: Vec<usize> = (0..points.len()).map(|i| linkage.label_of(i)).collect();
+            prop_assert_eq!(&labels, &expected);
+            prop_assert_eq!(groups, expected.iter().map(|&l| l + 1).max().unwrap_or(0));
+        }
+
+        #[test]
+        fn with_owners_the_groups_follow_the_links_in_the_order_of_x_wherever_the_points_spread(
+            raw in proptest::collection::vec(
+                (0usize..40, -20.0f64..20.0, -2.5f64..2.5, -3.0f64..3.0, 0u8..2, 0u16..12), 0..300),
+            lanes in 1usize..40,
+        ) {
+            // One lane spreads the points wider in x, forty wider in y.
+            let points = lanes_stacked_in_y(&raw, lanes);
+            let mut linkage = Box::new(Linkage::new());
+            let groups = linkage.cluster(&points, &rule());
+            let expected = reference_labels_in_sweep_order(&points, &rule());
             let labels: Vec<usize> = (0..points.len()).map(|i| linkage.label_of(i)).collect();
             prop_assert_eq!(&labels, &expected);
             prop_assert_eq!(groups, expected.iter().map(|&l| l + 1).max().unwrap_or(0));

@@ -65,9 +65,13 @@ impl<P: DisplacementPredictor> Tracker<P> {
     fn owner_of(&self, measurement: &Measurement) -> (Option<u16>, Option<u16>) {
         let position_m = measurement.position();
         let tracks = self.table.tracks();
+        let holders = self
+            .confirmed
+            .holders(position_m, |row| self.holds(row, position_m, self.owner_margin_m(row)).is_some());
         let mut best: Option<(usize, f64)> = None;
         let mut shadowed = None;
-        for row in self.confirmed_near(position_m.x) {
+        // The holders in the order of their priors' x: the choice below depends on it.
+        for row in self.confirmed.rows(&holders) {
             let Some(distance_m2) = self.holds(row, position_m, self.owner_margin_m(row)) else { continue };
             let better = match best {
                 None => true,
@@ -134,21 +138,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
         ended
     }
 
-    /// Sorts the confirmed tracks by the x of their priors (`confirmed_by_x`), and finds how far
-    /// from its centre any of them can hold a detection (`confirmed_reach_m`): the circle through
-    /// the corners of the largest class box grown by the largest margin.
+    /// Indexes the confirmed tracks for the look-ups near a detection (`confirmed_index.rs`),
+    /// with how far from its centre any of them can hold a detection: the circle through the
+    /// corners of the largest class box grown by the largest margin.
     fn index_confirmed_tracks(&mut self) {
-        self.confirmed_by_x.clear();
-        let tracks = self.table.tracks();
-        for (row, (track, prior)) in tracks.iter().zip(self.priors.iter()).enumerate() {
-            if track.status.is_confirmed() {
-                // At most MAX_TRACKS rows, so this never overflows.
-                let _ = self.confirmed_by_x.try_push((prior.fused.mean.x, row as u16));
-            }
-        }
-        self.confirmed_by_x.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let margin_m = self.config.frame.grouping.owner_margin_m;
-        self.confirmed_reach_m = crate::measurement::ObjectClass::ALL
+        let reach_m = crate::measurement::ObjectClass::ALL
             .iter()
             .map(|&class| {
                 let extent = &self.config.classes.get(class).extent;
@@ -159,25 +154,20 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 )
             })
             .fold(0.0, f64::max);
+        let confirmed = self
+            .table
+            .tracks()
+            .iter()
+            .zip(self.priors.iter())
+            .enumerate()
+            .filter(|(_, (track, _))| track.status.is_confirmed())
+            .map(|(row, (_, prior))| (row as u16, prior.fused.mean, prior.fused_velocity_mps()));
+        self.confirmed.rebuild(confirmed, reach_m);
     }
 
-    /// The window of `confirmed_by_x` whose priors' x lie within the reach of `x_m`.
-    fn confirmed_window(&self, x_m: f64) -> (usize, usize) {
-        let reach_m = self.confirmed_reach_m;
-        let start = self.confirmed_by_x.partition_point(|&(x, _)| x < x_m - reach_m);
-        let end = self.confirmed_by_x.partition_point(|&(x, _)| x <= x_m + reach_m);
-        (start, end.max(start))
-    }
-
-    /// The rows of the confirmed tracks whose prior's x lies within the reach of `x_m`, in the
-    /// order of their x.
-    fn confirmed_near(&self, x_m: f64) -> impl Iterator<Item = usize> + '_ {
-        let (start, end) = self.confirmed_window(x_m);
-        self.confirmed_by_x[start..end].iter().map(|&(_, row)| usize::from(row))
-    }
-
-    /// When the track in `row` holds `position_m` on its object at its prior (its class's box
-    /// grown by `margin_m`): the squared distance from its centre, m².
+    /// When the confirmed track in `row` holds `position_m` on its object at its prior (its
+    /// class's box grown by `margin_m`): the squared distance from its centre, m². Only for the
+    /// tracks of the current step's [`index_confirmed_tracks`](Self::index_confirmed_tracks).
     fn holds(&self, row: usize, position_m: glam::DVec2, margin_m: f64) -> Option<f64> {
         let track = &self.table.tracks()[row];
         let prior = &self.priors[row];
@@ -190,7 +180,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
         let extent = crate::extent::ExtentConfig { absorb_margin_m: margin_m, ..*section };
         let centre_m = prior.fused.mean;
-        crate::extent::lies_on_object(&extent, centre_m, prior.fused_velocity_mps(), position_m)
+        crate::extent::lies_on_object(&extent, centre_m, self.confirmed.velocity_mps(row), position_m)
             .then(|| centre_m.distance_squared(position_m))
     }
 
@@ -224,9 +214,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }
                 let position_m = detection.measurement.position();
                 let line_of_sight = (position_m - detection.sensor_position_m).normalize_or_zero();
-                let (start, end) = self.confirmed_window(position_m.x);
-                for k in start..end {
-                    let row = usize::from(self.confirmed_by_x[k].1);
+                for row in self.confirmed.near(position_m) {
                     // On the box itself: a point cloud lies on it, a neighbour's detection rarely.
                     if self.holds(row, position_m, 0.0).is_none() {
                         continue;

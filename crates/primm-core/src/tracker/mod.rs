@@ -37,6 +37,7 @@ use alloc::vec;
 use arrayvec::ArrayVec;
 use glam::{DMat2, DVec2};
 
+mod confirmed_index;
 mod counters;
 mod geometry;
 mod ghosts;
@@ -180,10 +181,8 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     shadowed: Box<[bool; MAX_TRACKS]>,
     /// Per track: whether the deletion ends it as a shadowed duplicate.
     ending: Box<[bool; MAX_TRACKS]>,
-    /// The confirmed tracks by the x of their priors, (x, row), for the grouping's look-ups.
-    confirmed_by_x: Box<ArrayVec<(f64, u16), MAX_TRACKS>>,
-    /// How far from its centre a confirmed track can hold a detection in the grouping, m.
-    confirmed_reach_m: f64,
+    /// The confirmed tracks indexed for the grouping's look-ups.
+    confirmed: Box<confirmed_index::ConfirmedIndex>,
     /// Per track: its detections of one radar in the current frame (`learn_points`).
     owned_counts: Box<[u16; MAX_TRACKS]>,
     /// The current frame as read once from the caller; validation reads only this copy.
@@ -253,8 +252,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             grouped_frame: false,
             group_first_index: Box::new([0; MAX_MEASUREMENTS_PER_FRAME]),
             group_is_centre: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
-            confirmed_by_x: Box::new(ArrayVec::new()),
-            confirmed_reach_m: 0.0,
+            confirmed: Box::new(confirmed_index::ConfirmedIndex::new()),
             owned_counts: Box::new([0; MAX_TRACKS]),
             shadowed: Box::new([false; MAX_TRACKS]),
             ending: Box::new([false; MAX_TRACKS]),
