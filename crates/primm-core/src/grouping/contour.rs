@@ -9,32 +9,58 @@
 //! that centroid's offset. Without a heading (a slow object) the box is a disc of radius
 //! `(length + width) / 4`, whose visible arc weighted alike has its centroid `π/4` of the radius
 //! towards the sensor.
+//!
+//! Where on the contour a detection falls is random, so the mean of `n` detections scatters
+//! about that centroid with the contour's own covariance over `n`: each visible face spreads
+//! its points uniformly along its length (`ℓ²/12` along it), and the faces' middles spread
+//! about the centroid by their weights. That covariance, over the group's count, is added to
+//! the radar's noise of the group's measurement (`crate::tracker`'s grouping).
 
 use crate::extent::ExtentConfig;
-use glam::DVec2;
+use glam::{DMat2, DVec2};
 
-/// The offset from the centre of the centroid of the visible contour of an object of `extent`
-/// centred at `centre_m`, moving with `velocity_mps` (the heading; below the extent's
-/// `min_heading_speed_mps` the disc), seen by a sensor at `sensor_m`, m. Zero when the sensor
-/// lies inside the object.
-pub fn visible_contour_offset(
+/// The visible contour of an object seen by one sensor: where the centroid of its points
+/// lies from the object's centre, and how single points scatter about it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VisibleContour {
+    /// The centroid's offset from the centre, m.
+    pub offset_m: DVec2,
+    /// The covariance of one point of the contour about the centroid, m².
+    pub covariance_m2: DMat2,
+}
+
+/// The visible contour of an object of `extent` centred at `centre_m`, moving with
+/// `velocity_mps` (the heading; below the extent's `min_heading_speed_mps` the disc), seen by
+/// a sensor at `sensor_m`. With the sensor inside the object, no offset and the spread of the
+/// whole outline.
+pub fn visible_contour(
     extent: &ExtentConfig,
     centre_m: DVec2,
     velocity_mps: DVec2,
     sensor_m: DVec2,
-) -> DVec2 {
+) -> VisibleContour {
     let to_sensor = sensor_m - centre_m;
     let distance_m = to_sensor.length();
-    if !(distance_m > 0.0) {
-        return DVec2::ZERO;
-    }
+    let radius_m = 0.25 * (extent.length_m + extent.width_m);
     let speed = velocity_mps.length();
-    if !(speed >= extent.min_heading_speed_mps) {
-        let radius_m = 0.25 * (extent.length_m + extent.width_m);
-        if distance_m <= radius_m {
-            return DVec2::ZERO;
+    if !(distance_m > 0.0) || !(speed >= extent.min_heading_speed_mps) {
+        if !(distance_m > radius_m) {
+            return VisibleContour {
+                offset_m: DVec2::ZERO,
+                covariance_m2: DMat2::from_diagonal(DVec2::splat(0.5 * radius_m * radius_m)),
+            };
         }
-        return to_sensor / distance_m * (core::f64::consts::FRAC_PI_4 * radius_m);
+        // The half circle facing the sensor, weighted by the cosine to the line of sight:
+        // its points lie `E[cos² φ] = 2/3` of the radius² along the line of sight (less the
+        // centroid's `(π/4)²`) and `E[sin² φ] = 1/3` across it.
+        let line_of_sight = to_sensor / distance_m;
+        let quarter_pi = core::f64::consts::FRAC_PI_4;
+        let along_m2 = radius_m * radius_m * (2.0 / 3.0 - quarter_pi * quarter_pi);
+        let across_m2 = radius_m * radius_m / 3.0;
+        return VisibleContour {
+            offset_m: line_of_sight * (quarter_pi * radius_m),
+            covariance_m2: outer(line_of_sight) * along_m2 + outer(line_of_sight.perp()) * across_m2,
+        };
     }
     let heading = velocity_mps / speed;
     let (half_length, half_width) = (0.5 * extent.length_m, 0.5 * extent.width_m);
@@ -44,7 +70,7 @@ pub fn visible_contour_offset(
         (heading.perp(), half_width, extent.length_m),
         (-heading.perp(), half_width, extent.length_m),
     ];
-    let (mut weighted_m, mut total) = (DVec2::ZERO, 0.0);
+    let (mut weighted_m, mut second_m2, mut total) = (DVec2::ZERO, DMat2::ZERO, 0.0);
     for (normal, half_depth, face_length_m) in faces {
         let middle_m = normal * half_depth;
         let towards = to_sensor - middle_m;
@@ -52,14 +78,24 @@ pub fn visible_contour_offset(
         if cosine > 0.0 {
             let weight = face_length_m * cosine;
             weighted_m += middle_m * weight;
+            // About the centre: the middle's outer product and the face's uniform spread.
+            second_m2 +=
+                (outer(middle_m) + outer(normal.perp()) * (face_length_m * face_length_m / 12.0)) * weight;
             total += weight;
         }
     }
     if total > 0.0 {
-        weighted_m / total
+        let centroid_m = weighted_m / total;
+        VisibleContour { offset_m: centroid_m, covariance_m2: second_m2 / total - outer(centroid_m) }
     } else {
-        DVec2::ZERO
+        let half_m2 = 0.5 * radius_m * radius_m;
+        VisibleContour { offset_m: DVec2::ZERO, covariance_m2: DMat2::from_diagonal(DVec2::splat(half_m2)) }
     }
+}
+
+/// `v vᵀ`.
+fn outer(v: DVec2) -> DMat2 {
+    DMat2::from_cols(v * v.x, v * v.y)
 }
 
 /// `π/4`, the share of a disc's radius at which its visible arc's centroid lies (for tests).
@@ -77,14 +113,14 @@ mod tests {
     #[test]
     fn a_car_seen_from_straight_behind_shows_its_rear_face_half_a_length_back() {
         let offset =
-            visible_contour_offset(&car(), DVec2::new(30.0, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO);
+            visible_contour(&car(), DVec2::new(30.0, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO).offset_m;
         assert!((offset - DVec2::new(-2.25, 0.0)).length() < 1e-9, "{offset}");
     }
 
     #[test]
     fn a_car_seen_from_its_corner_shows_both_near_faces_by_their_apparent_widths() {
         let centre = DVec2::new(30.0, 30.0);
-        let offset = visible_contour_offset(&car(), centre, DVec2::new(10.0, 0.0), DVec2::ZERO);
+        let offset = visible_contour(&car(), centre, DVec2::new(10.0, 0.0), DVec2::ZERO).offset_m;
         // The rear face (1.8 m wide) and the right side (4.5 m long) are seen at about 45°.
         let expected_x = -2.25 * 1.8 / (1.8 + 4.5);
         let expected_y = -0.9 * 4.5 / (1.8 + 4.5);
@@ -95,11 +131,63 @@ mod tests {
     #[test]
     fn a_standing_car_is_a_disc_and_a_sensor_inside_gives_no_offset() {
         let extent = car();
-        let offset = visible_contour_offset(&extent, DVec2::new(0.0, 20.0), DVec2::ZERO, DVec2::ZERO);
+        let offset = visible_contour(&extent, DVec2::new(0.0, 20.0), DVec2::ZERO, DVec2::ZERO).offset_m;
         let radius = 0.25 * (extent.length_m + extent.width_m);
         assert!((offset - DVec2::new(0.0, -QUARTER_PI * radius)).length() < 1e-12, "{offset}");
         let inside =
-            visible_contour_offset(&extent, DVec2::new(0.5, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO);
+            visible_contour(&extent, DVec2::new(0.5, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO).offset_m;
         assert_eq!(inside, DVec2::ZERO);
+    }
+
+    #[test]
+    fn seen_from_straight_behind_the_points_spread_along_the_rear_face_only() {
+        let contour = visible_contour(&car(), DVec2::new(30.0, 0.0), DVec2::new(10.0, 0.0), DVec2::ZERO);
+        // A uniform spread over the 1.8 m rear face: 1.8² / 12 across the line of sight.
+        let covariance = contour.covariance_m2;
+        assert!(covariance.x_axis.x.abs() < 1e-12, "{covariance}");
+        assert!((covariance.y_axis.y - 1.8f64.powi(2) / 12.0).abs() < 1e-12, "{covariance}");
+    }
+
+    #[test]
+    fn seen_from_its_corner_the_points_spread_over_both_faces_about_their_centroid() {
+        let extent = car();
+        let centre = DVec2::new(30.0, 30.0);
+        let contour = visible_contour(&extent, centre, DVec2::new(10.0, 0.0), DVec2::ZERO);
+        // Sample the two visible faces densely, each point weighted by its face's cosine.
+        let sensor_from_centre = -centre;
+        let faces = [(DVec2::new(-1.0, 0.0), 2.25, 1.8), (DVec2::new(0.0, -1.0), 0.9, 4.5)];
+        let (mut sum, mut second, mut total) = (DVec2::ZERO, DMat2::ZERO, 0.0);
+        for (normal, half_depth, length) in faces {
+            let middle = normal * half_depth;
+            let towards = sensor_from_centre - middle;
+            let cosine = normal.dot(towards) / towards.length();
+            let steps = 2000;
+            for step in 0..steps {
+                let along = length * ((step as f64 + 0.5) / steps as f64 - 0.5);
+                let point = middle + normal.perp() * along;
+                let weight = cosine * length / steps as f64;
+                sum += point * weight;
+                second += outer(point) * weight;
+                total += weight;
+            }
+        }
+        let mean = sum / total;
+        let expected = second / total - outer(mean);
+        assert!((contour.offset_m - mean).length() < 1e-9, "{} {mean}", contour.offset_m);
+        for (got, want) in contour.covariance_m2.to_cols_array().iter().zip(expected.to_cols_array()) {
+            assert!((got - want).abs() < 1e-4, "{} {expected}", contour.covariance_m2);
+        }
+    }
+
+    #[test]
+    fn a_standing_car_spreads_its_points_mostly_across_the_line_of_sight() {
+        let extent = car();
+        let contour = visible_contour(&extent, DVec2::new(0.0, 20.0), DVec2::ZERO, DVec2::ZERO);
+        let radius = 0.25 * (extent.length_m + extent.width_m);
+        let covariance = contour.covariance_m2;
+        assert!((covariance.x_axis.x - radius * radius / 3.0).abs() < 1e-12, "{covariance}");
+        let along = radius * radius * (2.0 / 3.0 - QUARTER_PI * QUARTER_PI);
+        assert!((covariance.y_axis.y - along).abs() < 1e-12 && covariance.x_axis.y.abs() < 1e-12);
+        assert!(covariance.y_axis.y < 0.2 * covariance.x_axis.x);
     }
 }

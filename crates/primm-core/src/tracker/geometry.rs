@@ -178,15 +178,21 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let slot = self.sensors.slot(measurement.sensor_id);
             let sensor = self.sensors.get(slot);
             let position_m = sensor.position_m(self.step_pose);
-            let noise_m2 = sensor.noise(self.step_pose).covariance_m2(measurement.position() - position_m);
+            let mut noise_m2 =
+                sensor.noise(self.step_pose).covariance_m2(measurement.position() - position_m);
             let extent = &self.config.classes.get(measurement.class).extent;
+            // A group moved to its object's centre is a measurement of the centre, scattered
+            // by where its detections fell on the contour.
+            let centre_spread_m2 = if self.grouped_frame { self.group_centre_spread[index] } else { None };
+            if let Some(spread_m2) = centre_spread_m2 {
+                noise_m2 += spread_m2;
+            }
             self.measurement_sensors[index] = MeasurementSensor {
                 position_m,
                 mounted: sensor.mount.is_some(),
                 noise_m2,
                 slot: slot as u8,
-                // A group moved to its object's centre is a measurement of the centre.
-                reflection_scale: if self.grouped_frame && self.group_is_centre[index] {
+                reflection_scale: if centre_spread_m2.is_some() {
                     0.0
                 } else {
                     sensor.reflection_scale(measurement.class, extent)

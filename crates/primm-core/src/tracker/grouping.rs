@@ -8,6 +8,7 @@ use crate::grouping::frame_groups::Detection;
 use crate::grouping::DetectionModel;
 use crate::measurement::{FrameView, Measurement};
 use crate::predictor::DisplacementPredictor;
+use glam::DMat2;
 
 impl<P: DisplacementPredictor> Tracker<P> {
     /// Hands the frame's accepted detections of radars that deliver points (or may: `auto`)
@@ -248,7 +249,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.validated.set_len(groups);
         for group in 0..groups {
             let mut measurement = self.frame_groups.measurement(group);
-            self.group_is_centre[group] = self.move_to_centre(group, &mut measurement);
+            self.group_centre_spread[group] = self.move_to_centre(group, &mut measurement);
             self.validated.set(group, Some(measurement));
             self.accepted[group] = true;
             self.fates[group] = MeasurementFate::Unassigned;
@@ -261,30 +262,35 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// Moves the measurement of `group` from the mean of its detections to the centre of its
     /// object when the group holds several detections and a confirmed track of an extended
     /// class owns it: by the offset of the visible contour's centroid of the track's box at its
-    /// prior (`crate::grouping::contour`). Returns whether it did; such a measurement is then a
-    /// measurement of the centre (reflection scale 0).
-    fn move_to_centre(&self, group: usize, measurement: &mut Measurement) -> bool {
-        let Some(owner) = self.frame_groups.owner(group) else { return false };
-        if self.frame_groups.members(group).len() < 2 {
-            return false;
+    /// prior (`crate::grouping::contour`). Returns, when it did, the covariance of the moved
+    /// mean about the centre from where its detections fell on the contour (the contour's
+    /// covariance over the count); such a measurement is then a measurement of the centre
+    /// (reflection scale 0) with that covariance added to the radar's noise. A single
+    /// detection keeps the radar's reflection model: moved to the contour's centroid, it lost
+    /// accuracy on the `extended` validation split, whose radars briefly took points.
+    fn move_to_centre(&self, group: usize, measurement: &mut Measurement) -> Option<DMat2> {
+        let owner = self.frame_groups.owner(group)?;
+        let count = self.frame_groups.members(group).len();
+        if count < 2 {
+            return None;
         }
         let row = usize::from(owner);
         let class = self.table.tracks()[row].class;
         let extent = &self.config.classes.get(class).extent;
         if !extent.enabled {
-            return false;
+            return None;
         }
         let prior = &self.priors[row];
         let sensor_m = self.sensors.of(measurement.sensor_id).position_m(self.step_pose);
-        let offset_m = crate::grouping::contour::visible_contour_offset(
+        let contour = crate::grouping::contour::visible_contour(
             extent,
             prior.fused.mean,
             prior.fused_velocity_mps(),
             sensor_m,
         );
-        measurement.x_m -= offset_m.x;
-        measurement.y_m -= offset_m.y;
-        true
+        measurement.x_m -= contour.offset_m.x;
+        measurement.y_m -= contour.offset_m.y;
+        Some(contour.covariance_m2 * (1.0 / count as f64))
     }
 
     /// After a grouped frame: the measurement index of every row names its group's

@@ -173,9 +173,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     grouped_frame: bool,
     /// The frame index of each group's representative detection (when `grouped_frame`).
     group_first_index: Box<[u16; MAX_MEASUREMENTS_PER_FRAME]>,
-    /// Whether each group's measurement is a measurement of its object's centre (when
-    /// `grouped_frame`).
-    group_is_centre: Box<[bool; MAX_MEASUREMENTS_PER_FRAME]>,
+    /// For each group moved to its object's centre (when `grouped_frame`), the covariance of
+    /// its measurement about the centre from the contour's spread, m²; `None` for the others.
+    group_centre_spread: Box<[Option<glam::DMat2>; MAX_MEASUREMENTS_PER_FRAME]>,
     /// Per track: whether an older track of its class nearby took a detection on its object in
     /// the current grouped frame (`grouping`).
     shadowed: Box<[bool; MAX_TRACKS]>,
@@ -251,7 +251,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             frame_groups: Box::new(crate::grouping::frame_groups::FrameGroups::new()),
             grouped_frame: false,
             group_first_index: Box::new([0; MAX_MEASUREMENTS_PER_FRAME]),
-            group_is_centre: Box::new([false; MAX_MEASUREMENTS_PER_FRAME]),
+            group_centre_spread: Box::new([None; MAX_MEASUREMENTS_PER_FRAME]),
             confirmed: Box::new(confirmed_index::ConfirmedIndex::new()),
             owned_counts: Box::new([0; MAX_TRACKS]),
             shadowed: Box::new([false; MAX_TRACKS]),
