@@ -83,6 +83,7 @@ impl FrameGroups {
             radial_velocity_mps: 0.0,
             sensor_slot: 0,
             owner: NO_OWNER,
+            pedestrian: false,
         };
         FrameGroups {
             detections: vec![NO_DETECTION; CAPACITY].into_boxed_slice(),
@@ -160,6 +161,7 @@ impl FrameGroups {
                     radial_velocity_mps: detection.measurement.radial_velocity_mps,
                     sensor_slot: detection.sensor_slot,
                     owner: detection.owner.unwrap_or(NO_OWNER),
+                    pedestrian: detection.measurement.class == crate::measurement::ObjectClass::Pedestrian,
                 };
                 self.group_of[index] = points as u16;
                 points += 1;

@@ -40,6 +40,9 @@ pub struct LinkPoint {
     pub sensor_slot: u8,
     /// The owner (a track's table row), or [`NO_OWNER`].
     pub owner: u16,
+    /// Whether it is labelled a pedestrian: two such points link within the rule's
+    /// `pedestrian_distance_scale` of the link distance.
+    pub pedestrian: bool,
 }
 
 /// The owner of a point that no track holds.
@@ -54,12 +57,18 @@ pub struct LinkRule {
     pub distance_per_range: f64,
     /// Largest difference of radial velocity of a link, m/s.
     pub radial_velocity_gap_mps: f64,
+    /// The share of the link distance within which two points both labelled pedestrian link,
+    /// in (0, 1].
+    pub pedestrian_distance_scale: f64,
 }
 
 impl LinkRule {
     /// Whether `a` and `b` link.
     pub fn links(&self, a: &LinkPoint, b: &LinkPoint) -> bool {
-        let reach_m = self.reach_m(a.range_m.min(b.range_m));
+        let mut reach_m = self.reach_m(a.range_m.min(b.range_m));
+        if a.pedestrian && b.pedestrian {
+            reach_m *= self.pedestrian_distance_scale;
+        }
         a.sensor_slot == b.sensor_slot
             && (a.radial_velocity_mps - b.radial_velocity_mps).abs() <= self.radial_velocity_gap_mps
             && a.position_m.distance_squared(b.position_m) <= reach_m * reach_m
@@ -332,7 +341,12 @@ mod tests {
     use proptest::prelude::*;
 
     fn rule() -> LinkRule {
-        LinkRule { distance_m: 1.5, distance_per_range: 0.01, radial_velocity_gap_mps: 2.0 }
+        LinkRule {
+            distance_m: 1.5,
+            distance_per_range: 0.01,
+            radial_velocity_gap_mps: 2.0,
+            pedestrian_distance_scale: 0.5,
+        }
     }
 
     fn point(x: f64, y: f64, radial_velocity_mps: f64, sensor_slot: u8) -> LinkPoint {
@@ -343,6 +357,7 @@ mod tests {
             radial_velocity_mps,
             sensor_slot,
             owner: NO_OWNER,
+            pedestrian: false,
         }
     }
 
@@ -424,7 +439,12 @@ mod tests {
         raw.iter()
             .map(|&(lane, x, dy, v, s, owner)| {
                 let y = -2.0 * lanes as f64 + 4.0 * (lane % lanes) as f64 + dy;
-                LinkPoint { owner: if owner < 6 { owner } else { NO_OWNER }, ..point(x, y, v, s) }
+                LinkPoint {
+                    owner: if owner < 6 { owner } else { NO_OWNER },
+                    // Every third point a pedestrian: their links reach half as far.
+                    pedestrian: owner % 3 == 0,
+                    ..point(x, y, v, s)
+                }
             })
             .collect()
     }
@@ -440,6 +460,21 @@ mod tests {
         let mut linkage = Box::new(Linkage::new());
         assert_eq!(linkage.cluster(&points, &rule()), 2);
         assert_eq!([0, 1, 2, 3].map(|index| linkage.label_of(index)), [0, 0, 0, 1]);
+    }
+
+    #[test]
+    fn two_people_walking_a_metre_apart_stay_two_groups_where_a_cars_points_a_metre_apart_link() {
+        let pedestrian = |x: f64| LinkPoint { pedestrian: true, ..point(x, 10.0, 1.0, 0) };
+        // The link distance at 10 m is 1.6 m; between pedestrians' detections, 0.8 m.
+        let people = [pedestrian(0.0), pedestrian(0.3), pedestrian(1.2), pedestrian(1.4)];
+        let mut linkage = Box::new(Linkage::new());
+        assert_eq!(linkage.cluster(&people, &rule()), 2);
+        assert_eq!([0, 1, 2, 3].map(|index| linkage.label_of(index)), [0, 0, 1, 1]);
+        let car = [point(0.0, 10.0, 1.0, 0), point(0.3, 10.0, 1.0, 0), point(1.2, 10.0, 1.0, 0)];
+        assert_eq!(linkage.cluster(&car, &rule()), 1);
+        // A car's point labelled pedestrian by mistake still links to the car's at full reach.
+        let mislabelled = [point(0.0, 10.0, 1.0, 0), pedestrian(1.2)];
+        assert_eq!(linkage.cluster(&mislabelled, &rule()), 1);
     }
 
     #[test]

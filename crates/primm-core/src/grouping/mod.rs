@@ -62,6 +62,10 @@ pub struct GroupingConfig {
     pub link_distance_per_range: f64,
     /// Largest difference of radial velocity between two linked detections, m/s (absent: 2.0).
     pub link_radial_velocity_gap_mps: f64,
+    /// The share of the link distance within which two detections both labelled pedestrian
+    /// link, dimensionless in (0, 1] (absent: 0.5): people walking side by side, a metre
+    /// apart, stay two groups, where a car's faces span metres.
+    pub pedestrian_link_scale: f64,
     /// How far beyond its box (the class's extent at the track's prior) a detection still lies
     /// on a confirmed track's object and joins its group, m (absent: 2.0). Wider than the
     /// extent's `absorb_margin_m`: the prior's position error and the spread of a point cloud
@@ -83,6 +87,7 @@ impl Default for GroupingConfig {
             link_distance_m: 2.0,
             link_distance_per_range: 0.02,
             link_radial_velocity_gap_mps: 2.0,
+            pedestrian_link_scale: 0.5,
             owner_margin_m: 2.0,
             points_share_threshold: 0.3,
             points_prior_scans: 1.0,
@@ -101,6 +106,7 @@ impl GroupingConfig {
             distance_m: self.link_distance_m,
             distance_per_range: self.link_distance_per_range,
             radial_velocity_gap_mps: self.link_radial_velocity_gap_mps,
+            pedestrian_distance_scale: self.pedestrian_link_scale,
         }
     }
 
@@ -115,6 +121,9 @@ impl GroupingConfig {
         }
         if !within(self.link_radial_velocity_gap_mps, 0.0, 100.0) {
             return Some(("frame.grouping.link_radial_velocity_gap_mps", "must lie in [0, 100] m/s"));
+        }
+        if !(self.pedestrian_link_scale > 0.0 && self.pedestrian_link_scale <= 1.0) {
+            return Some(("frame.grouping.pedestrian_link_scale", "must lie in (0, 1]"));
         }
         if !within(self.owner_margin_m, 0.0, 20.0) {
             return Some(("frame.grouping.owner_margin_m", "must lie in [0, 20] m"));
