@@ -136,6 +136,23 @@ fn an_auto_radar_turns_to_points_on_a_point_cloud_and_stays_with_objects_otherwi
 }
 
 #[test]
+fn a_radar_that_has_seen_no_vehicle_follows_the_radars_that_have() {
+    // Only the front-left radar (id 3) sees the cars; the left radar (id 4) sees nothing.
+    let (_, tracker) = confirmed_per_frame(config(DetectionModel::Auto), &cars(300, 5));
+    let left = tracker.sensors().of(Some(4));
+    assert_eq!(left.points.samples, 0);
+    assert!(left.groups_detections(), "{:?}", left.points);
+
+    let mut alone = config(DetectionModel::Auto);
+    alone.frame.grouping.points_pool_scans = 0.0;
+    let (_, tracker) = confirmed_per_frame(alone, &cars(300, 5));
+    assert!(!tracker.sensors().of(Some(4)).groups_detections());
+
+    let (_, tracker) = confirmed_per_frame(config(DetectionModel::Auto), &cars(300, 1));
+    assert!(!tracker.sensors().of(Some(4)).groups_detections());
+}
+
+#[test]
 fn object_radars_are_tracked_exactly_as_without_a_front_end() {
     let frames = cars(120, 1);
     let mut auto = Tracker::new(config(DetectionModel::Auto)).unwrap();
@@ -287,4 +304,9 @@ fn bad_point_cloud_keys_are_refused_by_name() {
         "frame.grouping.points_share_threshold"
     );
     assert_eq!(refused(|c| c.frame.grouping.points_prior_scans = 0.0), "frame.grouping");
+    assert_eq!(refused(|c| c.frame.grouping.points_pool_scans = -1.0), "frame.grouping.points_pool_scans");
+    assert_eq!(
+        refused(|c| c.frame.grouping.pedestrian_link_scale = 0.0),
+        "frame.grouping.pedestrian_link_scale"
+    );
 }

@@ -79,6 +79,9 @@ pub struct GroupingConfig {
     pub points_prior_scans: f64,
     /// Memory of the share, in track scans (absent: 2000).
     pub points_window_scans: f64,
+    /// Weight of the pooled share of every `auto` radar in one radar's decision, in track scans
+    /// (absent: 20; 0: each radar decides alone).
+    pub points_pool_scans: f64,
 }
 
 impl Default for GroupingConfig {
@@ -92,6 +95,7 @@ impl Default for GroupingConfig {
             points_share_threshold: 0.3,
             points_prior_scans: 1.0,
             points_window_scans: 2000.0,
+            points_pool_scans: 20.0,
         }
     }
 }
@@ -130,6 +134,9 @@ impl GroupingConfig {
         }
         if !(self.points_share_threshold > POINTS_SHARE_HYSTERESIS && self.points_share_threshold < 1.0) {
             return Some(("frame.grouping.points_share_threshold", "must lie in (0.1, 1)"));
+        }
+        if !within(self.points_pool_scans, 0.0, 1e9) {
+            return Some(("frame.grouping.points_pool_scans", "must lie in [0, 1e9]"));
         }
         if !(within(self.points_prior_scans, 1e-9, 1e9) && within(self.points_window_scans, 1e-9, 1e9)) {
             return Some((

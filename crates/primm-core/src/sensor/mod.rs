@@ -235,6 +235,30 @@ impl SensorSet {
         &mut self.platform
     }
 
+    /// Decides for every radar with `detections = "auto"` whether it delivers points, from its
+    /// own share and the share pooled over the radars with at least `points_pool_scans` track
+    /// scans of their own ([`PointsEstimate::decide`]); before any has, each radar decides
+    /// alone. A radar's first few scans, whose share swings, never move the others.
+    pub fn decide_points(&mut self, config: &crate::grouping::GroupingConfig) {
+        let slots = || (0..self.mounted).chain(core::iter::once(UNMOUNTED));
+        let auto = |sensor: &Sensor| sensor.detections == DetectionModel::Auto;
+        let (mut multiples, mut scans) = (0.0, 0.0);
+        for slot in slots() {
+            let sensor = &self.sensors[slot];
+            if auto(sensor) && sensor.points.samples as f64 >= config.points_pool_scans {
+                multiples += sensor.points.multiples;
+                scans += sensor.points.track_scans;
+            }
+        }
+        let pooled_share = (scans > 0.0).then(|| multiples / scans);
+        for slot in slots() {
+            let sensor = &mut self.sensors[slot];
+            if auto(sensor) {
+                sensor.points.decide(config, pooled_share);
+            }
+        }
+    }
+
     /// The mounted sensors, in configuration order, then the unmounted one.
     pub fn iter(&self) -> impl Iterator<Item = &Sensor> {
         self.sensors[..self.mounted].iter().chain(core::iter::once(&self.sensors[UNMOUNTED]))

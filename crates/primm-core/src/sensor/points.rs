@@ -56,6 +56,7 @@ impl PointsEstimate {
     }
 
     /// Takes one track scan with `detections` (at least one) of the radar on the track's object.
+    /// The decision follows with [`Self::decide`].
     pub fn observe(&mut self, config: &GroupingConfig, detections: usize) {
         if self.samples == 0 {
             self.track_scans = config.points_prior_scans;
@@ -70,7 +71,28 @@ impl PointsEstimate {
             self.track_scans = window;
             self.multiples *= scale;
         }
-        let share = self.share();
+    }
+
+    /// The share the decision compares: the radar's own counts with the share pooled over the
+    /// vehicle's `auto` radars that have evidence (`pooled_share`, when any have), weighing
+    /// `points_pool_scans` track scans. A radar that sees few vehicles (one looking sideways)
+    /// then follows the others until its own scans outweigh them.
+    pub fn decision_share(&self, config: &GroupingConfig, pooled_share: Option<f64>) -> f64 {
+        let (pool_scans, pool_multiples) = match pooled_share {
+            Some(share) => (config.points_pool_scans, config.points_pool_scans * share),
+            None => (0.0, 0.0),
+        };
+        let scans = self.track_scans + pool_scans;
+        if scans > 0.0 {
+            ((self.multiples + pool_multiples) / scans).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Decides, with hysteresis, from [`Self::decision_share`].
+    pub fn decide(&mut self, config: &GroupingConfig, pooled_share: Option<f64>) {
+        let share = self.decision_share(config, pooled_share);
         let decided = if self.points {
             share >= config.points_share_threshold - POINTS_SHARE_HYSTERESIS
         } else {
@@ -86,6 +108,13 @@ impl PointsEstimate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One track scan, decided on the radar's own counts (no pool).
+    fn observe_alone(estimate: &mut PointsEstimate, config: &GroupingConfig, detections: usize) {
+        let config = GroupingConfig { points_pool_scans: 0.0, ..*config };
+        estimate.observe(&config, detections);
+        estimate.decide(&config, None);
+    }
 
     #[test]
     fn a_radar_without_evidence_delivers_objects() {
@@ -104,10 +133,10 @@ mod tests {
         let mut estimate = PointsEstimate::new();
         // 10 pseudo-scans at share 0: the share passes 0.35 at the 6th multiple (6 / 16).
         for scan in 1..=5 {
-            estimate.observe(&config, 4);
+            observe_alone(&mut estimate, &config, 4);
             assert!(!estimate.points, "switched after {scan} scans");
         }
-        estimate.observe(&config, 3);
+        observe_alone(&mut estimate, &config, 3);
         assert!(estimate.points);
         assert_eq!(estimate.switches, 1);
     }
@@ -116,10 +145,10 @@ mod tests {
     fn with_the_default_prior_of_one_track_scan_the_first_multiple_decides() {
         let config = GroupingConfig::default();
         let mut estimate = PointsEstimate::new();
-        estimate.observe(&config, 1);
+        observe_alone(&mut estimate, &config, 1);
         assert!(!estimate.points, "{}", estimate.share());
         // (0 + 0 + 1) / (1 + 2) = 0.33 passes 0.3.
-        estimate.observe(&config, 2);
+        observe_alone(&mut estimate, &config, 2);
         assert!(estimate.points, "{}", estimate.share());
     }
 
@@ -128,12 +157,12 @@ mod tests {
         let config = GroupingConfig { points_window_scans: 100.0, ..GroupingConfig::default() };
         let mut estimate = PointsEstimate::new();
         for _ in 0..200 {
-            estimate.observe(&config, 4);
+            observe_alone(&mut estimate, &config, 4);
         }
         assert!(estimate.points);
         let mut scans_to_fall_back = 0;
         while estimate.points {
-            estimate.observe(&config, 1);
+            observe_alone(&mut estimate, &config, 1);
             scans_to_fall_back += 1;
             assert!(scans_to_fall_back < 1000);
         }
@@ -148,9 +177,32 @@ mod tests {
         let config = GroupingConfig::default();
         let mut estimate = PointsEstimate::new();
         for scan in 0..5000 {
-            estimate.observe(&config, if scan % 5 == 0 { 2 } else { 1 });
+            observe_alone(&mut estimate, &config, if scan % 5 == 0 { 2 } else { 1 });
         }
         assert!(!estimate.points);
         assert!((estimate.share() - 0.2).abs() < 0.02);
+    }
+
+    #[test]
+    fn a_radar_that_sees_few_vehicles_follows_the_pool_until_its_own_scans_outweigh_it() {
+        let config = GroupingConfig { points_pool_scans: 20.0, ..GroupingConfig::default() };
+        let mut sideways = PointsEstimate::new();
+        // No scans of its own: the pool's share 0.5 decides.
+        sideways.decide(&config, Some(0.5));
+        assert!(sideways.points);
+        // Its own scans, all single detections, then outweigh the pool: (0 + 20·0.5) / (1 + n + 20)
+        // falls below 0.2 (the threshold less the hysteresis) once n passes 29.
+        let mut scans = 0;
+        while sideways.points {
+            sideways.observe(&config, 1);
+            sideways.decide(&config, Some(0.5));
+            scans += 1;
+            assert!(scans < 100);
+        }
+        assert_eq!(scans, 30);
+        // With an object-list pool nothing turns.
+        let mut alone = PointsEstimate::new();
+        alone.decide(&config, Some(0.05));
+        assert!(!alone.points);
     }
 }

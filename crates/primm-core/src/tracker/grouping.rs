@@ -239,6 +239,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 }
             }
         }
+        self.sensors.decide_points(&config);
     }
 
     /// Forms the groups and makes them the validated frame's measurements.
