@@ -106,6 +106,37 @@ fn a_point_cloud_radar_gives_one_track_per_car_where_each_detection_as_an_object
 }
 
 #[test]
+fn a_new_cars_group_starts_its_track_behind_its_mean_by_the_visible_arc_of_a_disc() {
+    // Four points across the rear face of a car 30 m ahead, seen by the front-left radar.
+    let sensor_m = DVec2::new(3.86, 0.70);
+    let velocity = DVec2::new(12.0, 0.0);
+    let mut frame = Frame::new(0.0);
+    frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
+    let points: Vec<DVec2> = [-0.9, -0.3, 0.3, 0.9].iter().map(|&y| DVec2::new(27.75, y)).collect();
+    for point in &points {
+        frame.measurements.push(Measurement {
+            x_m: point.x,
+            y_m: point.y,
+            radial_velocity_mps: velocity.dot((*point - sensor_m).normalize()),
+            rcs_dbsm: 5.0,
+            class: ObjectClass::Car,
+            sensor_id: Some(3),
+            ground_truth_id: Some(1),
+        });
+    }
+    let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();
+    let outputs = tracker.step(&frame).unwrap();
+    assert_eq!(outputs.len(), 1, "{outputs:?}");
+    let extent = Config::default().classes.get(ObjectClass::Car).extent;
+    let radius_m = 0.25 * (extent.length_m + extent.width_m);
+    let mean_m = points.iter().copied().sum::<DVec2>() / 4.0;
+    // No heading yet: the centre lies π/4 of the disc's radius beyond the mean.
+    let expected_m = mean_m + (mean_m - sensor_m).normalize() * (core::f64::consts::FRAC_PI_4 * radius_m);
+    let started_m = outputs[0].position_m;
+    assert!(started_m.distance(expected_m) < 1e-9, "started at {started_m}, expected {expected_m}");
+}
+
+#[test]
 fn a_track_of_a_group_names_one_of_its_detections() {
     let frames = cars(60, 5);
     let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();

@@ -260,35 +260,34 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.grouped_frame = true;
     }
 
-    /// Moves the measurement of `group` from the mean of its detections to the centre of its
-    /// object when the group holds several detections and a confirmed track of an extended
-    /// class owns it: by the offset of the visible contour's centroid of the track's box at its
-    /// prior (`crate::grouping::contour`). Returns, when it did, the covariance of the moved
-    /// mean about the centre from where its detections fell on the contour (the contour's
-    /// covariance over the count); such a measurement is then a measurement of the centre
-    /// (reflection scale 0) with that covariance added to the radar's noise. A single
-    /// detection keeps the radar's reflection model: moved to the contour's centroid, it lost
-    /// accuracy on the `extended` validation split, whose radars briefly took points.
+    /// Moves the measurement of `group`, when it holds several detections of an extended class,
+    /// from the mean of its detections to the centre of its object by the offset of the
+    /// visible contour's centroid (`crate::grouping::contour`): of the owning confirmed track's
+    /// box at its prior, or, for a group no track owns (a new object, no heading yet), of the
+    /// disc about the group's mean. Returns, when it did, the covariance of the moved mean
+    /// about the centre from where its detections fell on the contour (the contour's covariance
+    /// over the count); such a measurement is then a measurement of the centre (reflection
+    /// scale 0) with that covariance added to the radar's noise. A single detection keeps the
+    /// radar's reflection model: moved to the contour's centroid, it lost accuracy on the
+    /// `extended` validation split, whose radars briefly took points.
     fn move_to_centre(&self, group: usize, measurement: &mut Measurement) -> Option<DMat2> {
-        let owner = self.frame_groups.owner(group)?;
         let count = self.frame_groups.members(group).len();
         if count < 2 {
             return None;
         }
-        let row = usize::from(owner);
-        let class = self.table.tracks()[row].class;
+        let owner = self.frame_groups.owner(group).map(usize::from);
+        let class = owner.map_or(measurement.class, |row| self.table.tracks()[row].class);
         let extent = &self.config.classes.get(class).extent;
         if !extent.enabled {
             return None;
         }
-        let prior = &self.priors[row];
         let sensor_m = self.sensors.of(measurement.sensor_id).position_m(self.step_pose);
-        let contour = crate::grouping::contour::visible_contour(
-            extent,
-            prior.fused.mean,
-            prior.fused_velocity_mps(),
-            sensor_m,
-        );
+        // A tracked object's box at its prior; a new object's disc about the group's mean.
+        let (centre_m, velocity_mps) = match owner {
+            Some(row) => (self.priors[row].fused.mean, self.priors[row].fused_velocity_mps()),
+            None => (measurement.position(), glam::DVec2::ZERO),
+        };
+        let contour = crate::grouping::contour::visible_contour(extent, centre_m, velocity_mps, sensor_m);
         measurement.x_m -= contour.offset_m.x;
         measurement.y_m -= contour.offset_m.y;
         Some(contour.covariance_m2 * (1.0 / count as f64))
