@@ -302,13 +302,8 @@ fn the_tracks_started_on_one_car_before_an_auto_radar_turned_to_points_end_but_o
 
 #[test]
 fn the_point_cloud_sensor_file_is_the_shipped_configuration_with_every_radar_delivering_points() {
-    // ... and its groups' detection probability 2.5 times the classes' (docs/EVALUATION.md).
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/sensors/point_cloud.toml");
-    let mut expected = config(DetectionModel::Points);
-    for sensor in expected.frame.sensors.iter_mut() {
-        sensor.detection_probability_factor = 2.5;
-    }
-    assert_eq!(primm_config::from_file(&path).unwrap(), expected);
+    assert_eq!(primm_config::from_file(&path).unwrap(), config(DetectionModel::Points));
 }
 
 #[test]

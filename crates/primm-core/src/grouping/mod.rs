@@ -82,6 +82,11 @@ pub struct GroupingConfig {
     /// Weight of the pooled share of every `auto` radar in one radar's decision, in track scans
     /// (absent: 20; 0: each radar decides alone).
     pub points_pool_scans: f64,
+    /// Factor on the existence model's detection probabilities (every class's, after the
+    /// sensor's own factor; at most 0.999) for a radar while it groups its detections,
+    /// dimensionless, > 0 (absent: 2.5): a group misses its object only when every one of the
+    /// object's detections does.
+    pub detection_probability_factor: f64,
 }
 
 impl Default for GroupingConfig {
@@ -96,6 +101,7 @@ impl Default for GroupingConfig {
             points_prior_scans: 1.0,
             points_window_scans: 2000.0,
             points_pool_scans: 20.0,
+            detection_probability_factor: 2.5,
         }
     }
 }
@@ -134,6 +140,9 @@ impl GroupingConfig {
         }
         if !(self.points_share_threshold > POINTS_SHARE_HYSTERESIS && self.points_share_threshold < 1.0) {
             return Some(("frame.grouping.points_share_threshold", "must lie in (0.1, 1)"));
+        }
+        if !(self.detection_probability_factor > 0.0 && self.detection_probability_factor <= 1e3) {
+            return Some(("frame.grouping.detection_probability_factor", "must lie in (0, 1000]"));
         }
         if !within(self.points_pool_scans, 0.0, 1e9) {
             return Some(("frame.grouping.points_pool_scans", "must lie in [0, 1e9]"));

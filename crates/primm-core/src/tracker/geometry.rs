@@ -201,8 +201,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// The detection probability and clutter density of `class` for the sensor in `slot`.
+    /// The detection probability and clutter density of `class` for the sensor in `slot`: its
+    /// configured ones, the detection probability scaled by the grouping's
+    /// `detection_probability_factor` while the radar groups its detections.
     pub(super) fn detection_and_clutter(&self, class: ObjectClass, slot: usize) -> (f64, f64) {
-        self.sensors.get(slot).detection_and_clutter(class)
+        let sensor = self.sensors.get(slot);
+        let (detection, clutter) = sensor.detection_and_clutter(class);
+        if sensor.groups_detections() {
+            let factor = self.config.frame.grouping.detection_probability_factor;
+            ((detection * factor).min(crate::sensor::MAX_DETECTION_PROBABILITY), clutter)
+        } else {
+            (detection, clutter)
+        }
     }
 }
