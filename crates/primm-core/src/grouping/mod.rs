@@ -82,10 +82,11 @@ pub struct GroupingConfig {
     /// Weight of the pooled share of every `auto` radar in one radar's decision, in track scans
     /// (absent: 20; 0: each radar decides alone).
     pub points_pool_scans: f64,
-    /// Factor on the existence model's detection probabilities (every class's, after the
-    /// sensor's own factor; at most 0.999) for a radar while it groups its detections,
-    /// dimensionless, > 0 (absent: 2.5): a group misses its object only when every one of the
-    /// object's detections does.
+    /// Factor on the existence model's detection probability (every class's, after the
+    /// sensor's own factor; at most 0.999) in a scan in which a radar that groups its
+    /// detections missed a track, dimensionless, > 0 (absent: 2.5): a group misses its object
+    /// only when every one of the object's detections does. A detection keeps the configured
+    /// probability, so that an echo seen scan after scan is confirmed no faster.
     pub detection_probability_factor: f64,
 }
 

@@ -201,10 +201,18 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// The detection probability and clutter density of `class` for the sensor in `slot`: its
-    /// configured ones, the detection probability scaled by the grouping's
-    /// `detection_probability_factor` while the radar groups its detections.
+    /// The detection probability and clutter density of `class` for the sensor in `slot`.
     pub(super) fn detection_and_clutter(&self, class: ObjectClass, slot: usize) -> (f64, f64) {
+        self.sensors.get(slot).detection_and_clutter(class)
+    }
+
+    /// The same for a scan in which the sensor missed a track: while the radar groups its
+    /// detections, the detection probability is scaled by the grouping's
+    /// `detection_probability_factor` (a group misses its object only when every one of its
+    /// detections does, so a scan without it says more of the object's absence). A detection
+    /// keeps the configured probability, so that an echo seen scan after scan (a multipath
+    /// ghost) is confirmed no faster than on an object radar.
+    pub(super) fn missed_detection_and_clutter(&self, class: ObjectClass, slot: usize) -> (f64, f64) {
         let sensor = self.sensors.get(slot);
         let (detection, clutter) = sensor.detection_and_clutter(class);
         if sensor.groups_detections() {

@@ -174,7 +174,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 let mut missed = false;
                 let prior_m = self.priors[i].fused.mean;
                 for sensor in self.scanning_sensors.iter().filter(|s| s.field_of_view.contains(prior_m)) {
-                    let (detection, clutter) = self.detection_and_clutter(track.class, sensor.slot);
+                    let (detection, clutter) = self.missed_detection_and_clutter(track.class, sensor.slot);
                     existence_probability = existence::updated_existence(
                         existence_probability,
                         Evidence::MissedInView,
@@ -184,7 +184,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                     missed = true;
                 }
                 if self.unknown_sensor_view.is_some_and(|view| view.contains(prior_m)) {
-                    let (detection, clutter) = self.detection_and_clutter(track.class, UNMOUNTED);
+                    let (detection, clutter) = self.missed_detection_and_clutter(track.class, UNMOUNTED);
                     existence_probability = existence::updated_existence(
                         existence_probability,
                         Evidence::MissedInView,
