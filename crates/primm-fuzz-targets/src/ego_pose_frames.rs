@@ -255,38 +255,36 @@ fn receive(
     let answer = unsafe { answer.assume_init_ref() };
     assert_eq!(answer.count as usize, count);
     for track in answer.valid_tracks() {
-        assert!(
-            track.x_m.is_finite() && track.y_m.is_finite(),
-            "a track with a non-finite position: {track:?}"
-        );
-        match (pose, track.world()) {
-            (None, None) => {}
-            (None, Some([world_x_m, world_y_m, _, _])) => {
-                assert!(
-                    stationary,
-                    "a world estimate without a pose, the sensors not found standing: {track:?}"
-                );
-                let scale = 1.0 + track.x_m.abs().max(track.y_m.abs());
-                let difference = (track.x_m - world_x_m).abs().max((track.y_m - world_y_m).abs());
-                assert!(
-                    difference <= 1e-9 * scale,
-                    "a frame without a pose at the world origin: vehicle and world positions disagree by {difference} m: {track:?}"
-                );
-            }
-            (Some(pose), Some([world_x_m, world_y_m, _, _])) => {
-                let (sin, cos) = pose.yaw_rad.sin_cos();
-                let moved_x_m = pose.x_m + cos * track.x_m - sin * track.y_m;
-                let moved_y_m = pose.y_m + sin * track.x_m + cos * track.y_m;
-                let scale = 1.0 + pose.x_m.abs().max(pose.y_m.abs()) + track.x_m.abs().max(track.y_m.abs());
-                let difference = (moved_x_m - world_x_m).abs().max((moved_y_m - world_y_m).abs());
-                assert!(
-                    difference <= 1e-9 * scale,
-                    "vehicle and world positions disagree by {difference} m: pose {pose:?}, track {track:?}"
-                );
-            }
-            (Some(_), None) => panic!("a track tracked with a valid pose has no world estimate: {track:?}"),
-        }
+        check_world_estimate(track, pose, stationary);
     }
+}
+
+/// A written track's position is finite, and its world estimate is where the frame's pose puts
+/// its vehicle-frame position: with a pose, always present; without one, present only when the
+/// sensors were found `stationary` as the frame came (the frame is then at the world origin).
+fn check_world_estimate(track: &primm_wire::WireTrack, pose: Option<EgoPose>, stationary: bool) {
+    assert!(track.x_m.is_finite() && track.y_m.is_finite(), "a track with a non-finite position: {track:?}");
+    let frame_pose = match (pose, track.world()) {
+        (_, None) => {
+            assert!(pose.is_none(), "a track tracked with a valid pose has no world estimate: {track:?}");
+            return;
+        }
+        (Some(pose), Some(_)) => pose,
+        (None, Some(_)) => {
+            assert!(stationary, "a world estimate without a pose, the sensors not found standing: {track:?}");
+            EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 }
+        }
+    };
+    let Some([world_x_m, world_y_m, _, _]) = track.world() else { return };
+    let (sin, cos) = frame_pose.yaw_rad.sin_cos();
+    let moved_x_m = frame_pose.x_m + cos * track.x_m - sin * track.y_m;
+    let moved_y_m = frame_pose.y_m + sin * track.x_m + cos * track.y_m;
+    let scale = 1.0 + frame_pose.x_m.abs().max(frame_pose.y_m.abs()) + track.x_m.abs().max(track.y_m.abs());
+    let difference = (moved_x_m - world_x_m).abs().max((moved_y_m - world_y_m).abs());
+    assert!(
+        difference <= 1e-9 * scale,
+        "vehicle and world positions disagree by {difference} m: pose {frame_pose:?}, track {track:?}"
+    );
 }
 
 #[cfg(test)]
