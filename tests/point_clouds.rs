@@ -1,6 +1,7 @@
 //! Radars that report several detections per object (`crate::grouping`, ARCHITECTURE.md "Point
 //! clouds"): a point-cloud radar's detections become one track per object, `detections =
-//! "auto"` finds out which kind of radar it has, object radars are left as they are, a frame
+//! "auto"` finds out which kind of radar it has, a scan's wrong labels do not take a tracked
+//! object's detections from its track, object radars are left as they are, a frame
 //! above capacity is refused and counted, and late frames give what in-order arrival gives.
 
 use glam::DVec2;
@@ -103,6 +104,36 @@ fn a_point_cloud_radar_gives_one_track_per_car_where_each_detection_as_an_object
     assert!(tracker.stats().detections_grouped > 200 * 2 * 3, "{:?}", tracker.stats().detections_grouped);
     let (ungrouped, _) = confirmed_per_frame(config(DetectionModel::Objects), &frames);
     assert!(ungrouped > 2.5, "{ungrouped} confirmed tracks per frame without grouping");
+}
+
+#[test]
+fn a_scan_that_labels_a_tracked_cars_points_pedestrian_still_updates_the_cars_track() {
+    // Every fourth scan after the first second, all of the first car's detections carry the
+    // pedestrian label (a radar's classifier is wrong a tenth of the time, now and then for a
+    // whole object).
+    let mut frames = cars(200, 5);
+    for frame in frames.iter_mut().skip(20).step_by(4) {
+        for measurement in frame.measurements.iter_mut().filter(|m| m.ground_truth_id == Some(1)) {
+            measurement.class = ObjectClass::Pedestrian;
+        }
+    }
+    let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();
+    let mut checked = 0;
+    for (k, frame) in frames.iter().enumerate() {
+        let outputs = tracker.step(frame).unwrap();
+        if k < 20 || k % 4 != 0 {
+            continue;
+        }
+        let updated_cars = outputs
+            .iter()
+            .filter(|output| output.class == ObjectClass::Car && output.status.is_confirmed())
+            .filter(|output| output.measurement_index.is_some())
+            .count();
+        assert_eq!(updated_cars, 2, "scan {k}: {outputs:?}");
+        assert!(outputs.iter().all(|output| output.class == ObjectClass::Car), "scan {k}: {outputs:?}");
+        checked += 1;
+    }
+    assert_eq!(checked, 45);
 }
 
 #[test]

@@ -10,7 +10,8 @@
 //!   by less than its width over its range, so the body's returns agree to within the
 //!   radar's noise and the median of theirs is the body's.
 //! * **Class:** the majority of the detections' labels; a tie goes to the class of the
-//!   strongest detection (largest radar cross section).
+//!   strongest detection (largest radar cross section). The tracker gives a group that a
+//!   confirmed track owns that track's class instead (`crate::tracker`'s grouping).
 //! * **Radar cross section:** the sum of the detections' powers, in dBsm.
 //! * **Ground truth** (carried for evaluation only): the majority id.
 

@@ -250,6 +250,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
         self.validated.set_len(groups);
         for group in 0..groups {
             let mut measurement = self.frame_groups.measurement(group);
+            // A confirmed track's class is many scans' evidence; one scan's labels, a tenth of
+            // them wrong, do not overrule it for the detections on its object.
+            if let Some(row) = self.frame_groups.owner(group) {
+                measurement.class = self.table.tracks()[usize::from(row)].class;
+            }
             self.group_centre_spread[group] = self.move_to_centre(group, &mut measurement);
             self.validated.set(group, Some(measurement));
             self.accepted[group] = true;
