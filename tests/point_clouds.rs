@@ -360,6 +360,10 @@ fn bad_point_cloud_keys_are_refused_by_name() {
         refused(|c| c.frame.grouping.points_share_threshold = 1.0),
         "frame.grouping.points_share_threshold"
     );
+    assert_eq!(
+        refused(|c| c.frame.grouping.points_fallback_share = 0.3),
+        "frame.grouping.points_fallback_share"
+    );
     assert_eq!(refused(|c| c.frame.grouping.points_prior_scans = 0.0), "frame.grouping");
     assert_eq!(refused(|c| c.frame.grouping.points_pool_scans = -1.0), "frame.grouping.points_pool_scans");
     assert_eq!(

@@ -73,8 +73,14 @@ pub struct GroupingConfig {
     pub owner_margin_m: f64,
     /// With `detections = "auto"`: the share of a radar's confirmed-track scans with several
     /// detections on the track's object above which the radar delivers points, in (0, 1)
-    /// (absent: 0.3). It falls back to objects below this share less 0.1.
+    /// (absent: 0.3). It falls back to objects below `points_fallback_share`.
     pub points_share_threshold: f64,
+    /// With `detections = "auto"`: the share below which a radar that turned to points falls
+    /// back to objects, in [0, `points_share_threshold`) (absent: 0.05). Far below the
+    /// threshold: a point cloud's share dips where its vehicles are far or hidden (one
+    /// detection each), and an object radar that once turned to points has seen a vehicle's
+    /// several detections in one scan.
+    pub points_fallback_share: f64,
     /// Weight of the prior share 0 (objects), in track scans (absent: 1).
     pub points_prior_scans: f64,
     /// Memory of the share, in track scans (absent: 2000).
@@ -99,6 +105,7 @@ impl Default for GroupingConfig {
             pedestrian_link_scale: 0.5,
             owner_margin_m: 2.0,
             points_share_threshold: 0.3,
+            points_fallback_share: 0.05,
             points_prior_scans: 1.0,
             points_window_scans: 2000.0,
             points_pool_scans: 20.0,
@@ -106,9 +113,6 @@ impl Default for GroupingConfig {
         }
     }
 }
-
-/// The hysteresis of the points decision under `points_share_threshold`.
-pub const POINTS_SHARE_HYSTERESIS: f64 = 0.1;
 
 impl GroupingConfig {
     /// The rule two detections link by.
@@ -139,8 +143,11 @@ impl GroupingConfig {
         if !within(self.owner_margin_m, 0.0, 20.0) {
             return Some(("frame.grouping.owner_margin_m", "must lie in [0, 20] m"));
         }
-        if !(self.points_share_threshold > POINTS_SHARE_HYSTERESIS && self.points_share_threshold < 1.0) {
-            return Some(("frame.grouping.points_share_threshold", "must lie in (0.1, 1)"));
+        if !(self.points_share_threshold > 0.0 && self.points_share_threshold < 1.0) {
+            return Some(("frame.grouping.points_share_threshold", "must lie in (0, 1)"));
+        }
+        if !(self.points_fallback_share >= 0.0 && self.points_fallback_share < self.points_share_threshold) {
+            return Some(("frame.grouping.points_fallback_share", "must lie in [0, points_share_threshold)"));
         }
         if !(self.detection_probability_factor > 0.0 && self.detection_probability_factor <= 1e3) {
             return Some(("frame.grouping.detection_probability_factor", "must lie in (0, 1000]"));

@@ -13,11 +13,12 @@
 //! behaviour of a tracker without a front end) enters as `points_prior_scans` pseudo-scans, and
 //! beyond `points_window_scans` counts and prior are scaled down together. The radar is taken to
 //! deliver points once the share passes `points_share_threshold`, and objects again once it
-//! falls below that less [`POINTS_SHARE_HYSTERESIS`], so that a share near the threshold does
-//! not switch the front end from scan to scan. The share is counted in either state from the
+//! falls below `points_fallback_share`, far below it: a share near the threshold does not
+//! switch the front end from scan to scan, and a point cloud whose vehicles are far or hidden
+//! for a while (one detection each) keeps its groups. The share is counted in either state from the
 //! raw detections, so the decision does not feed back into its own evidence.
 
-use crate::grouping::{GroupingConfig, POINTS_SHARE_HYSTERESIS};
+use crate::grouping::GroupingConfig;
 
 /// A radar's running share of multiple detections per confirmed track and its decision.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,7 +95,7 @@ impl PointsEstimate {
     pub fn decide(&mut self, config: &GroupingConfig, pooled_share: Option<f64>) {
         let share = self.decision_share(config, pooled_share);
         let decided = if self.points {
-            share >= config.points_share_threshold - POINTS_SHARE_HYSTERESIS
+            share >= config.points_fallback_share
         } else {
             share > config.points_share_threshold
         };
@@ -154,7 +155,11 @@ mod tests {
 
     #[test]
     fn a_radar_that_turns_out_to_deliver_objects_falls_back_with_hysteresis() {
-        let config = GroupingConfig { points_window_scans: 100.0, ..GroupingConfig::default() };
+        let config = GroupingConfig {
+            points_window_scans: 100.0,
+            points_fallback_share: 0.2,
+            ..GroupingConfig::default()
+        };
         let mut estimate = PointsEstimate::new();
         for _ in 0..200 {
             observe_alone(&mut estimate, &config, 4);
@@ -166,9 +171,9 @@ mod tests {
             scans_to_fall_back += 1;
             assert!(scans_to_fall_back < 1000);
         }
-        // It falls back below 0.2 (the threshold 0.3 less the hysteresis), not at 0.3.
+        // It falls back below the fallback share 0.2, not at the threshold 0.3.
         let share = estimate.share();
-        assert!(share < config.points_share_threshold - POINTS_SHARE_HYSTERESIS && share > 0.15, "{share}");
+        assert!(share < config.points_fallback_share && share > 0.15, "{share}");
         assert_eq!(estimate.switches, 2);
     }
 
@@ -177,21 +182,44 @@ mod tests {
         let config = GroupingConfig::default();
         let mut estimate = PointsEstimate::new();
         for scan in 0..5000 {
-            observe_alone(&mut estimate, &config, if scan % 5 == 0 { 2 } else { 1 });
+            observe_alone(&mut estimate, &config, if scan % 5 == 4 { 2 } else { 1 });
+            assert!(!estimate.points, "turned at scan {scan}: {}", estimate.share());
         }
-        assert!(!estimate.points);
         assert!((estimate.share() - 0.2).abs() < 0.02);
     }
 
     #[test]
+    fn an_object_list_whose_first_track_scan_is_a_multiple_turns_and_stays_above_the_fallback() {
+        // The light prior turns a radar on its first multiple; a share of 0.2 then lies above
+        // the fallback share, so it stays grouped (the price of keeping point clouds grouped
+        // while their vehicles are far).
+        let config = GroupingConfig::default();
+        let mut estimate = PointsEstimate::new();
+        for scan in 0..5000 {
+            observe_alone(&mut estimate, &config, if scan % 5 == 0 { 2 } else { 1 });
+        }
+        assert!(estimate.points);
+        assert_eq!(estimate.switches, 1);
+        // Only single detections from then on: it falls back once the share drops below 0.05.
+        while estimate.points {
+            observe_alone(&mut estimate, &config, 1);
+        }
+        assert!(estimate.share() < config.points_fallback_share, "{}", estimate.share());
+    }
+
+    #[test]
     fn a_radar_that_sees_few_vehicles_follows_the_pool_until_its_own_scans_outweigh_it() {
-        let config = GroupingConfig { points_pool_scans: 20.0, ..GroupingConfig::default() };
+        let config = GroupingConfig {
+            points_pool_scans: 20.0,
+            points_fallback_share: 0.2,
+            ..GroupingConfig::default()
+        };
         let mut sideways = PointsEstimate::new();
         // No scans of its own: the pool's share 0.5 decides.
         sideways.decide(&config, Some(0.5));
         assert!(sideways.points);
         // Its own scans, all single detections, then outweigh the pool: (0 + 20·0.5) / (1 + n + 20)
-        // falls below 0.2 (the threshold less the hysteresis) once n passes 29.
+        // falls below the fallback share 0.2 once n passes 29.
         let mut scans = 0;
         while sideways.points {
             sideways.observe(&config, 1);
