@@ -76,10 +76,9 @@ pub struct GroupingConfig {
     /// (absent: 0.3). It falls back to objects below `points_fallback_share`.
     pub points_share_threshold: f64,
     /// With `detections = "auto"`: the share below which a radar that turned to points falls
-    /// back to objects, in [0, `points_share_threshold`) (absent: 0.05). Far below the
-    /// threshold: a point cloud's share dips where its vehicles are far or hidden (one
-    /// detection each), and an object radar that once turned to points has seen a vehicle's
-    /// several detections in one scan.
+    /// back to objects, in [0, `points_share_threshold`) (absent: 0.2). Lower keeps a point
+    /// cloud grouped while its vehicles are far or hidden (one detection each), but an object
+    /// radar that turned to points by chance then stays grouped.
     pub points_fallback_share: f64,
     /// Weight of the prior share 0 (objects), in track scans (absent: 1).
     pub points_prior_scans: f64,
@@ -105,7 +104,7 @@ impl Default for GroupingConfig {
             pedestrian_link_scale: 0.5,
             owner_margin_m: 2.0,
             points_share_threshold: 0.3,
-            points_fallback_share: 0.05,
+            points_fallback_share: 0.2,
             points_prior_scans: 1.0,
             points_window_scans: 2000.0,
             points_pool_scans: 20.0,

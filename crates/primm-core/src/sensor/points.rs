@@ -13,9 +13,8 @@
 //! behaviour of a tracker without a front end) enters as `points_prior_scans` pseudo-scans, and
 //! beyond `points_window_scans` counts and prior are scaled down together. The radar is taken to
 //! deliver points once the share passes `points_share_threshold`, and objects again once it
-//! falls below `points_fallback_share`, far below it: a share near the threshold does not
-//! switch the front end from scan to scan, and a point cloud whose vehicles are far or hidden
-//! for a while (one detection each) keeps its groups. The share is counted in either state from the
+//! falls below `points_fallback_share`, so that a share near the threshold does not switch
+//! the front end from scan to scan. The share is counted in either state from the
 //! raw detections, so the decision does not feed back into its own evidence.
 
 use crate::grouping::GroupingConfig;
@@ -155,11 +154,7 @@ mod tests {
 
     #[test]
     fn a_radar_that_turns_out_to_deliver_objects_falls_back_with_hysteresis() {
-        let config = GroupingConfig {
-            points_window_scans: 100.0,
-            points_fallback_share: 0.2,
-            ..GroupingConfig::default()
-        };
+        let config = GroupingConfig { points_window_scans: 100.0, ..GroupingConfig::default() };
         let mut estimate = PointsEstimate::new();
         for _ in 0..200 {
             observe_alone(&mut estimate, &config, 4);
@@ -189,11 +184,11 @@ mod tests {
     }
 
     #[test]
-    fn an_object_list_whose_first_track_scan_is_a_multiple_turns_and_stays_above_the_fallback() {
-        // The light prior turns a radar on its first multiple; a share of 0.2 then lies above
-        // the fallback share, so it stays grouped (the price of keeping point clouds grouped
-        // while their vehicles are far).
-        let config = GroupingConfig::default();
+    fn an_object_list_whose_first_track_scan_is_a_multiple_stays_grouped_above_a_low_fallback() {
+        // The light prior turns a radar on its first multiple; with a fallback share of 0.05 a
+        // share of 0.2 then keeps it grouped (the price of keeping point clouds grouped while
+        // their vehicles are far), where the default 0.2 lets it fall back.
+        let config = GroupingConfig { points_fallback_share: 0.05, ..GroupingConfig::default() };
         let mut estimate = PointsEstimate::new();
         for scan in 0..5000 {
             observe_alone(&mut estimate, &config, if scan % 5 == 0 { 2 } else { 1 });
@@ -209,11 +204,7 @@ mod tests {
 
     #[test]
     fn a_radar_that_sees_few_vehicles_follows_the_pool_until_its_own_scans_outweigh_it() {
-        let config = GroupingConfig {
-            points_pool_scans: 20.0,
-            points_fallback_share: 0.2,
-            ..GroupingConfig::default()
-        };
+        let config = GroupingConfig { points_pool_scans: 20.0, ..GroupingConfig::default() };
         let mut sideways = PointsEstimate::new();
         // No scans of its own: the pool's share 0.5 decides.
         sideways.decide(&config, Some(0.5));
