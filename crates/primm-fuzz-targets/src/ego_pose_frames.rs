@@ -264,18 +264,14 @@ fn receive(
 /// sensors were found `stationary` as the frame came (the frame is then at the world origin).
 fn check_world_estimate(track: &primm_wire::WireTrack, pose: Option<EgoPose>, stationary: bool) {
     assert!(track.x_m.is_finite() && track.y_m.is_finite(), "a track with a non-finite position: {track:?}");
-    let frame_pose = match (pose, track.world()) {
-        (_, None) => {
-            assert!(pose.is_none(), "a track tracked with a valid pose has no world estimate: {track:?}");
-            return;
-        }
-        (Some(pose), Some(_)) => pose,
-        (None, Some(_)) => {
-            assert!(stationary, "a world estimate without a pose, the sensors not found standing: {track:?}");
-            EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 }
-        }
+    let Some([world_x_m, world_y_m, _, _]) = track.world() else {
+        assert!(pose.is_none(), "a track tracked with a valid pose has no world estimate: {track:?}");
+        return;
     };
-    let Some([world_x_m, world_y_m, _, _]) = track.world() else { return };
+    let frame_pose = pose.unwrap_or_else(|| {
+        assert!(stationary, "a world estimate without a pose, the sensors not found standing: {track:?}");
+        EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 }
+    });
     let (sin, cos) = frame_pose.yaw_rad.sin_cos();
     let moved_x_m = frame_pose.x_m + cos * track.x_m - sin * track.y_m;
     let moved_y_m = frame_pose.y_m + sin * track.x_m + cos * track.y_m;
