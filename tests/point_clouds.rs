@@ -1,7 +1,8 @@
 //! Radars that report several detections per object (`crate::grouping`, ARCHITECTURE.md "Point
 //! clouds"): a point-cloud radar's detections become one track per object, `detections =
 //! "auto"` finds out which kind of radar it has, a scan's wrong labels do not take a tracked
-//! object's detections from its track, object radars are left as they are, a frame
+//! object's detections from its track, a tracked car's group takes the detections near its box
+//! that move as its returns and no others, object radars are left as they are, a frame
 //! above capacity is refused and counted, and late frames give what in-order arrival gives.
 
 use glam::DVec2;
@@ -165,6 +166,51 @@ fn a_new_cars_group_starts_its_track_behind_its_mean_by_the_visible_arc_of_a_dis
     let expected_m = mean_m + (mean_m - sensor_m).normalize() * (core::f64::consts::FRAC_PI_4 * radius_m);
     let started_m = outputs[0].position_m;
     assert!(started_m.distance(expected_m) < 1e-9, "started at {started_m}, expected {expected_m}");
+}
+
+/// Detections grouped with others over 100 scans of [`cars`] with five points per car, and,
+/// from scan 40 on (the first car's track confirmed), one more detection per scan `ahead_m`
+/// beyond the first car's front, on its centre line, whose radial velocity is the car's along
+/// its line of sight times `sign`.
+fn grouped_with_one_more(ahead_m: f64, sign: f64, owner_margin_m: f64) -> u64 {
+    let sensor_m = DVec2::new(3.86, 0.70);
+    let mut frames = cars(100, 5);
+    for (k, frame) in frames.iter_mut().enumerate().skip(40) {
+        let point = DVec2::new(20.0 + 12.0 * 0.05 * k as f64 + 2.25 + ahead_m, 2.0);
+        frame.measurements.push(Measurement {
+            x_m: point.x,
+            y_m: point.y,
+            radial_velocity_mps: sign * DVec2::new(12.0, 0.0).dot((point - sensor_m).normalize()),
+            rcs_dbsm: 5.0,
+            class: ObjectClass::Car,
+            sensor_id: Some(3),
+            ground_truth_id: None,
+        });
+    }
+    let mut config = config(DetectionModel::Points);
+    config.frame.grouping.owner_margin_m = owner_margin_m;
+    let mut tracker = Tracker::new(config).unwrap();
+    for frame in &frames {
+        tracker.step(frame).unwrap();
+    }
+    tracker.stats().detections_grouped
+}
+
+#[test]
+fn a_detection_up_to_the_owner_margin_beyond_a_tracked_cars_box_joins_its_group_when_it_moves_as_a_return() {
+    // 3.4 m beyond the front of the car's true box, more than the link distance from its other
+    // points (its front points lie 1.1 m ahead of its centre), a return of a longer vehicle's
+    // front: inside the box at the track's prior grown by the default margin, not by 2 m.
+    let margin_m = Config::default().frame.grouping.owner_margin_m;
+    let (joined, alone) = (grouped_with_one_more(3.4, 1.0, margin_m), grouped_with_one_more(3.4, 1.0, 2.0));
+    assert!(joined >= alone + 55, "grouped {joined} with the default margin, {alone} with 2 m");
+    // Moving with the mirrored radial velocity (an image of the car in a wall across the road,
+    // or clutter) it is none of the car's returns: it joins no group, nearer the box too.
+    for ahead_m in [0.5, 3.4] {
+        let image = grouped_with_one_more(ahead_m, -1.0, margin_m);
+        let ret = grouped_with_one_more(ahead_m, 1.0, margin_m);
+        assert!(ret >= image + 55, "{ahead_m} m ahead: returns {ret} grouped, images {image}");
+    }
 }
 
 #[test]

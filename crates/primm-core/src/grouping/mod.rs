@@ -67,9 +67,11 @@ pub struct GroupingConfig {
     /// apart, stay two groups, where a car's faces span metres.
     pub pedestrian_link_scale: f64,
     /// How far beyond its box (the class's extent at the track's prior) a detection still lies
-    /// on a confirmed track's object and joins its group, m (absent: 2.0). Wider than the
-    /// extent's `absorb_margin_m`: the prior's position error and the spread of a point cloud
-    /// over the faces both reach beyond the box.
+    /// on a confirmed track's object and joins its group, m (absent: 3.0). Wider than the
+    /// extent's `absorb_margin_m`: the prior's position error, the spread of a point cloud over
+    /// the faces and a vehicle longer than the class's nominal box (a van, a lorry) all reach
+    /// beyond the box, and a detection of the object left out of its group pulls the group's
+    /// mean towards where the track already is.
     pub owner_margin_m: f64,
     /// With `detections = "auto"`: the share of a radar's confirmed-track scans with several
     /// detections on the track's object above which the radar delivers points, in (0, 1)
@@ -102,7 +104,7 @@ impl Default for GroupingConfig {
             link_distance_per_range: 0.02,
             link_radial_velocity_gap_mps: 2.0,
             pedestrian_link_scale: 0.5,
-            owner_margin_m: 2.0,
+            owner_margin_m: 3.0,
             points_share_threshold: 0.3,
             points_fallback_share: 0.2,
             points_prior_scans: 1.0,

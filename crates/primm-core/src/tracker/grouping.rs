@@ -32,7 +32,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let candidate = sensor.detections != DetectionModel::Objects;
             let grouped = sensor.groups_detections();
             // Only grouped detections need their owner; an `auto` radar's count looks itself.
-            let (owner, shadowed) = if grouped { self.owner_of(&measurement) } else { (None, None) };
+            let sensor_position_m = sensor.position_m(self.step_pose);
+            let (owner, shadowed) =
+                if grouped { self.owner_of(&measurement, sensor_position_m) } else { (None, None) };
             if let Some(row) = shadowed.filter(|_| grouped) {
                 self.shadowed[usize::from(row)] = true;
             }
@@ -40,7 +42,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 measurement,
                 frame_index: index as u16,
                 sensor_slot: slot as u8,
-                sensor_position_m: sensor.position_m(self.step_pose),
+                sensor_position_m,
                 grouped,
                 owner,
             };
@@ -58,22 +60,29 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// The table row of the confirmed track (of any class: labels flip) whose object at its
-    /// prior holds `measurement` (its class's box grown by [`Self::owner_margin_m`]). When
+    /// prior holds `measurement` (its class's box grown by [`Self::owner_margin_m`]) and which
+    /// it moves with ([`Self::moves_with`]; `sensor_position_m` is its radar's). When
     /// several do, the nearest one's; but of two tracks that are likely one object followed
     /// twice ([`Self::duplicates`]), the older one's. The younger one is returned second: it is
     /// *shadowed*, and ends with the step when it took no measurement
     /// ([`Self::end_shadowed_tracks`]).
-    fn owner_of(&self, measurement: &Measurement) -> (Option<u16>, Option<u16>) {
+    fn owner_of(
+        &self,
+        measurement: &Measurement,
+        sensor_position_m: glam::DVec2,
+    ) -> (Option<u16>, Option<u16>) {
         let position_m = measurement.position();
         let tracks = self.table.tracks();
-        let holders = self
-            .confirmed
-            .holders(position_m, |row| self.holds(row, position_m, self.owner_margin_m(row)).is_some());
+        let holds = |row: usize| {
+            let distance_m2 = self.holds(row, position_m, self.owner_margin_m(row))?;
+            self.moves_with(row, measurement, sensor_position_m).then_some(distance_m2)
+        };
+        let holders = self.confirmed.holders(position_m, |row| holds(row).is_some());
         let mut best: Option<(usize, f64)> = None;
         let mut shadowed = None;
         // The holders in the order of their priors' x: the choice below depends on it.
         for row in self.confirmed.rows(&holders) {
-            let Some(distance_m2) = self.holds(row, position_m, self.owner_margin_m(row)) else { continue };
+            let Some(distance_m2) = holds(row) else { continue };
             let better = match best {
                 None => true,
                 Some((best_row, best_m2)) => {
@@ -92,6 +101,19 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         (best.map(|(row, _)| row as u16), shadowed)
+    }
+
+    /// Whether `measurement` moves as a return of the confirmed track in `row` can: its radial
+    /// velocity within `link_radial_velocity_gap_mps` of the span a rigid body's returns cover
+    /// along the line of sight from the radar, from the body's own radial speed `v_r` less
+    /// `|v_r|` to it plus `|v_r|` (a wheel's contact point stands still, its top moves at twice
+    /// the body's speed). A multipath image of the object moves with the mirrored velocity and
+    /// clutter as it will; both fall outside once the object moves faster than the gap.
+    fn moves_with(&self, row: usize, measurement: &Measurement, sensor_position_m: glam::DVec2) -> bool {
+        let line_of_sight = (measurement.position() - sensor_position_m).normalize_or_zero();
+        let expected_mps = self.priors[row].fused_velocity_mps().dot(line_of_sight);
+        (measurement.radial_velocity_mps - expected_mps).abs()
+            <= self.config.frame.grouping.link_radial_velocity_gap_mps + expected_mps.abs()
     }
 
     /// How far beyond its box a detection still joins the group of the track in `row`: the
