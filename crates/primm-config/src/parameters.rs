@@ -79,7 +79,7 @@ const PARAMETERS: &[Parameter] = &[
     p("frame.grouping.link_distance_per_range", "[0, 1]", "Growth of the link distance with range, m per m."),
     p("frame.grouping.link_radial_velocity_gap_mps", "[0, 100]", "Largest difference of radial velocity between two linked detections."),
     p("frame.grouping.pedestrian_link_scale", "(0, 1]", "Share of the link distance within which two detections both labelled pedestrian link."),
-    p("frame.grouping.owner_margin_m", "[0, 20]", "Point clouds: how far beyond a confirmed track's box a detection still joins its group."),
+    p("frame.grouping.owner_margin_m", "[0, 20]", "Point clouds: how far beyond a confirmed track's box a detection still joins its group (when its radial velocity is one of the object's returns)."),
     p("frame.grouping.points_share_threshold", "(0, 1)", "detections = auto: share of confirmed vehicle-track scans with several detections above which a radar delivers points."),
     p("frame.grouping.points_fallback_share", "[0, points_share_threshold)", "detections = auto: share below which a radar that delivers points falls back to objects."),
     p("frame.grouping.points_prior_scans", "(0, 1e9]", "Weight of the prior share 0 (objects), in track scans."),
