@@ -33,8 +33,11 @@
 //! One measurement says little: a single radial velocity, a position that a wall at any angle
 //! could explain. A ghost that slipped through (a pedestrian's, one in a wall across the
 //! heading at a junction, one born before its object's track was confirmed) gathers more while
-//! its track is tentative, so every tentative track with a prior is also held against each
-//! confirmed track older than it ([`Tracker::images_a_track`]). The would-be wall is then the
+//! its track is tentative, so every track that was tentative when the step began and has a
+//! prior is also held against each confirmed track older than it ([`Tracker::images_a_track`]);
+//! that includes a track that the step's update has just confirmed, as its first update does
+//! a pedestrian's image (a small spread makes a second detection at the predicted place strong
+//! evidence), which was otherwise never checked. The would-be wall is then the
 //! line halfway between the two fused centres, at right angles to the line joining them, at
 //! any orientation. The tentative track is the image, and ends (counted in
 //! `tentative_tracks_ended_as_ghost` as well), when all of these hold:
@@ -55,7 +58,7 @@
 //!   ([`GHOST_VELOCITY_GATE`]) of the two velocity covariances plus the class's
 //!   `likelihood_radial_velocity_std_mps` in every direction.
 //!
-//! Confirmed tracks are not checked: ending young ones too (up to 5 or 10 hits) lowered IDF1
+//! Tracks confirmed before the step are not checked: ending young ones too (up to 5 or 10 hits) lowered IDF1
 //! of confirmed tracks on the point-cloud validation split, ending real objects' tracks
 //! (docs/EVALUATION.md, "Point clouds"). Without the RCS condition the check also ended real
 //! objects' tentative tracks (pedestrians walking side by side, cars in adjacent lanes: one
@@ -136,14 +139,15 @@ impl<P: DisplacementPredictor> Tracker<P> {
         })
     }
 
-    /// Whether the tentative track in `row`, which has a prior this step, is the mirror image of
-    /// a confirmed track older than it in a wall halfway between them (module docs).
+    /// Whether the track in `row`, tentative when the step began (confirmed by this step's
+    /// update or not) and with a prior this step, is the mirror image of a confirmed track older
+    /// than it in a wall halfway between them (module docs).
     pub(super) fn images_a_track(&self, row: usize) -> bool {
         let tracks = self.table.tracks();
         let image = &tracks[row];
         if self.step_pose.is_none()
             || !self.grouped_frame
-            || image.status.is_confirmed()
+            || self.was_confirmed[row]
             || self.rows[row].prior_position_m.is_none()
         {
             return false;
