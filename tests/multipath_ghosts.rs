@@ -179,13 +179,12 @@ fn a_pedestrian_standing_behind_a_standing_car_is_tracked() {
     assert_eq!(tracker.stats().tentative_tracks_ended_as_ghost, 0);
 }
 
-#[test]
-fn a_pedestrians_image_ends_even_when_its_first_update_would_confirm_it() {
-    // A pedestrian (−5 dBsm) walking along x at 1.5 m/s at y = 2 m towards a building front
-    // across the pavement at x = 35 m, seen by the front-left radar (id 3) every 50 ms, and
-    // from 2 s on its image in the front, 8 dB weaker: a pedestrian's small spread makes a
-    // second detection at the predicted place strong evidence, so its track would be confirmed
-    // on its first update.
+/// A pedestrian (−5 dBsm) walking along x at 1.5 m/s at y = 2 m towards a building front
+/// across the pavement at x = 35 m, seen by the front-left radar (id 3) every 50 ms for 6 s, and
+/// from frame `image_from` on its image in the front, 8 dB weaker, listed before the pedestrian
+/// in each frame when `image_first`. Asserts that no track beyond the front is ever confirmed;
+/// returns the tracker.
+fn pedestrian_and_image(image_from: usize, image_first: bool) -> Tracker {
     let sensor_m = DVec2::new(3.86, 0.70);
     let frames: Vec<Frame> = (0..120)
         .map(|k| {
@@ -205,8 +204,12 @@ fn a_pedestrians_image_ends_even_when_its_first_update_would_confirm_it() {
                     ground_truth_id: id,
                 })
             };
+            let with_image = k >= image_from;
+            if with_image && image_first {
+                push(image, DVec2::new(-1.5, 0.0), -13.0, None);
+            }
             push(centre, DVec2::new(1.5, 0.0), -5.0, Some(1));
-            if k >= 40 {
+            if with_image && !image_first {
                 push(image, DVec2::new(-1.5, 0.0), -13.0, None);
             }
             frame
@@ -225,5 +228,22 @@ fn a_pedestrians_image_ends_even_when_its_first_update_would_confirm_it() {
             frame.timestamp_s
         );
     }
+    assert_eq!(tracker.tracks().iter().filter(|t| t.status.is_confirmed()).count(), 1);
+    tracker
+}
+
+#[test]
+fn a_pedestrians_image_ends_even_when_its_first_update_would_confirm_it() {
+    // A pedestrian's small spread makes a second detection at the predicted place strong
+    // evidence, so the image's track would be confirmed on its first update.
+    let tracker = pedestrian_and_image(40, false);
+    assert!(tracker.stats().tentative_tracks_ended_as_ghost > 10, "{:?}", tracker.stats());
+}
+
+#[test]
+fn an_image_that_appears_with_its_object_and_starts_its_track_first_ends() {
+    // From the first scan on, the image listed first: its track is started before the
+    // pedestrian's, in the same frame.
+    let tracker = pedestrian_and_image(0, true);
     assert!(tracker.stats().tentative_tracks_ended_as_ghost > 10, "{:?}", tracker.stats());
 }

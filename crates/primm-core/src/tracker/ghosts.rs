@@ -34,7 +34,9 @@
 //! could explain. A ghost that slipped through (a pedestrian's, one in a wall across the
 //! heading at a junction, one born before its object's track was confirmed) gathers more while
 //! its track is tentative, so every track that was tentative when the step began and has a
-//! prior is also held against each confirmed track older than it ([`Tracker::images_a_track`]);
+//! prior is also held against each confirmed track started no later than it, in the same frame
+//! too: at first sight an object and its image appear together, and the image's track may be
+//! the first of the frame ([`Tracker::images_a_track`]);
 //! that includes a track that the step's update has just confirmed, as its first update does
 //! a pedestrian's image (a small spread makes a second detection at the predicted place strong
 //! evidence), which was otherwise never checked. The would-be wall is then the
@@ -140,8 +142,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// Whether the track in `row`, tentative when the step began (confirmed by this step's
-    /// update or not) and with a prior this step, is the mirror image of a confirmed track older
-    /// than it in a wall halfway between them (module docs).
+    /// update or not) and with a prior this step, is the mirror image of a confirmed track started
+    /// no later than it in a wall halfway between them (module docs).
     pub(super) fn images_a_track(&self, row: usize) -> bool {
         let tracks = self.table.tracks();
         let image = &tracks[row];
@@ -155,8 +157,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let image_prior = self.priors[row].object_prior();
         let image_rcs_dbsm = mean_rcs_dbsm(image);
         tracks.iter().zip(self.rows.iter()).enumerate().any(|(other, (track, record))| {
-            let older = (track.started_s, track.id) < (image.started_s, image.id);
-            if other == row || !older || !track.status.is_confirmed() || record.prior_position_m.is_none() {
+            let not_younger = track.started_s <= image.started_s;
+            if other == row
+                || !not_younger
+                || !track.status.is_confirmed()
+                || record.prior_position_m.is_none()
+            {
                 return false;
             }
             let section = self.config.classes.get(track.class);
