@@ -150,7 +150,7 @@ fn pedestrian() -> ClassConfig {
         max_speed_mps: Some(12.0),
         likelihood_radial_velocity_std_mps: 0.7,
         existence: ExistenceConfig { detection_probability: 0.15, clutter_density_per_m2: 0.0004 },
-        duplicate_distance_m: 1.0,
+        duplicate_distance_m: 0.5,
         duplicate_speed_difference_mps: 1.0,
         radial_velocity_update: RadialVelocityUpdateConfig {
             enabled: true,
@@ -163,7 +163,7 @@ fn pedestrian() -> ClassConfig {
             width_m: 0.6,
             contour_std_m: 0.2,
             offset_scale: 0.5,
-            absorb_margin_m: 0.5,
+            absorb_margin_m: 0.3,
             ..ExtentConfig::default()
         },
         constant_velocity: ConstantVelocityConfig { acceleration_psd_m2_per_s3: 0.25 },

@@ -63,7 +63,7 @@ pub struct GroupingConfig {
     /// Largest difference of radial velocity between two linked detections, m/s (absent: 2.0).
     pub link_radial_velocity_gap_mps: f64,
     /// The share of the link distance within which two detections both labelled pedestrian
-    /// link, dimensionless in (0, 1] (absent: 0.5): people walking side by side, a metre
+    /// link, dimensionless in (0, 1] (absent: 0.25): people walking side by side, a metre
     /// apart, stay two groups, where a car's faces span metres.
     pub pedestrian_link_scale: f64,
     /// How far beyond its box (the class's extent at the track's prior) a detection still lies
@@ -103,7 +103,7 @@ impl Default for GroupingConfig {
             link_distance_m: 2.0,
             link_distance_per_range: 0.02,
             link_radial_velocity_gap_mps: 2.0,
-            pedestrian_link_scale: 0.5,
+            pedestrian_link_scale: 0.25,
             owner_margin_m: 3.0,
             points_share_threshold: 0.3,
             points_fallback_share: 0.2,
