@@ -34,12 +34,12 @@
 //! could explain. A ghost that slipped through (a pedestrian's, one in a wall across the
 //! heading at a junction, one born before its object's track was confirmed) gathers more while
 //! its track is tentative, so every track that was tentative when the step began and has a
-//! prior is also held against each confirmed track started no later than it, in the same frame
-//! too: at first sight an object and its image appear together, and the image's track may be
-//! the first of the frame ([`Tracker::images_a_track`]);
-//! that includes a track that the step's update has just confirmed, as its first update does
-//! a pedestrian's image (a small spread makes a second detection at the predicted place strong
-//! evidence), which was otherwise never checked. The would-be wall is then the
+//! prior is also held against each confirmed track started no later than it
+//! ([`Tracker::images_a_track`]). That includes a track the step's own update has just
+//! confirmed, as its first update confirms a pedestrian's image (a small spread makes a second
+//! detection at the predicted place strong evidence), and a track started in the same frame as
+//! the confirmed one: at first sight an object and its image appear together, and the image's
+//! track may be the frame's first. The would-be wall is then the
 //! line halfway between the two fused centres, at right angles to the line joining them, at
 //! any orientation. The tentative track is the image, and ends (counted in
 //! `tentative_tracks_ended_as_ghost` as well), when all of these hold:
@@ -60,8 +60,9 @@
 //!   ([`GHOST_VELOCITY_GATE`]) of the two velocity covariances plus the class's
 //!   `likelihood_radial_velocity_std_mps` in every direction.
 //!
-//! Tracks confirmed before the step are not checked: ending young ones too (up to 5 or 10 hits) lowered IDF1
-//! of confirmed tracks on the point-cloud validation split, ending real objects' tracks
+//! Tracks confirmed before the step are not checked: ending young ones too (up to 5 or 10
+//! hits) lowered IDF1 of confirmed tracks on the point-cloud validation split, ending real
+//! objects' tracks
 //! (docs/EVALUATION.md, "Point clouds"). Without the RCS condition the check also ended real
 //! objects' tentative tracks (pedestrians walking side by side, cars in adjacent lanes: one
 //! for every nine of ghosts and clutter) and IDF1 with point-cloud radars did not rise; with a

@@ -111,9 +111,15 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// clutter as it will; both fall outside once the object moves faster than the gap.
     fn moves_with(&self, row: usize, measurement: &Measurement, sensor_position_m: glam::DVec2) -> bool {
         let line_of_sight = (measurement.position() - sensor_position_m).normalize_or_zero();
-        let expected_mps = self.priors[row].fused_velocity_mps().dot(line_of_sight);
+        let expected_mps = self.radial_velocity_mps(row, line_of_sight);
         (measurement.radial_velocity_mps - expected_mps).abs()
             <= self.config.frame.grouping.link_radial_velocity_gap_mps + expected_mps.abs()
+    }
+
+    /// The velocity of the confirmed track in `row` at its prior (as the step's index holds
+    /// it) along the unit `line_of_sight`, m/s.
+    fn radial_velocity_mps(&self, row: usize, line_of_sight: glam::DVec2) -> f64 {
+        self.confirmed.velocity_mps(row).dot(line_of_sight)
     }
 
     /// How far beyond its box a detection still joins the group of the track in `row`: the
@@ -243,7 +249,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
                         continue;
                     }
                     // Moving as the object: clutter and crossing objects in the box do not.
-                    let expected_mps = self.priors[row].fused_velocity_mps().dot(line_of_sight);
+                    let expected_mps = self.radial_velocity_mps(row, line_of_sight);
                     if (detection.measurement.radial_velocity_mps - expected_mps).abs()
                         <= config.link_radial_velocity_gap_mps
                     {
