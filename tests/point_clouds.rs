@@ -417,3 +417,53 @@ fn bad_point_cloud_keys_are_refused_by_name() {
         "frame.grouping.pedestrian_link_scale"
     );
 }
+
+/// Vehicles driving along x at `speed_mps` in the near lane of [`cars`], one behind the other
+/// (`(offset_m, length_m)`: the centre's offset along x and the length), seen by the front-left
+/// radar: per scan and vehicle a detection on its rear face and four along the side facing the
+/// radar, spread over its length.
+fn side_on(frames: usize, vehicles: &[(f64, f64)], speed_mps: f64) -> Vec<Frame> {
+    let mut noise = Noise(5);
+    let sensor_m = DVec2::new(3.86, 0.70);
+    let velocity = DVec2::new(speed_mps, 0.0);
+    (0..frames)
+        .map(|k| {
+            let t = 0.05 * k as f64;
+            let mut frame = Frame::new(t);
+            frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
+            for (id, &(offset_m, length_m)) in vehicles.iter().enumerate() {
+                let centre = DVec2::new(20.0 + offset_m + speed_mps * t, 2.0);
+                let half_m = 0.5 * length_m;
+                let mut points = [centre + DVec2::new(-half_m, 0.3 * noise.next()); 5];
+                for (p, point) in points.iter_mut().skip(1).enumerate() {
+                    let along_m = -half_m + length_m * (p as f64 + 0.5 + 0.5 * noise.next()) / 4.0;
+                    *point = centre + DVec2::new(along_m, -0.9);
+                }
+                for point in points {
+                    frame.measurements.push(Measurement {
+                        x_m: point.x + 0.2 * noise.next(),
+                        y_m: point.y + 0.2 * noise.next(),
+                        radial_velocity_mps: velocity.dot((point - sensor_m).normalize()),
+                        rcs_dbsm: 10.0,
+                        class: ObjectClass::Car,
+                        sensor_id: Some(3),
+                        ground_truth_id: Some(id as u64 + 1),
+                    });
+                }
+            }
+            frame
+        })
+        .collect()
+}
+
+#[test]
+fn a_lorry_tracked_at_both_ends_as_objects_keeps_one_track_once_its_radar_groups() {
+    // 7.5 m long, 3 m more than the car class's box: tracked as objects (as an `auto` radar
+    // does first), its detections start tracks at its rear and its front, whose boxes overlap.
+    let lorry = side_on(200, &[(0.0, 7.5)], 8.0);
+    let (as_objects, _) = confirmed_per_frame(config(DetectionModel::Objects), &lorry);
+    assert!(as_objects > 2.5, "{as_objects} confirmed tracks per frame as objects");
+    let (auto, tracker) = confirmed_per_frame(config(DetectionModel::Auto), &lorry);
+    assert!(tracker.sensors().of(Some(3)).groups_detections());
+    assert!((auto - 1.0).abs() < 0.05, "{auto} confirmed tracks per frame");
+}

@@ -74,6 +74,10 @@ pub enum PresetChoice {
     /// about three clutter points per scan, a tenth of the class labels wrong.
     #[value(name = "point_cloud", alias = "point-cloud")]
     PointCloud,
+    /// The point_cloud scene from radars that resolve range finer than azimuth: a car's near
+    /// side as densely populated as its rear or front.
+    #[value(name = "point_cloud_range", alias = "point-cloud-range")]
+    PointCloudRange,
 }
 
 impl From<PresetChoice> for Preset {
@@ -91,6 +95,7 @@ impl From<PresetChoice> for Preset {
             PresetChoice::Centroid => Preset::Centroid,
             PresetChoice::DenseStatic => Preset::DenseStatic,
             PresetChoice::PointCloud => Preset::PointCloud,
+            PresetChoice::PointCloudRange => Preset::PointCloudRange,
         }
     }
 }

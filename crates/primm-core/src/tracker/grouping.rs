@@ -135,17 +135,53 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// Whether the tracks in rows `older` and `younger` follow one object: of one class with
-    /// centres within its `duplicate_distance_m`, or the younger one's centre on the older
-    /// one's object (its class's box grown by `extent.absorb_margin_m`; a pedestrian track
-    /// started on a car by a wrong label).
+    /// Whether the confirmed tracks in rows `older` and `younger` follow one object: of one
+    /// class with centres within its `duplicate_distance_m`, or with overlapping boxes
+    /// ([`Self::boxes_overlap`]), or the younger one's centre on the older one's object (its
+    /// class's box grown by `extent.absorb_margin_m`; a pedestrian track started on a car by a
+    /// wrong label).
     fn duplicates(&self, older: usize, younger: usize) -> bool {
         let tracks = self.table.tracks();
         let younger_m = self.priors[younger].fused.mean;
         let apart_m = self.priors[older].fused.mean.distance(younger_m);
         let section = self.config.classes.get(tracks[older].class);
         (tracks[older].class == tracks[younger].class && apart_m <= section.duplicate_distance_m)
+            || self.boxes_overlap(older, younger)
             || self.holds(older, younger_m, section.extent.absorb_margin_m).is_some()
+    }
+
+    /// Whether the confirmed tracks in rows `older` and `younger`, of one class with an extent,
+    /// move as one (fused velocities within the class's `duplicate_speed_difference_mps`, at
+    /// least its `extent.min_heading_speed_mps`) with boxes that overlap at their priors (the
+    /// younger one's centre within the older one's box doubled along its heading). Two vehicles
+    /// cannot stand in each other's box; a vehicle longer than the class's box, whose front
+    /// and rear were tracked apart while its radar still delivered objects, does.
+    fn boxes_overlap(&self, older: usize, younger: usize) -> bool {
+        let tracks = self.table.tracks();
+        let section = self.config.classes.get(tracks[older].class);
+        let extent = &section.extent;
+        let velocity_mps = self.confirmed.velocity_mps(older);
+        let moving_as_one = velocity_mps.distance(self.confirmed.velocity_mps(younger))
+            <= section.duplicate_speed_difference_mps;
+        if tracks[older].class != tracks[younger].class
+            || !extent.enabled
+            || !(velocity_mps.length() >= extent.min_heading_speed_mps)
+            || !moving_as_one
+        {
+            return false;
+        }
+        let doubled = crate::extent::ExtentConfig {
+            length_m: 2.0 * extent.length_m,
+            width_m: 2.0 * extent.width_m,
+            absorb_margin_m: 0.0,
+            ..*extent
+        };
+        crate::extent::lies_on_object(
+            &doubled,
+            self.priors[older].fused.mean,
+            velocity_mps,
+            self.priors[younger].fused.mean,
+        )
     }
 
     /// Before the deletion: marks for ending (counted as deleted) every shadowed track that took

@@ -143,7 +143,8 @@ impl<'a> ScanSensor<'a> {
     }
 }
 
-/// The box faces of an object turned towards the sensor, weighted by their apparent width.
+/// The box faces of an object turned towards the sensor, weighted by their apparent width
+/// (and their depth in range, [`ReflectionConfig::range_extent_weight`]).
 pub(super) struct VisibleFaces {
     corners: [DVec2; 4],
     faces: [(usize, f64); 4],
@@ -206,7 +207,7 @@ pub(crate) fn scan(
         };
         let max_range = mount.layout.max_range_m.min(refl.detection_range_m);
         let Some(range) = range_if_in_view(&sensor, object, max_range) else { continue };
-        let Some(faces) = visible_faces(object, origin) else { continue };
+        let Some(faces) = visible_faces(object, origin, refl.range_extent_weight) else { continue };
         let truth = ObjectTruth {
             position: ego.world_to_car(object.kin.position),
             velocity: ego.rotate_to_car(object.kin.velocity()),
@@ -443,8 +444,10 @@ fn range_if_in_view(sensor: &ScanSensor<'_>, object: &Agent, max_range: f64) -> 
     Some(range)
 }
 
-/// The faces of `object`'s box turned towards `origin`; `None` when none is.
-fn visible_faces(object: &Agent, origin: DVec2) -> Option<VisibleFaces> {
+/// The faces of `object`'s box turned towards `origin`, each weighted by its apparent width
+/// plus `range_extent_weight` times its depth along the line of sight
+/// ([`ReflectionConfig::range_extent_weight`]); `None` when none is.
+fn visible_faces(object: &Agent, origin: DVec2, range_extent_weight: f64) -> Option<VisibleFaces> {
     let corners = object.corners();
     let mut faces: [(usize, f64); 4] = [(0, 0.0); 4];
     let mut total = 0.0;
@@ -456,7 +459,8 @@ fn visible_faces(object: &Agent, origin: DVec2) -> Option<VisibleFaces> {
         let mid = 0.5 * (a + b);
         let to_sensor = (origin - mid).normalize_or_zero();
         let facing = outward.dot(to_sensor);
-        let weight = if facing > 0.0 { edge.length() * facing } else { 0.0 };
+        let depth = range_extent_weight * edge.normalize_or_zero().dot(to_sensor).abs();
+        let weight = if facing > 0.0 { edge.length() * (facing + depth) } else { 0.0 };
         faces[k] = (k, weight);
         total += weight;
     }

@@ -53,11 +53,18 @@ pub enum Preset {
     /// walking in groups side by side, multipath ghosts behind the walls along the roads, about
     /// three clutter points per scan, and a tenth of the class labels wrong.
     PointCloud,
+    /// The [`Preset::PointCloud`] scene from radars that resolve range finer than azimuth
+    /// ([`ReflectionConfig::range_extent_weight`] 3): a car's faces hold points by their depth
+    /// in range as well as their apparent width, so a car ahead and aside shows its near side
+    /// as densely as its rear.
+    ///
+    /// [`ReflectionConfig::range_extent_weight`]: super::types::ReflectionConfig::range_extent_weight
+    PointCloudRange,
 }
 
 impl Preset {
     /// All presets.
-    pub const ALL: [Preset; 12] = [
+    pub const ALL: [Preset; 13] = [
         Preset::Default,
         Preset::Robustness,
         Preset::Turning,
@@ -70,11 +77,12 @@ impl Preset {
         Preset::Centroid,
         Preset::DenseStatic,
         Preset::PointCloud,
+        Preset::PointCloudRange,
     ];
 
     /// The preset's name (`default`, `robustness`, `turning`, `clutter`, `clutter_turning`,
     /// `extended`, `extended_turning`, `extended_clutter`, `extended_clutter_turning`, `centroid`,
-    /// `dense_static`, `point_cloud`).
+    /// `dense_static`, `point_cloud`, `point_cloud_range`).
     pub fn name(self) -> &'static str {
         match self {
             Preset::Default => "default",
@@ -89,6 +97,7 @@ impl Preset {
             Preset::Centroid => "centroid",
             Preset::DenseStatic => "dense_static",
             Preset::PointCloud => "point_cloud",
+            Preset::PointCloudRange => "point_cloud_range",
         }
     }
 
@@ -112,6 +121,7 @@ impl Preset {
             Preset::Centroid => ScenarioConfig::centroid(),
             Preset::DenseStatic => ScenarioConfig::dense_static(),
             Preset::PointCloud => ScenarioConfig::point_cloud(),
+            Preset::PointCloudRange => ScenarioConfig::point_cloud_range(),
         }
     }
 }
@@ -227,6 +237,14 @@ impl ScenarioConfig {
             ..ClutterConfig::urban()
         };
         config.point_cloud = PointCloudConfig::detections();
+        config
+    }
+
+    /// The range-resolving detection-level preset: see [`Preset::PointCloudRange`].
+    pub fn point_cloud_range() -> Self {
+        let mut config = Self::point_cloud();
+        config.splits.seed_base = 0x5043_5241_4e47;
+        config.car_reflection.range_extent_weight = 3.0;
         config
     }
 
@@ -364,6 +382,7 @@ mod tests {
                     | Preset::ExtendedClutterTurning
                     | Preset::DenseStatic
                     | Preset::PointCloud
+                    | Preset::PointCloudRange
             );
             assert_eq!(clutter.is_enabled(), expected, "{preset}");
         }
@@ -421,9 +440,21 @@ mod tests {
         base.car_reflection = Preset::ClutterTurning.config().car_reflection;
         base.splits.seed_base = Preset::ClutterTurning.config().splits.seed_base;
         assert_eq!(base, Preset::ClutterTurning.config());
+        let point_clouds = [Preset::PointCloud, Preset::PointCloudRange];
         for preset in Preset::ALL {
-            assert_eq!(preset.config().point_cloud.enabled, preset == Preset::PointCloud, "{preset}");
+            assert_eq!(preset.config().point_cloud.enabled, point_clouds.contains(&preset), "{preset}");
         }
+    }
+
+    #[test]
+    fn the_range_resolving_point_cloud_preset_differs_only_in_the_faces_weights_and_seeds() {
+        let mut config = Preset::PointCloudRange.config();
+        assert_eq!(config.car_reflection.range_extent_weight, 3.0);
+        assert_eq!(Preset::PointCloud.config().car_reflection.range_extent_weight, 0.0);
+        assert_ne!(config.splits.seed_base, Preset::PointCloud.config().splits.seed_base);
+        config.car_reflection.range_extent_weight = 0.0;
+        config.splits.seed_base = Preset::PointCloud.config().splits.seed_base;
+        assert_eq!(config, Preset::PointCloud.config());
     }
 
     #[test]

@@ -308,6 +308,15 @@ pub struct ReflectionConfig {
     /// Probability that a point comes from inside the outline (wheel houses, underbody, the
     /// far side seen under the vehicle) instead of from the visible outline.
     pub interior_probability: f64,
+    /// How a visible face's share of the points grows with its extent along the line of
+    /// sight, dimensionless, ≥ 0: a face's weight is its length times the cosine between its
+    /// outward normal and the line of sight (its apparent width: resolution cells across the
+    /// beam) plus this times the cosine between the face itself and the line of sight (its
+    /// depth in range: resolution cells along the beam). A radar's range cells are finer than
+    /// its azimuth cells at all but short range (0.15–0.5 m against 1–2 m at 20 m for 2–6°),
+    /// so such a radar sees the near side of a car ahead of it and aside as an L, its side
+    /// face full of points; 0 weighs the apparent width alone.
+    pub range_extent_weight: f64,
     /// Mean RCS of one point seen head-on or from behind, dBsm.
     pub rcs_front_dbsm: f64,
     /// Mean RCS of one point seen from the side, dBsm.

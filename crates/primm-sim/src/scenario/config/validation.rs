@@ -276,6 +276,7 @@ impl ScenarioConfig {
             }
             probability(&field("corner_probability"), refl.corner_probability)?;
             probability(&field("interior_probability"), refl.interior_probability)?;
+            non_negative(&field("range_extent_weight"), refl.range_extent_weight)?;
             finite(&field("rcs_front_dbsm"), refl.rcs_front_dbsm)?;
             finite(&field("rcs_side_dbsm"), refl.rcs_side_dbsm)?;
             non_negative(&field("rcs_fluctuation_db"), refl.rcs_fluctuation_db)?;
