@@ -106,7 +106,7 @@ const PARAMETERS: &[Parameter] = &[
     p("classes.<class>.max_speed_mps", "> 0", "Highest speed over ground of the class; faster estimates are scaled back (world frame)."),
     p("classes.<class>.likelihood_radial_velocity_std_mps", "> 0", "Likelihood cost: spread of a radial velocity minus the track's last one."),
     p("classes.<class>.duplicate_distance_m", "> 0", "Duplicate check: largest distance between two tracks of one object."),
-    p("classes.<class>.duplicate_speed_difference_mps", "> 0", "Duplicate check: largest velocity difference between two tracks of one object."),
+    p("classes.<class>.duplicate_speed_difference_mps", "> 0", "Duplicate check: largest velocity difference between two tracks of one object (also between two tracks of a class with an extent whose boxes overlap, in a point cloud's owner look-up)."),
     p("classes.<class>.existence.detection_probability", "(0, 1)", "Probability that a sensor with the object in view reports it in a scan."),
     p("classes.<class>.existence.clutter_density_per_m2", ">= 0", "False detections of the class per scan and square metre of field of view."),
     p("classes.<class>.radial_velocity_update.enabled", "true, false", "Whether the radial velocity updates the velocity (a Kalman row of CV, CA, CT)."),
