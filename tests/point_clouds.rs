@@ -35,6 +35,24 @@ fn config(detections: DetectionModel) -> Config {
     config
 }
 
+/// A car's detection by the front-left radar (id 3) at `position_m`.
+fn car_detection(
+    position_m: DVec2,
+    radial_velocity_mps: f64,
+    rcs_dbsm: f64,
+    ground_truth_id: Option<u64>,
+) -> Measurement {
+    Measurement {
+        x_m: position_m.x,
+        y_m: position_m.y,
+        radial_velocity_mps,
+        rcs_dbsm,
+        class: ObjectClass::Car,
+        sensor_id: Some(3),
+        ground_truth_id,
+    }
+}
+
 /// Two cars driving side by side along x at 12 m/s, 3.5 m apart, ahead of a standing ego, seen
 /// by the front-left radar (id 3) every 50 ms: `points` detections per car per scan on its rear
 /// face and the near side, with ±0.1 m of noise, and one wheel return at twice the body's
@@ -52,15 +70,8 @@ fn cars(frames: usize, points: usize) -> Vec<Frame> {
                 let velocity = DVec2::new(12.0, 0.0);
                 let radial = |point: DVec2| velocity.dot((point - sensor_m).normalize());
                 let mut push = |point: DVec2, radial_velocity_mps: f64| {
-                    frame.measurements.push(Measurement {
-                        x_m: point.x + 0.2 * noise.next(),
-                        y_m: point.y + 0.2 * noise.next(),
-                        radial_velocity_mps,
-                        rcs_dbsm: 5.0,
-                        class: ObjectClass::Car,
-                        sensor_id: Some(3),
-                        ground_truth_id: Some(id),
-                    })
+                    let measured_m = DVec2::new(point.x + 0.2 * noise.next(), point.y + 0.2 * noise.next());
+                    frame.measurements.push(car_detection(measured_m, radial_velocity_mps, 5.0, Some(id)))
                 };
                 if points == 1 {
                     push(centre, radial(centre));
@@ -146,15 +157,8 @@ fn a_new_cars_group_starts_its_track_behind_its_mean_by_the_visible_arc_of_a_dis
     frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
     let points: Vec<DVec2> = [-0.9, -0.3, 0.3, 0.9].iter().map(|&y| DVec2::new(27.75, y)).collect();
     for point in &points {
-        frame.measurements.push(Measurement {
-            x_m: point.x,
-            y_m: point.y,
-            radial_velocity_mps: velocity.dot((*point - sensor_m).normalize()),
-            rcs_dbsm: 5.0,
-            class: ObjectClass::Car,
-            sensor_id: Some(3),
-            ground_truth_id: Some(1),
-        });
+        let radial_velocity_mps = velocity.dot((*point - sensor_m).normalize());
+        frame.measurements.push(car_detection(*point, radial_velocity_mps, 5.0, Some(1)));
     }
     let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();
     let outputs = tracker.step(&frame).unwrap();
@@ -177,15 +181,8 @@ fn grouped_with_one_more(ahead_m: f64, sign: f64, owner_margin_m: f64) -> u64 {
     let mut frames = cars(100, 5);
     for (k, frame) in frames.iter_mut().enumerate().skip(40) {
         let point = DVec2::new(20.0 + 12.0 * 0.05 * k as f64 + 2.25 + ahead_m, 2.0);
-        frame.measurements.push(Measurement {
-            x_m: point.x,
-            y_m: point.y,
-            radial_velocity_mps: sign * DVec2::new(12.0, 0.0).dot((point - sensor_m).normalize()),
-            rcs_dbsm: 5.0,
-            class: ObjectClass::Car,
-            sensor_id: Some(3),
-            ground_truth_id: None,
-        });
+        let radial_velocity_mps = sign * DVec2::new(12.0, 0.0).dot((point - sensor_m).normalize());
+        frame.measurements.push(car_detection(point, radial_velocity_mps, 5.0, None));
     }
     let mut config = config(DetectionModel::Points);
     config.frame.grouping.owner_margin_m = owner_margin_m;
@@ -440,15 +437,14 @@ fn side_on(frames: usize, vehicles: &[(f64, f64)], speed_mps: f64) -> Vec<Frame>
                     *point = centre + DVec2::new(along_m, -0.9);
                 }
                 for point in points {
-                    frame.measurements.push(Measurement {
-                        x_m: point.x + 0.2 * noise.next(),
-                        y_m: point.y + 0.2 * noise.next(),
-                        radial_velocity_mps: velocity.dot((point - sensor_m).normalize()),
-                        rcs_dbsm: 10.0,
-                        class: ObjectClass::Car,
-                        sensor_id: Some(3),
-                        ground_truth_id: Some(id as u64 + 1),
-                    });
+                    let measured_m = DVec2::new(point.x + 0.2 * noise.next(), point.y + 0.2 * noise.next());
+                    let radial_velocity_mps = velocity.dot((point - sensor_m).normalize());
+                    frame.measurements.push(car_detection(
+                        measured_m,
+                        radial_velocity_mps,
+                        10.0,
+                        Some(id as u64 + 1),
+                    ));
                 }
             }
             frame

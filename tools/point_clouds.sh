@@ -31,24 +31,24 @@ for preset in point_cloud point_cloud_range; do
     [ "$preset" = point_cloud ] || data="$out/data_$preset"
     [ -d "$data/validation" ] || "$primm" generate --output "$data" --split validation --preset "$preset" --sequences 16 > /dev/null
     [ -d "$data/evaluation" ] || "$primm" generate --output "$data" --split evaluation --preset "$preset" > /dev/null
-for split in validation evaluation; do
-    for setting in shipped points objects; do
-        case $setting in
-            shipped) config=config/primm.toml ;;
-            points) config=config/sensors/point_cloud.toml ;;
-            objects) config="$out/objects.toml" ;;
-        esac
-        json="$out/$preset-$split-$setting.json"
-        "$primm" eval --data "$data/$split" --methods imm --config "$config" --json "$json" > /dev/null
-        python3 - "$json" "$preset" "$split" "$setting" >> "$csv" <<'PY'
+    for split in validation evaluation; do
+        for setting in shipped points objects; do
+            case $setting in
+                shipped) config=config/primm.toml ;;
+                points) config=config/sensors/point_cloud.toml ;;
+                objects) config="$out/objects.toml" ;;
+            esac
+            json="$out/$preset-$split-$setting.json"
+            "$primm" eval --data "$data/$split" --methods imm --config "$config" --json "$json" > /dev/null
+            python3 - "$json" "$preset" "$split" "$setting" >> "$csv" <<'PY'
 import json, sys
 imm = json.load(open(sys.argv[1]))["methods"]["imm"]
 c = imm["confirmed_tracks"]
 car = imm["scenarios"]["class_car"]["rmse_xy"]
 print(f"{sys.argv[2]},{sys.argv[3]},{sys.argv[4]},{c['idf1']:.4f},{c['tracks_per_object_frame']:.3f},{car:.3f},{imm['rmse_xy']:.3f},{c['ghost_born_share']:.3f},{c['idsw']}")
 PY
+        done
     done
-done
 done
 column -s, -t < "$csv"
 if [ "$results" = "--results" ]; then
