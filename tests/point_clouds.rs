@@ -408,6 +408,10 @@ fn bad_point_cloud_keys_are_refused_by_name() {
         "frame.grouping.points_fallback_share"
     );
     assert_eq!(refused(|c| c.frame.grouping.points_prior_scans = 0.0), "frame.grouping");
+    assert_eq!(
+        refused(|c| c.frame.grouping.points_evidence_margin_m = -0.5),
+        "frame.grouping.points_evidence_margin_m"
+    );
     assert_eq!(refused(|c| c.frame.grouping.points_pool_scans = -1.0), "frame.grouping.points_pool_scans");
     assert_eq!(
         refused(|c| c.frame.grouping.pedestrian_link_scale = 0.0),
@@ -462,4 +466,41 @@ fn a_lorry_tracked_at_both_ends_as_objects_keeps_one_track_once_its_radar_groups
     let (auto, tracker) = confirmed_per_frame(config(DetectionModel::Auto), &lorry);
     assert!(tracker.sensors().of(Some(3)).groups_detections());
     assert!((auto - 1.0).abs() < 0.05, "{auto} confirmed tracks per frame");
+}
+
+/// Six cars queued nose to tail, 0.7 m between bumpers, driving along −x at 4 m/s in the near
+/// lane of [`cars`] towards and past the front-left radar, which reports each as an object at
+/// the point of its outline nearest to the radar (with ±0.1 m of noise).
+fn queue_passing(frames: usize) -> Vec<Frame> {
+    let mut noise = Noise(17);
+    let sensor_m = DVec2::new(3.86, 0.70);
+    let velocity = DVec2::new(-4.0, 0.0);
+    (0..frames)
+        .map(|k| {
+            let t = 0.05 * k as f64;
+            let mut frame = Frame::new(t);
+            frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
+            for id in 0..6u64 {
+                let centre = DVec2::new(22.0 + 5.2 * id as f64 - 4.0 * t, 2.0);
+                let nearest =
+                    centre + (sensor_m - centre).clamp(DVec2::new(-2.25, -0.9), DVec2::new(2.25, 0.9));
+                let measured_m = DVec2::new(nearest.x + 0.2 * noise.next(), nearest.y + 0.2 * noise.next());
+                let radial_velocity_mps = velocity.dot((nearest - sensor_m).normalize());
+                frame.measurements.push(car_detection(measured_m, radial_velocity_mps, 10.0, Some(id + 1)));
+            }
+            frame
+        })
+        .collect()
+}
+
+#[test]
+fn a_queue_of_cars_an_object_list_reports_nose_to_tail_keeps_an_auto_radar_with_objects() {
+    // As the queue passes the radar, a car's rear corner lies within the evidence margin of the
+    // box of the car behind it, whose front corner the radar reports.
+    let frames = queue_passing(300);
+    let (_, tracker) = confirmed_per_frame(config(DetectionModel::Auto), &frames);
+    let sensor = tracker.sensors().of(Some(3));
+    assert!(sensor.points.samples > 300, "{:?}", sensor.points);
+    assert!(!sensor.groups_detections(), "{:?}", sensor.points);
+    assert!(sensor.points.share() < 0.15, "{:?}", sensor.points);
 }

@@ -82,8 +82,14 @@ pub struct GroupingConfig {
     /// cloud grouped while its vehicles are far or hidden (one detection each), but an object
     /// radar that turned to points by chance then stays grouped.
     pub points_fallback_share: f64,
-    /// Weight of the prior share 0 (objects), in track scans (absent: 1).
+    /// Weight of the prior share 0 (objects), in track scans (absent: 3).
     pub points_prior_scans: f64,
+    /// With `detections = "auto"`: how far beyond a confirmed vehicle track's box (the class's
+    /// extent at the track's prior) a detection still counts towards the radar's share of
+    /// multiples, m, in [0, 20] (absent: 1.0). While a point cloud is still tracked one
+    /// detection at a time its tracks stand off their objects' centres, and a box not grown
+    /// holds few of the object's points.
+    pub points_evidence_margin_m: f64,
     /// Memory of the share, in track scans (absent: 2000).
     pub points_window_scans: f64,
     /// Weight of the pooled share of every `auto` radar in one radar's decision, in track scans
@@ -107,7 +113,8 @@ impl Default for GroupingConfig {
             owner_margin_m: 3.0,
             points_share_threshold: 0.3,
             points_fallback_share: 0.2,
-            points_prior_scans: 1.0,
+            points_prior_scans: 3.0,
+            points_evidence_margin_m: 1.0,
             points_window_scans: 2000.0,
             points_pool_scans: 20.0,
             detection_probability_factor: 2.5,
@@ -152,6 +159,9 @@ impl GroupingConfig {
         }
         if !(self.detection_probability_factor > 0.0 && self.detection_probability_factor <= 1e3) {
             return Some(("frame.grouping.detection_probability_factor", "must lie in (0, 1000]"));
+        }
+        if !within(self.points_evidence_margin_m, 0.0, 20.0) {
+            return Some(("frame.grouping.points_evidence_margin_m", "must lie in [0, 20] m"));
         }
         if !within(self.points_pool_scans, 0.0, 1e9) {
             return Some(("frame.grouping.points_pool_scans", "must lie in [0, 1e9]"));

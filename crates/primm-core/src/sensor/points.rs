@@ -142,12 +142,13 @@ mod tests {
     }
 
     #[test]
-    fn with_the_default_prior_of_one_track_scan_the_first_multiple_decides() {
+    fn with_the_default_prior_of_three_track_scans_the_second_multiple_decides() {
         let config = GroupingConfig::default();
         let mut estimate = PointsEstimate::new();
-        observe_alone(&mut estimate, &config, 1);
+        observe_alone(&mut estimate, &config, 2);
+        // (0 + 1) / (3 + 1) = 0.25 stays below 0.3.
         assert!(!estimate.points, "{}", estimate.share());
-        // (0 + 0 + 1) / (1 + 2) = 0.33 passes 0.3.
+        // (0 + 1 + 1) / (3 + 2) = 0.4 passes it.
         observe_alone(&mut estimate, &config, 2);
         assert!(estimate.points, "{}", estimate.share());
     }
@@ -185,10 +186,14 @@ mod tests {
 
     #[test]
     fn an_object_list_whose_first_track_scan_is_a_multiple_stays_grouped_above_a_low_fallback() {
-        // The light prior turns a radar on its first multiple; with a fallback share of 0.05 a
-        // share of 0.2 then keeps it grouped (the price of keeping point clouds grouped while
-        // their vehicles are far), where the default 0.2 lets it fall back.
-        let config = GroupingConfig { points_fallback_share: 0.05, ..GroupingConfig::default() };
+        // A prior of one track scan turns a radar on its first multiple; with a fallback share of
+        // 0.05 a share of 0.2 then keeps it grouped (the price of keeping point clouds grouped
+        // while their vehicles are far), where the default 0.2 lets it fall back.
+        let config = GroupingConfig {
+            points_fallback_share: 0.05,
+            points_prior_scans: 1.0,
+            ..GroupingConfig::default()
+        };
         let mut estimate = PointsEstimate::new();
         for scan in 0..5000 {
             observe_alone(&mut estimate, &config, if scan % 5 == 0 { 2 } else { 1 });
@@ -209,8 +214,8 @@ mod tests {
         // No scans of its own: the pool's share 0.5 decides.
         sideways.decide(&config, Some(0.5));
         assert!(sideways.points);
-        // Its own scans, all single detections, then outweigh the pool: (0 + 20·0.5) / (1 + n + 20)
-        // falls below the fallback share 0.2 once n passes 29.
+        // Its own scans, all single detections, then outweigh the pool: (0 + 20·0.5) / (3 + n + 20)
+        // falls below the fallback share 0.2 once n passes 27.
         let mut scans = 0;
         while sideways.points {
             sideways.observe(&config, 1);
@@ -218,7 +223,7 @@ mod tests {
             scans += 1;
             assert!(scans < 100);
         }
-        assert_eq!(scans, 30);
+        assert_eq!(scans, 28);
         // With an object-list pool nothing turns.
         let mut alone = PointsEstimate::new();
         alone.decide(&config, Some(0.05));

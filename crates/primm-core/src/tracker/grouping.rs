@@ -250,10 +250,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// Each confirmed track's count of the frame's detections of an `auto` radar on its object
-    /// and moving as it (every detection inside its box, not grown, whose radial velocity is the track's along the detection's line of sight within
-    /// `link_radial_velocity_gap_mps`, so that clutter and crossing objects in the box do not
-    /// count; whichever track owns it: a radar's point cloud tracked one detection at a time gives an object
-    /// several tracks, each holding the object's detections) into that radar's
+    /// and moving as it (every detection inside its box grown by `points_evidence_margin_m` and
+    /// inside no other object's box, whose radial velocity is the track's along the detection's
+    /// line of sight within `link_radial_velocity_gap_mps`, so that clutter and crossing objects
+    /// in the box do not count; whichever track owns it: a radar's point cloud tracked one
+    /// detection at a time gives an object several tracks, each holding the object's detections)
+    /// into that radar's
     /// [`PointsEstimate`](crate::sensor::points::PointsEstimate), one radar at a time.
     fn learn_points(&mut self) {
         let config = self.config.frame.grouping;
@@ -280,8 +282,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 let position_m = detection.measurement.position();
                 let line_of_sight = (position_m - detection.sensor_position_m).normalize_or_zero();
                 for row in self.confirmed.near(position_m) {
-                    // On the box itself: a point cloud lies on it, a neighbour's detection rarely.
-                    if self.holds(row, position_m, 0.0).is_none() {
+                    // On the box grown by the evidence margin, and not on another object's box:
+                    // a point cloud lies on its object, a neighbour's detection on the neighbour.
+                    if self.holds(row, position_m, config.points_evidence_margin_m).is_none()
+                        || self.held_by_another_object(row, position_m)
+                    {
                         continue;
                     }
                     // Moving as the object: clutter and crossing objects in the box do not.
@@ -304,6 +309,18 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         self.sensors.decide_points(&config);
+    }
+
+    /// Whether a confirmed track other than the one in `row`, and not following its object
+    /// (neither is the other's duplicate), holds `position_m` inside its box (not grown): the
+    /// detection is then a neighbour's, a car queued behind or parked beside, and says nothing of
+    /// how many detections the radar gives one object.
+    fn held_by_another_object(&self, row: usize, position_m: glam::DVec2) -> bool {
+        self.confirmed.near(position_m).any(|other| {
+            other != row
+                && self.holds(other, position_m, 0.0).is_some()
+                && !(self.duplicates(row, other) || self.duplicates(other, row))
+        })
     }
 
     /// Forms the groups and makes them the validated frame's measurements.
