@@ -13,8 +13,8 @@
 //! Where on the contour a detection falls is random, so the mean of `n` detections scatters
 //! about that centroid with the contour's own covariance over `n`: each visible face spreads
 //! its points uniformly along its length (`ℓ²/12` along it), and the faces' middles spread
-//! about the centroid by their weights. That covariance, over the group's count, is added to
-//! the radar's noise of the group's measurement (`crate::tracker`'s grouping).
+//! about the centroid by their weights. Each detection's own radar noise averages down the
+//! same way, so the group's measurement carries both over `n` ([`group_noise_m2`]).
 
 use crate::extent::ExtentConfig;
 use glam::{DMat2, DVec2};
@@ -91,6 +91,14 @@ pub fn visible_contour(
         let half_m2 = 0.5 * radius_m * radius_m;
         VisibleContour { offset_m: DVec2::ZERO, covariance_m2: DMat2::from_diagonal(DVec2::splat(half_m2)) }
     }
+}
+
+/// The noise of a group's mean of `count` detections moved to the centre: each detection
+/// carries the radar's noise `radar_noise_m2` and falls on the contour with the contour's
+/// covariance of one point `contour_m2`, independently, so the mean carries
+/// `(R + Σ_c) / count`, m².
+pub fn group_noise_m2(radar_noise_m2: DMat2, contour_m2: DMat2, count: usize) -> DMat2 {
+    (radar_noise_m2 + contour_m2) * (1.0 / count.max(1) as f64)
 }
 
 /// `v vᵀ`.
@@ -189,5 +197,58 @@ mod tests {
         let along = radius * radius * (2.0 / 3.0 - QUARTER_PI * QUARTER_PI);
         assert!((covariance.y_axis.y - along).abs() < 1e-12 && covariance.x_axis.y.abs() < 1e-12);
         assert!(covariance.y_axis.y < 0.2 * covariance.x_axis.x);
+    }
+
+    #[test]
+    fn the_mean_of_a_groups_detections_scatters_about_the_centre_as_its_noise_says() {
+        // Groups of 4 detections on a car seen from its corner: each falls on a visible face
+        // (by the faces' weights, uniformly along it) and carries the radar's noise. The
+        // moved means' covariance about the centre is the contour's and the radar's over 4.
+        let extent = car();
+        let centre = DVec2::new(30.0, 30.0);
+        let contour = visible_contour(&extent, centre, DVec2::new(10.0, 0.0), DVec2::ZERO);
+        let radar_noise = DMat2::from_diagonal(DVec2::new(0.09, 0.25));
+        let faces = [(DVec2::new(-1.0, 0.0), 2.25, 1.8), (DVec2::new(0.0, -1.0), 0.9, 4.5)];
+        let weights: Vec<f64> = faces
+            .iter()
+            .map(|&(normal, half_depth, length)| {
+                let towards = -centre - normal * half_depth;
+                length * normal.dot(towards) / towards.length()
+            })
+            .collect();
+        let mut state = 7u64;
+        let mut uniform = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let (count, trials) = (4usize, 40_000usize);
+        let mut second = DMat2::ZERO;
+        for _ in 0..trials {
+            let mut sum = DVec2::ZERO;
+            for _ in 0..count {
+                let (normal, half_depth, length) =
+                    if uniform() * (weights[0] + weights[1]) < weights[0] { faces[0] } else { faces[1] };
+                let point = normal * half_depth + normal.perp() * (length * (uniform() - 0.5));
+                // Box–Muller for the radar's noise, axis by axis.
+                let (u1, u2) = (uniform(), uniform());
+                let radius = (-2.0 * u1.ln()).sqrt();
+                let angle = 2.0 * core::f64::consts::PI * u2;
+                let noise = DVec2::new(0.3 * radius * angle.cos(), 0.5 * radius * angle.sin());
+                sum += point + noise;
+            }
+            let error = sum / count as f64 - contour.offset_m;
+            second += outer(error);
+        }
+        let measured = second / trials as f64;
+        let expected = group_noise_m2(radar_noise, contour.covariance_m2, count);
+        for (got, want) in measured.to_cols_array().iter().zip(expected.to_cols_array()) {
+            assert!(
+                (got - want).abs() < 0.05 * expected.x_axis.x.max(expected.y_axis.y),
+                "{measured} {expected}"
+            );
+        }
+        // The radar's noise undivided would overstate it by far.
+        let undivided = radar_noise + contour.covariance_m2 * (1.0 / count as f64);
+        assert!(undivided.y_axis.y > 1.5 * measured.y_axis.y, "{undivided} {measured}");
     }
 }

@@ -181,11 +181,12 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let mut noise_m2 =
                 sensor.noise(self.step_pose).covariance_m2(measurement.position() - position_m);
             let extent = &self.config.classes.get(measurement.class).extent;
-            // A group moved to its object's centre is a measurement of the centre, scattered
-            // by where its detections fell on the contour.
+            // A group moved to its object's centre is a measurement of the centre: the mean of
+            // its detections, each with the radar's noise and scattered over the contour.
             let centre_spread_m2 = if self.grouped_frame { self.group_centre_spread[index] } else { None };
             if let Some(spread_m2) = centre_spread_m2 {
-                noise_m2 += spread_m2;
+                let count = self.frame_groups.members(index).len();
+                noise_m2 = crate::grouping::contour::group_noise_m2(noise_m2, spread_m2, count);
             }
             self.measurement_sensors[index] = MeasurementSensor {
                 position_m,

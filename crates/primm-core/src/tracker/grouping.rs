@@ -350,10 +350,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// from the mean of its detections to the centre of its object by the offset of the
     /// visible contour's centroid (`crate::grouping::contour`): of the owning confirmed track's
     /// box at its prior, or, for a group no track owns (a new object, no heading yet), of the
-    /// disc about the group's mean. Returns, when it did, the covariance of the moved mean
-    /// about the centre from where its detections fell on the contour (the contour's covariance
-    /// over the count); such a measurement is then a measurement of the centre (reflection
-    /// scale 0) with that covariance added to the radar's noise. A single detection keeps the
+    /// disc about the group's mean. Returns, when it did, the contour's covariance of one point
+    /// about its centroid; such a measurement is then a measurement of the centre (reflection
+    /// scale 0) whose noise is that covariance and the radar's, over the count
+    /// (`crate::grouping::contour::group_noise_m2`). A single detection keeps the
     /// radar's reflection model: moved to the contour's centroid, it lost accuracy on the
     /// `extended` validation split, whose radars briefly took points.
     fn move_to_centre(&self, group: usize, measurement: &mut Measurement) -> Option<DMat2> {
@@ -376,7 +376,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
         let contour = crate::grouping::contour::visible_contour(extent, centre_m, velocity_mps, sensor_m);
         measurement.x_m -= contour.offset_m.x;
         measurement.y_m -= contour.offset_m.y;
-        Some(contour.covariance_m2 * (1.0 / count as f64))
+        Some(contour.covariance_m2)
     }
 
     /// After a grouped frame: the measurement index of every row names its group's

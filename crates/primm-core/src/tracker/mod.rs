@@ -173,8 +173,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     grouped_frame: bool,
     /// The frame index of each group's representative detection (when `grouped_frame`).
     group_first_index: Box<[u16; MAX_MEASUREMENTS_PER_FRAME]>,
-    /// For each group moved to its object's centre (when `grouped_frame`), the covariance of
-    /// its measurement about the centre from the contour's spread, m²; `None` for the others.
+    /// For each group moved to its object's centre (when `grouped_frame`), the contour's
+    /// covariance of one point about its centroid, m² (`grouping::contour::group_noise_m2`);
+    /// `None` for the others.
     group_centre_spread: Box<[Option<glam::DMat2>; MAX_MEASUREMENTS_PER_FRAME]>,
     /// Per track: whether an older track of its class nearby took a detection on its object in
     /// the current grouped frame (`grouping`).
