@@ -1,7 +1,7 @@
 //! Multipath ghosts (`tracker/ghosts.rs`, ARCHITECTURE.md "Point clouds"): a measurement at the
-//! mirror image of a confirmed moving track in a wall along its heading, moving as that image,
-//! starts no track on a point-cloud radar; a real object at the same place that moves otherwise
-//! is tracked, and an object radar's frames are not checked. A tentative track that a weaker
+//! mirror image of a confirmed moving track in a wall along its heading, moving as that image
+//! and weaker, starts no track on a point-cloud radar; a real object at the same place that
+//! moves otherwise, or is as strong, is tracked, and an object radar's frames are not checked. A tentative track that a weaker
 //! echo at the mirror image in a wall at any angle started ends (also when its first update
 //! would confirm it, as a pedestrian's does), a standing car's image too; one
 //! as strong as the object, moving otherwise, or of another class behind a standing object, is
@@ -78,14 +78,26 @@ fn confirmed(frames: &[Frame]) -> (usize, Tracker) {
 #[test]
 fn the_image_of_a_car_in_a_wall_along_the_road_starts_no_track() {
     // A wall at y = 10 m: the image at y = 18 m moves with the mirrored velocity (the same, the
-    // wall being parallel to it).
+    // wall being parallel to it), 8 dB weaker than the car.
     let mirror = |_, centre: DVec2, velocity: DVec2| {
-        (DVec2::new(centre.x, 20.0 - centre.y), DVec2::new(velocity.x, -velocity.y))
+        (DVec2::new(centre.x, 20.0 - centre.y), DVec2::new(velocity.x, -velocity.y), -3.0)
     };
-    let (count, tracker) = confirmed(&frames(mirror));
+    let (count, tracker) = confirmed(&car_and_second(12.0, 40, ObjectClass::Car, mirror));
     assert_eq!(count, 1);
     let stats = tracker.stats();
     assert!(stats.initiations_refused_as_ghost > 50, "{stats:?}");
+}
+
+#[test]
+fn a_car_as_strong_as_another_where_its_image_would_be_is_tracked() {
+    // The same place and velocity as the image above, but as strong as the car: a second car
+    // in a lane beyond it.
+    let beside = |_, centre: DVec2, velocity: DVec2| {
+        (DVec2::new(centre.x, 20.0 - centre.y), DVec2::new(velocity.x, -velocity.y))
+    };
+    let (count, tracker) = confirmed(&frames(beside));
+    assert_eq!(count, 2);
+    assert_eq!(tracker.stats().initiations_refused_as_ghost, 0);
 }
 
 #[test]

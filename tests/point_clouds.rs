@@ -504,3 +504,30 @@ fn a_queue_of_cars_an_object_list_reports_nose_to_tail_keeps_an_auto_radar_with_
     assert!(!sensor.groups_detections(), "{:?}", sensor.points);
     assert!(sensor.points.share() < 0.15, "{:?}", sensor.points);
 }
+
+#[test]
+fn a_car_that_appears_in_the_next_lane_beyond_a_tracked_car_moving_alike_starts_its_track() {
+    // The second car, in a lane 5.5 m beyond the first (beyond its owner margin) and 1.5 m
+    // ahead, appears after 1 s where an image of the first in a wall between the lanes would
+    // stand, moving as such an image would; it is as strong as the first, so it is no image.
+    let sensor_m = DVec2::new(3.86, 0.70);
+    let mut frames = cars(300, 5);
+    for (k, frame) in frames.iter_mut().enumerate() {
+        frame.measurements.retain(|measurement| k >= 20 || measurement.ground_truth_id != Some(2));
+        for measurement in frame.measurements.iter_mut().filter(|m| m.ground_truth_id == Some(2)) {
+            measurement.x_m += 1.5;
+            measurement.y_m += 2.0;
+            let line_of_sight = (measurement.position() - sensor_m).normalize();
+            measurement.radial_velocity_mps = 12.0 * line_of_sight.x;
+        }
+    }
+    let mut tracker = Tracker::new(config(DetectionModel::Points)).unwrap();
+    let mut last = Vec::new();
+    for frame in &frames {
+        last = tracker.step(frame).unwrap().to_vec();
+    }
+    assert_eq!(tracker.stats().initiations_refused_as_ghost, 0);
+    let confirmed: Vec<_> = last.iter().filter(|output| output.status.is_confirmed()).collect();
+    assert_eq!(confirmed.len(), 2, "{confirmed:?}");
+    assert!(confirmed.iter().any(|output| output.ground_truth_id == Some(2)), "{confirmed:?}");
+}
