@@ -282,17 +282,15 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 let position_m = detection.measurement.position();
                 let line_of_sight = (position_m - detection.sensor_position_m).normalize_or_zero();
                 for row in self.confirmed.near(position_m) {
-                    // On the box grown by the evidence margin, and not on another object's box:
-                    // a point cloud lies on its object, a neighbour's detection on the neighbour.
-                    if self.holds(row, position_m, config.points_evidence_margin_m).is_none()
-                        || self.held_by_another_object(row, position_m)
-                    {
-                        continue;
-                    }
-                    // Moving as the object: clutter and crossing objects in the box do not.
+                    // On the box grown by the evidence margin (a point cloud lies on its object),
+                    // moving as the object (clutter and crossing objects in the box do not), and
+                    // not on another object's box (a neighbour's detection lies on the
+                    // neighbour); the costliest test last.
                     let expected_mps = self.radial_velocity_mps(row, line_of_sight);
-                    if (detection.measurement.radial_velocity_mps - expected_mps).abs()
-                        <= config.link_radial_velocity_gap_mps
+                    if self.holds(row, position_m, config.points_evidence_margin_m).is_some()
+                        && (detection.measurement.radial_velocity_mps - expected_mps).abs()
+                            <= config.link_radial_velocity_gap_mps
+                        && !self.held_by_another_object(row, position_m)
                     {
                         self.owned_counts[row] += 1;
                     }
