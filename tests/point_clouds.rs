@@ -359,10 +359,11 @@ fn late_point_cloud_frames_give_the_tracks_and_the_estimates_of_in_order_arrival
 
 #[test]
 fn the_tracks_started_on_one_car_before_an_auto_radar_turned_to_points_end_but_one_per_car() {
-    // Objects first: every detection of the two cars starts a track, several are confirmed per
-    // car; once the radar turns to points the younger ones are shadowed and end.
+    // Objects first (the first scans' clusters not heeded): every detection of the two cars
+    // starts a track, several are confirmed per car; once the radar turns to points the younger
+    // ones are shadowed and end.
     let frames = cars(300, 5);
-    let mut tracker = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    let mut tracker = Tracker::new(without_scan_evidence(config(DetectionModel::Auto))).unwrap();
     let mut most_confirmed = 0;
     for frame in &frames {
         let confirmed = tracker.step(frame).unwrap().iter().filter(|o| o.status.is_confirmed()).count();
@@ -372,6 +373,69 @@ fn the_tracks_started_on_one_car_before_an_auto_radar_turned_to_points_end_but_o
     let survivors: Vec<_> = tracker.tracks().iter().filter(|t| t.status.is_confirmed()).collect();
     assert_eq!(survivors.len(), 2, "{survivors:?}");
     assert!(tracker.sensors().of(Some(3)).groups_detections());
+}
+
+/// `config` with an `auto` radar's first scans not heeded: it starts as objects whatever they
+/// show.
+fn without_scan_evidence(mut config: Config) -> Config {
+    config.frame.grouping.points_scan_share = 1.0;
+    config
+}
+
+#[test]
+fn an_auto_radar_whose_first_scans_show_point_clouds_groups_them_from_the_start() {
+    // The cars' four face detections link into clusters of four in the first scan.
+    let frames = cars(300, 5);
+    let most_confirmed = |config: Config| {
+        let mut tracker = Tracker::new(config).unwrap();
+        frames
+            .iter()
+            .map(|frame| tracker.step(frame).unwrap().iter().filter(|o| o.status.is_confirmed()).count())
+            .max()
+    };
+    let (auto, points, objects_first) = (
+        most_confirmed(config(DetectionModel::Auto)),
+        most_confirmed(config(DetectionModel::Points)),
+        most_confirmed(without_scan_evidence(config(DetectionModel::Auto))),
+    );
+    assert!(auto <= points && auto < objects_first, "{auto:?} {points:?} {objects_first:?}");
+    let mut tracker = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    for (k, frame) in frames.iter().enumerate() {
+        tracker.step(frame).unwrap();
+        if k == 0 {
+            let sensor = tracker.sensors().of(Some(3));
+            assert!(sensor.groups_detections(), "{:?}", sensor.points);
+            // Ten vehicle detections, the wheel returns (twice the body's radial velocity) apart.
+            assert_eq!(sensor.points.scan_detections, 10);
+            assert!(sensor.points.scan_clustered >= 6, "{:?}", sensor.points);
+        }
+    }
+    let sensor = tracker.sensors().of(Some(3));
+    assert!(sensor.groups_detections() && sensor.points.samples > 100, "{:?}", sensor.points);
+    assert_eq!(sensor.points.switches, 1, "{:?}", sensor.points);
+}
+
+#[test]
+fn an_auto_radar_whose_first_scans_give_objects_one_or_two_detections_starts_with_objects() {
+    // Two cars side by side, one detection each, and a second detection on the first car now
+    // and then (a radar that reflects on the outline): pairs, no cluster of three.
+    let mut frames = cars(300, 1);
+    for (k, frame) in frames.iter_mut().enumerate().filter(|(k, _)| k % 3 == 0) {
+        let mut second = frame.measurements[0];
+        second.x_m -= 1.5;
+        second.y_m += 0.2 * (k % 2) as f64;
+        frame.measurements.push(second);
+    }
+    let mut tracker = Tracker::new(config(DetectionModel::Auto)).unwrap();
+    for frame in &frames[..10] {
+        tracker.step(frame).unwrap();
+        let sensor = tracker.sensors().of(Some(3));
+        assert!(!sensor.groups_detections(), "{:?}", sensor.points);
+    }
+    let sensor = tracker.sensors().of(Some(3));
+    // Counted until the radar's first track scan.
+    assert_eq!(sensor.points.scan_clustered, 0, "{:?}", sensor.points);
+    assert!(sensor.points.scan_detections >= 4 && sensor.points.samples > 0, "{:?}", sensor.points);
 }
 
 #[test]
@@ -413,6 +477,11 @@ fn bad_point_cloud_keys_are_refused_by_name() {
         "frame.grouping.points_evidence_margin_m"
     );
     assert_eq!(refused(|c| c.frame.grouping.points_pool_scans = -1.0), "frame.grouping.points_pool_scans");
+    assert_eq!(refused(|c| c.frame.grouping.points_scan_share = 0.0), "frame.grouping.points_scan_share");
+    assert_eq!(
+        refused(|c| c.frame.grouping.points_scan_prior_detections = f64::NAN),
+        "frame.grouping.points_scan_prior_detections"
+    );
     assert_eq!(
         refused(|c| c.frame.grouping.pedestrian_link_scale = 0.0),
         "frame.grouping.pedestrian_link_scale"

@@ -25,7 +25,7 @@ text = text.replace("[[frame.sensors]]\n", '[[frame.sensors]]\ndetections = "obj
 open(sys.argv[1], "w").write(text)
 PY
 csv="$out/point_clouds.csv"
-echo "preset,split,sensors,idf1_confirmed,confirmed_tracks_per_object_frame,car_rmse_xy_m,rmse_xy_m,ghost_born_share,id_switches" > "$csv"
+echo "preset,split,sensors,idf1_confirmed,confirmed_tracks_per_object_frame,car_rmse_xy_m,car_rmse_xy_confirmed_m,rmse_xy_m,ghost_born_share,id_switches" > "$csv"
 for preset in point_cloud point_cloud_range; do
     data="$out/data"
     [ "$preset" = point_cloud ] || data="$out/data_$preset"
@@ -44,8 +44,8 @@ for preset in point_cloud point_cloud_range; do
 import json, sys
 imm = json.load(open(sys.argv[1]))["methods"]["imm"]
 c = imm["confirmed_tracks"]
-car = imm["scenarios"]["class_car"]["rmse_xy"]
-print(f"{sys.argv[2]},{sys.argv[3]},{sys.argv[4]},{c['idf1']:.4f},{c['tracks_per_object_frame']:.3f},{car:.3f},{imm['rmse_xy']:.3f},{c['ghost_born_share']:.3f},{c['idsw']}")
+car = imm["scenarios"]["class_car"]
+print(f"{sys.argv[2]},{sys.argv[3]},{sys.argv[4]},{c['idf1']:.4f},{c['tracks_per_object_frame']:.3f},{car['rmse_xy']:.3f},{car['confirmed_rmse_xy']:.3f},{imm['rmse_xy']:.3f},{c['ghost_born_share']:.3f},{c['idsw']}")
 PY
         done
     done

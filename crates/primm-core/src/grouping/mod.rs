@@ -90,6 +90,13 @@ pub struct GroupingConfig {
     /// detection at a time its tracks stand off their objects' centres, and a box not grown
     /// holds few of the object's points.
     pub points_evidence_margin_m: f64,
+    /// With `detections = "auto"`, before a radar's first track scan: the share of the `auto`
+    /// radars' vehicle detections in clusters of at least three linked ones above which a
+    /// radar starts as points, in (0, 1] (absent: 0.2; 1: never; `crate::sensor::points`).
+    pub points_scan_share: f64,
+    /// Weight of the share 0 (no clusters) in that share, in vehicle detections, ≥ 0
+    /// (absent: 20).
+    pub points_scan_prior_detections: f64,
     /// Memory of the share, in track scans (absent: 2000).
     pub points_window_scans: f64,
     /// Weight of the pooled share of every `auto` radar in one radar's decision, in track scans
@@ -115,6 +122,8 @@ impl Default for GroupingConfig {
             points_fallback_share: 0.2,
             points_prior_scans: 3.0,
             points_evidence_margin_m: 1.0,
+            points_scan_share: 0.2,
+            points_scan_prior_detections: 20.0,
             points_window_scans: 2000.0,
             points_pool_scans: 20.0,
             detection_probability_factor: 2.5,
@@ -162,6 +171,12 @@ impl GroupingConfig {
         }
         if !within(self.points_evidence_margin_m, 0.0, 20.0) {
             return Some(("frame.grouping.points_evidence_margin_m", "must lie in [0, 20] m"));
+        }
+        if !(self.points_scan_share > 0.0 && self.points_scan_share <= 1.0) {
+            return Some(("frame.grouping.points_scan_share", "must lie in (0, 1]"));
+        }
+        if !within(self.points_scan_prior_detections, 0.0, 1e9) {
+            return Some(("frame.grouping.points_scan_prior_detections", "must lie in [0, 1e9]"));
         }
         if !within(self.points_pool_scans, 0.0, 1e9) {
             return Some(("frame.grouping.points_pool_scans", "must lie in [0, 1e9]"));

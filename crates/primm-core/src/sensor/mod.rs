@@ -238,7 +238,10 @@ impl SensorSet {
     /// Decides for every radar with `detections = "auto"` whether it delivers points, from its
     /// own share and the share pooled over the radars with at least `points_pool_scans` track
     /// scans of their own ([`PointsEstimate::decide`]); before any has, each radar decides
-    /// alone. A radar's first few scans, whose share swings, never move the others.
+    /// alone. A radar's first few scans, whose share swings, never move the others. Before its
+    /// first track scan a radar's prior follows the clusters of the scans of every `auto`
+    /// radar before theirs ([`PointsEstimate::observe_scan`]; its own alone when
+    /// `points_pool_scans` is 0).
     pub fn decide_points(&mut self, config: &crate::grouping::GroupingConfig) {
         let slots = || (0..self.mounted).chain(core::iter::once(UNMOUNTED));
         let auto = |sensor: &Sensor| sensor.detections == DetectionModel::Auto;
@@ -251,9 +254,29 @@ impl SensorSet {
             }
         }
         let pooled_share = (scans > 0.0).then(|| multiples / scans);
+        // The scans before each radar's first track scan, pooled over the `auto` radars (each
+        // radar's own when they decide alone).
+        let (mut detections, mut clustered) = (0.0, 0.0);
+        for slot in slots() {
+            let sensor = &self.sensors[slot];
+            if auto(sensor) {
+                detections += f64::from(sensor.points.scan_detections);
+                clustered += f64::from(sensor.points.scan_clustered);
+            }
+        }
+        let alone = config.points_pool_scans == 0.0;
+        let scan_points = |(detections, clustered): (f64, f64)| {
+            clustered / (detections + config.points_scan_prior_detections) > config.points_scan_share
+        };
         for slot in slots() {
             let sensor = &mut self.sensors[slot];
             if auto(sensor) {
+                if sensor.points.samples == 0 {
+                    let own =
+                        (f64::from(sensor.points.scan_detections), f64::from(sensor.points.scan_clustered));
+                    sensor.points.scan_points =
+                        scan_points(if alone { own } else { (detections, clustered) });
+                }
                 sensor.points.decide(config, pooled_share);
             }
         }

@@ -16,8 +16,25 @@
 //! falls below `points_fallback_share`, so that a share near the threshold does not switch
 //! the front end from scan to scan. The share is counted in either state from the
 //! raw detections, so the decision does not feed back into its own evidence.
+//!
+//! Before its first track scan a radar has no confirmed track to count on, and tracking a point
+//! cloud one detection at a time in those scans starts several tracks per vehicle that outlive
+//! the decision. So until then its scans speak for themselves: the share of its vehicle
+//! detections that lie in a cluster of at least [`SCAN_CLUSTER_DETECTIONS`] vehicle
+//! detections linked by the grouping's link rule (`crate::grouping::linkage`), pooled over the
+//! `auto` radars with `points_scan_prior_detections` pseudo-detections outside any cluster. An
+//! object list puts one detection on each object, and objects are metres apart; a radar that
+//! reflects on the outline gives an object a second detection now and then; a point cloud gives
+//! a vehicle three or more detections in most scans. Past `points_scan_share` the radar starts
+//! as points, and its prior then weighs its `points_prior_scans` pseudo-scans at share 1 instead
+//! of 0.
 
 use crate::grouping::GroupingConfig;
+
+/// The fewest linked vehicle detections of one scan that count as one object's point cloud
+/// before a radar's first track scan: more than the pair an outline radar gives an object now
+/// and then.
+pub const SCAN_CLUSTER_DETECTIONS: usize = 3;
 
 /// A radar's running share of multiple detections per confirmed track and its decision.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,6 +49,13 @@ pub struct PointsEstimate {
     pub points: bool,
     /// Times the decision changed.
     pub switches: u64,
+    /// Vehicle detections of the radar's scans before its first track scan.
+    pub scan_detections: u32,
+    /// Those of them in a cluster of at least [`SCAN_CLUSTER_DETECTIONS`].
+    pub scan_clustered: u32,
+    /// Whether the scans before the first track scan (pooled over the `auto` radars) said
+    /// points: the prior's share is then 1.
+    pub scan_points: bool,
 }
 
 impl Default for PointsEstimate {
@@ -43,7 +67,16 @@ impl Default for PointsEstimate {
 impl PointsEstimate {
     /// The estimate at its prior: objects, share 0.
     pub const fn new() -> Self {
-        PointsEstimate { track_scans: 0.0, multiples: 0.0, samples: 0, points: false, switches: 0 }
+        PointsEstimate {
+            track_scans: 0.0,
+            multiples: 0.0,
+            samples: 0,
+            points: false,
+            switches: 0,
+            scan_detections: 0,
+            scan_clustered: 0,
+            scan_points: false,
+        }
     }
 
     /// The share of multiples, in [0, 1] (0 before the first track scan).
@@ -60,7 +93,7 @@ impl PointsEstimate {
     pub fn observe(&mut self, config: &GroupingConfig, detections: usize) {
         if self.samples == 0 {
             self.track_scans = config.points_prior_scans;
-            self.multiples = 0.0;
+            self.multiples = self.prior_multiples(config);
         }
         self.track_scans += 1.0;
         self.multiples += f64::from(u8::from(detections >= 2));
@@ -73,6 +106,27 @@ impl PointsEstimate {
         }
     }
 
+    /// The prior's multiples: its pseudo-scans at share 1 when the scans before the first track
+    /// scan said points, else 0.
+    fn prior_multiples(&self, config: &GroupingConfig) -> f64 {
+        if self.scan_points {
+            config.points_prior_scans
+        } else {
+            0.0
+        }
+    }
+
+    /// Takes one scan's vehicle detections before the first track scan: `detections` of them,
+    /// `clustered` in a cluster of at least [`SCAN_CLUSTER_DETECTIONS`]. Ignored once the radar
+    /// has track scans.
+    pub fn observe_scan(&mut self, detections: usize, clustered: usize) {
+        if self.samples == 0 {
+            let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+            self.scan_detections = self.scan_detections.saturating_add(count(detections));
+            self.scan_clustered = self.scan_clustered.saturating_add(count(clustered.min(detections)));
+        }
+    }
+
     /// The share the decision compares: the radar's own counts with the share pooled over the
     /// vehicle's `auto` radars that have evidence (`pooled_share`, when any have), weighing
     /// `points_pool_scans` track scans. A radar that sees few vehicles (one looking sideways)
@@ -82,9 +136,16 @@ impl PointsEstimate {
             Some(share) => (config.points_pool_scans, config.points_pool_scans * share),
             None => (0.0, 0.0),
         };
-        let scans = self.track_scans + pool_scans;
+        // Before the first track scan the prior alone speaks for the radar, and only when its
+        // scans said points (a prior at share 0 leaves the decision to the pool, as before).
+        let (own_scans, own_multiples) = match (self.samples, self.scan_points) {
+            (0, true) => (config.points_prior_scans, config.points_prior_scans),
+            (0, false) => (0.0, 0.0),
+            _ => (self.track_scans, self.multiples),
+        };
+        let scans = own_scans + pool_scans;
         if scans > 0.0 {
-            ((self.multiples + pool_multiples) / scans).clamp(0.0, 1.0)
+            ((own_multiples + pool_multiples) / scans).clamp(0.0, 1.0)
         } else {
             0.0
         }
@@ -205,6 +266,42 @@ mod tests {
             observe_alone(&mut estimate, &config, 1);
         }
         assert!(estimate.share() < config.points_fallback_share, "{}", estimate.share());
+    }
+
+    #[test]
+    fn a_radar_whose_first_scans_said_points_starts_grouped_and_its_prior_then_weighs_share_one() {
+        let config = GroupingConfig::default();
+        let mut estimate = PointsEstimate::new();
+        estimate.observe_scan(12, 9);
+        assert_eq!((estimate.scan_detections, estimate.scan_clustered), (12, 9));
+        estimate.scan_points = true;
+        estimate.decide(&config, None);
+        assert!(estimate.points);
+        // Its track scans then show single detections only: (3 + 0) / (3 + n) falls below the
+        // fallback share 0.2 once n passes 12.
+        let mut scans = 0;
+        while estimate.points {
+            observe_alone(&mut estimate, &config, 1);
+            scans += 1;
+            assert!(scans < 100);
+        }
+        assert_eq!(scans, 13);
+        // Scans after the first track scan are not counted.
+        estimate.observe_scan(50, 50);
+        assert_eq!((estimate.scan_detections, estimate.scan_clustered), (12, 9));
+    }
+
+    #[test]
+    fn a_radar_whose_first_scans_said_objects_decides_as_before() {
+        let config = GroupingConfig::default();
+        let (mut heeded, mut plain) = (PointsEstimate::new(), PointsEstimate::new());
+        heeded.observe_scan(40, 2);
+        for detections in [2, 1, 2, 2, 1] {
+            for estimate in [&mut heeded, &mut plain] {
+                observe_alone(estimate, &config, detections);
+            }
+            assert_eq!((heeded.points, heeded.share()), (plain.points, plain.share()));
+        }
     }
 
     #[test]

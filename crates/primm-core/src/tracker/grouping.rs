@@ -10,6 +10,11 @@ use crate::measurement::{FrameView, Measurement};
 use crate::predictor::DisplacementPredictor;
 use glam::DMat2;
 
+/// The most vehicle detections of one radar's scan that [`Tracker::scan_clusters`] links (the
+/// first in frame order): a point cloud's vehicles show within far fewer, and the pairwise
+/// links stay cheap.
+const SCAN_EVIDENCE_DETECTIONS: usize = 128;
+
 impl<P: DisplacementPredictor> Tracker<P> {
     /// Hands the frame's accepted detections of radars that deliver points (or may: `auto`)
     /// to the grouping with the confirmed track whose object holds each, counts what the
@@ -270,6 +275,10 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
         let tracks = self.table.len();
         for slot in slots {
+            if self.sensors.get(usize::from(slot)).points.samples == 0 {
+                let (detections, clustered) = self.scan_clusters(slot);
+                self.sensors.get_mut(usize::from(slot)).points.observe_scan(detections, clustered);
+            }
             self.owned_counts[..tracks].fill(0);
             for detection in self.frame_groups.detections() {
                 // A vehicle's points, by their labels (a tenth may be wrong): a pedestrian
@@ -307,6 +316,63 @@ impl<P: DisplacementPredictor> Tracker<P> {
             }
         }
         self.sensors.decide_points(&config);
+    }
+
+    /// The frame's vehicle-labelled detections of the radar in `slot` (the first
+    /// [`SCAN_EVIDENCE_DETECTIONS`] of them in frame order) and how many of those lie in a
+    /// cluster of at least [`SCAN_CLUSTER_DETECTIONS`](crate::sensor::points::SCAN_CLUSTER_DETECTIONS)
+    /// linked by the grouping's link rule: the scan's own evidence of a point cloud before the
+    /// radar's first track scan.
+    fn scan_clusters(&self, slot: u8) -> (usize, usize) {
+        use crate::grouping::linkage::{LinkPoint, NO_OWNER};
+        let rule = self.config.frame.grouping.link_rule();
+        let mut points = arrayvec::ArrayVec::<LinkPoint, SCAN_EVIDENCE_DETECTIONS>::new();
+        let vehicles = self.frame_groups.detections().filter(|detection| {
+            detection.sensor_slot == slot
+                && self.config.classes.get(detection.measurement.class).extent.enabled
+        });
+        for detection in vehicles.take(SCAN_EVIDENCE_DETECTIONS) {
+            let position_m = detection.measurement.position();
+            points.push(LinkPoint {
+                position_m,
+                range_m: position_m.distance(detection.sensor_position_m),
+                radial_velocity_mps: detection.measurement.radial_velocity_mps,
+                sensor_slot: slot,
+                owner: NO_OWNER,
+                pedestrian: false,
+            });
+        }
+        // Union-find over the pairs that link (at most 128 points: 8,128 pairs, once per scan
+        // of a radar that has no track scan yet).
+        let mut parent = [0u8; SCAN_EVIDENCE_DETECTIONS];
+        for (index, entry) in parent.iter_mut().enumerate().take(points.len()) {
+            *entry = index as u8;
+        }
+        fn root(parent: &mut [u8], mut index: usize) -> usize {
+            while usize::from(parent[index]) != index {
+                parent[index] = parent[usize::from(parent[index])];
+                index = usize::from(parent[index]);
+            }
+            index
+        }
+        for a in 0..points.len() {
+            for b in a + 1..points.len() {
+                if rule.links(&points[a], &points[b]) {
+                    let (root_a, root_b) = (root(&mut parent, a), root(&mut parent, b));
+                    parent[root_a.max(root_b)] = root_a.min(root_b) as u8;
+                }
+            }
+        }
+        let mut sizes = [0u8; SCAN_EVIDENCE_DETECTIONS];
+        for index in 0..points.len() {
+            sizes[root(&mut parent, index)] += 1;
+        }
+        let clustered = (0..points.len())
+            .filter(|&index| {
+                usize::from(sizes[root(&mut parent, index)]) >= crate::sensor::points::SCAN_CLUSTER_DETECTIONS
+            })
+            .count();
+        (points.len(), clustered)
     }
 
     /// Whether a confirmed track other than the one in `row`, and not following its object

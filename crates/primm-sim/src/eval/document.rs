@@ -134,13 +134,21 @@ pub struct MotionDocument {
     pub gt_object_frames: u64,
 }
 
-/// An RMSE in the plane and its sample count.
+/// An RMSE in the plane and its sample count, over every row and over the rows of confirmed
+/// tracks.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct RmseDocument {
     /// RMSE in the plane, m.
     pub rmse_xy: Option<f64>,
     /// Priors scored.
     pub rmse_samples: u64,
+    /// RMSE in the plane over the rows a confirmed track took, m (`None` on other entries than
+    /// classes, and where no confirmed track took a row).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub confirmed_rmse_xy: Option<f64>,
+    /// Priors scored in `confirmed_rmse_xy`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub confirmed_rmse_samples: Option<u64>,
 }
 
 /// Identity metrics of a subset of the rows (Table V).
@@ -383,7 +391,12 @@ impl From<&IdentityCounts> for IdentityDocument {
 
 impl From<&RmseAccumulator> for RmseDocument {
     fn from(acc: &RmseAccumulator) -> Self {
-        RmseDocument { rmse_xy: acc.rmse_xy(), rmse_samples: acc.count() }
+        RmseDocument {
+            rmse_xy: acc.rmse_xy(),
+            rmse_samples: acc.count(),
+            confirmed_rmse_xy: None,
+            confirmed_rmse_samples: None,
+        }
     }
 }
 
@@ -456,7 +469,15 @@ impl ScenarioDocuments {
         let classes = result
             .class_rmse
             .iter()
-            .map(|(class, acc)| (format!("class_{}", class.name()), RmseDocument::from(acc)))
+            .map(|(class, acc)| {
+                let confirmed = result.class_confirmed_rmse.get(class).copied().unwrap_or_default();
+                let document = RmseDocument {
+                    confirmed_rmse_xy: confirmed.rmse_xy(),
+                    confirmed_rmse_samples: Some(confirmed.count()),
+                    ..RmseDocument::from(acc)
+                };
+                (format!("class_{}", class.name()), document)
+            })
             .collect();
         let ego_motion = result
             .ego_identity

@@ -70,6 +70,10 @@ pub struct MethodResult {
     /// Prior RMSE per object class.
     #[serde(default)]
     pub class_rmse: BTreeMap<ObjectClass, RmseAccumulator>,
+    /// Prior RMSE per object class over the rows a confirmed track took
+    /// ([`AssociationRecord::is_confirmed_track_frame`]): the error of the tracks a user sees.
+    #[serde(default)]
+    pub class_confirmed_rmse: BTreeMap<ObjectClass, RmseAccumulator>,
     /// Posterior mode probabilities of the updates per object class (classes with updates only).
     #[serde(default)]
     pub class_modes: BTreeMap<ObjectClass, ModeProbabilityAccumulator>,
@@ -112,6 +116,7 @@ impl MethodResult {
             missed_detection: BTreeMap::new(),
             modes: ModeProbabilityAccumulator::new(),
             class_rmse: BTreeMap::new(),
+            class_confirmed_rmse: BTreeMap::new(),
             class_modes: BTreeMap::new(),
             ego_rmse: BTreeMap::new(),
             ego_identity: BTreeMap::new(),
@@ -146,6 +151,9 @@ impl MethodResult {
         self.modes.merge(&other.modes);
         for (class, acc) in &other.class_rmse {
             self.class_rmse.entry(*class).or_default().merge(acc);
+        }
+        for (class, acc) in &other.class_confirmed_rmse {
+            self.class_confirmed_rmse.entry(*class).or_default().merge(acc);
         }
         for (class, acc) in &other.class_modes {
             self.class_modes.entry(*class).or_default().merge(acc);
@@ -219,6 +227,9 @@ impl MethodEvaluator {
             }
             result.rmse.push_record(record);
             result.class_rmse.entry(class).or_default().push_record(record);
+            if record.is_confirmed_track_frame() {
+                result.class_confirmed_rmse.entry(class).or_default().push_record(record);
+            }
             if result.velocity.push_record(record) {
                 result.class_velocity.entry(class).or_default().push_record(record);
             }
@@ -436,6 +447,35 @@ mod tests {
         assert_eq!((result.identity.gt_object_frames, result.identity.idtp), (12, 12));
         // The straight motion is labelled from the tenth frame on, once per frame.
         assert_eq!(result.scenario_frames(MotionCategory::Straight), 3);
+    }
+
+    #[test]
+    fn a_class_error_over_confirmed_rows_leaves_out_the_tentative_tracks_priors() {
+        // Object 1's track is tentative for its first four frames, with priors 3 m off; later
+        // 0.5 m off. Object 2's rows are all confirmed, 0.5 m off.
+        let mut records = sequence(0.5);
+        for record in records.iter_mut().filter(|record| record.ground_truth_id == Some(1)) {
+            if record.frame < 4 {
+                record.track_confirmed = Some(false);
+                record.prior = record.prior.map(|_| record.true_position.unwrap() + DVec2::new(3.0, 0.0));
+            }
+        }
+        let mut evaluator = MethodEvaluator::new(Method::Imm);
+        evaluator.add_sequence(&records);
+        let result = evaluator.finish();
+        let all = result.class_rmse[&ObjectClass::Car];
+        let confirmed = result.class_confirmed_rmse[&ObjectClass::Car];
+        // All rows: 3 tentative priors (frames 1-3) 3 m off, 18 at 0.5 m.
+        assert_eq!((all.count(), confirmed.count()), (21, 18));
+        assert!((all.rmse_xy().unwrap() - ((3.0 * 9.0 + 18.0 * 0.25) / 21.0f64).sqrt()).abs() < 1e-12);
+        assert!((confirmed.rmse_xy().unwrap() - 0.5).abs() < 1e-12);
+        let document = crate::eval::document::MethodDocument::of(&result);
+        let car = &document.scenarios.classes["class_car"];
+        assert_eq!((car.confirmed_rmse_xy, car.confirmed_rmse_samples), (confirmed.rmse_xy(), Some(18)));
+        // Merging adds the confirmed rows as well.
+        let mut merged = result.clone();
+        merged.merge(&result);
+        assert_eq!(merged.class_confirmed_rmse[&ObjectClass::Car].count(), 36);
     }
 
     #[test]
