@@ -261,7 +261,9 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// in the box do not count; whichever track owns it: a radar's point cloud tracked one
     /// detection at a time gives an object several tracks, each holding the object's detections)
     /// into that radar's
-    /// [`PointsEstimate`](crate::sensor::points::PointsEstimate), one radar at a time.
+    /// [`PointsEstimate`](crate::sensor::points::PointsEstimate), one radar at a time; counted
+    /// up to two, as the estimate asks only for one or several. A radar without a track scan
+    /// yet also counts its scan's clusters ([`Self::scan_clusters`]).
     fn learn_points(&mut self) {
         let config = self.config.frame.grouping;
         let mut slots = arrayvec::ArrayVec::<u8, { crate::limits::MAX_SENSORS + 1 }>::new();
@@ -291,6 +293,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 let position_m = detection.measurement.position();
                 let line_of_sight = (position_m - detection.sensor_position_m).normalize_or_zero();
                 for row in self.confirmed.near(position_m) {
+                    // The estimate asks only whether a track scan holds one detection or
+                    // several, so a track that has two already needs no more.
+                    if self.owned_counts[row] >= 2 {
+                        continue;
+                    }
                     // On the box grown by the evidence margin (a point cloud lies on its object),
                     // moving as the object (clutter and crossing objects in the box do not), and
                     // not on another object's box (a neighbour's detection lies on the
