@@ -344,7 +344,11 @@ fn a_bad_measurement_is_rejected_alone_and_the_rest_of_the_frame_is_tracked() {
 #[test]
 fn a_full_table_refuses_new_tracks_and_keeps_the_old_ones() {
     use primm_core::track_table::MAX_TRACKS;
-    let mut tracker = Tracker::new(imm_config()).unwrap();
+    // An object list: 1 km out, the link distance of a point cloud's grouping (22 m there)
+    // would join the measurements below, 20 m apart, into groups.
+    let mut config = imm_config();
+    config.frame.unmounted_detections = primm_core::grouping::DetectionModel::Objects;
+    let mut tracker = Tracker::new(config).unwrap();
     // Frames of 256 far-apart measurements (half the table), shifted each frame so nothing
     // associates: the table fills up in two frames, then refuses.
     const PER_FRAME: usize = MAX_TRACKS / 2;

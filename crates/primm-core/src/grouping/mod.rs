@@ -92,7 +92,7 @@ pub struct GroupingConfig {
     pub points_evidence_margin_m: f64,
     /// With `detections = "auto"`, before a radar's first track scan: the share of the `auto`
     /// radars' vehicle detections in clusters of at least three linked ones above which a
-    /// radar starts as points, in (0, 1] (absent: 0.2; 1: never; `crate::sensor::points`).
+    /// radar starts as points, in (0, 1] (absent: 0.175; 1: never; `crate::sensor::points`).
     pub points_scan_share: f64,
     /// Weight of the share 0 (no clusters) in that share, in vehicle detections, ≥ 0
     /// (absent: 20).
@@ -122,7 +122,7 @@ impl Default for GroupingConfig {
             points_fallback_share: 0.2,
             points_prior_scans: 3.0,
             points_evidence_margin_m: 1.0,
-            points_scan_share: 0.2,
+            points_scan_share: 0.175,
             points_scan_prior_detections: 20.0,
             points_window_scans: 2000.0,
             points_pool_scans: 20.0,
