@@ -338,15 +338,17 @@ impl core::fmt::Display for SensorReport<'_> {
                     estimates.reflection.bounded + estimates.detection.bounded + estimates.clutter.bounded,
                 )?;
             }
-            if sensor.points.samples > 0 {
+            if sensor.points.samples > 0 || sensor.points.scan_detections > 0 {
                 start_line(f, sensor, &mut first)?;
                 write!(
                     f,
-                    " detections: {} ({}; several per track in {:.3} of {} vehicle track scans; decision changed {} times)",
+                    " detections: {} ({}; several per track in {:.3} of {} vehicle track scans; first scans: {} of {} vehicle detections in clusters; decision changed {} times)",
                     sensor.detections.name(),
                     if sensor.groups_detections() { "grouped as points" } else { "objects" },
                     sensor.points.share(),
                     sensor.points.samples,
+                    sensor.points.scan_clustered,
+                    sensor.points.scan_detections,
                     sensor.points.switches,
                 )?;
             }
