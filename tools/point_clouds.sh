@@ -2,10 +2,11 @@
 # Scores the IMM on the generator's point-cloud radars (ARCHITECTURE.md "Point clouds",
 # docs/EVALUATION.md "Point clouds") with three sensor settings: the shipped configuration
 # (detections = "auto"), config/sensors/point_cloud.toml (every radar "points") and every radar
-# "objects" (the tracker without its front end); on the validation split (16 sequences, where
-# the settings were chosen) and the evaluation split (22), of two presets: `point_cloud` and
-# `point_cloud_range` (the same scenes from radars that resolve range finer than azimuth, never
-# used for a choice). Writes OUT_DIR/point_clouds.csv and, with --results,
+# "objects" (the tracker without its front end); on the validation split (16 sequences, among
+# those the settings were chosen on) and the evaluation split (22), of two presets:
+# `point_cloud` and `point_cloud_range` (the same scenes from radars that resolve range finer
+# than azimuth). Car RMSE_xy over all rows and over confirmed tracks' rows. Writes
+# OUT_DIR/point_clouds.csv and, with --results,
 # docs/results/evaluation_point_cloud.csv.
 #   tools/point_clouds.sh [OUT_DIR] [--results]
 # PRIMM_BINARY names a binary to use instead of building one (the results file then names the
