@@ -193,6 +193,41 @@ impl FrameGroups {
         }
     }
 
+    /// Links the first `limit` detections that `keep` takes by `rule`, as their own groups
+    /// (owners left aside), and returns how many were taken and how many of those lie in a
+    /// group of at least `min_size`. Leaves the frame's groups to [`form`](Self::form).
+    pub fn clustered(
+        &mut self,
+        rule: &LinkRule,
+        keep: impl Fn(&Detection) -> bool,
+        limit: usize,
+        min_size: usize,
+    ) -> (usize, usize) {
+        let mut taken = 0;
+        for detection in self.detections[..self.count].iter().filter(|detection| keep(detection)).take(limit)
+        {
+            let position_m = detection.measurement.position();
+            self.points[taken] = LinkPoint {
+                position_m,
+                range_m: position_m.distance(detection.sensor_position_m),
+                radial_velocity_mps: detection.measurement.radial_velocity_mps,
+                sensor_slot: detection.sensor_slot,
+                owner: NO_OWNER,
+                pedestrian: false,
+            };
+            taken += 1;
+        }
+        let labels = self.linkage.cluster(&self.points[..taken], rule);
+        let sizes = &mut self.label_group[..labels];
+        sizes.fill(0);
+        for index in 0..taken {
+            sizes[self.linkage.label_of(index)] += 1;
+        }
+        let clustered =
+            (0..taken).filter(|&index| usize::from(sizes[self.linkage.label_of(index)]) >= min_size).count();
+        (taken, clustered)
+    }
+
     /// The number of groups of the latest [`form`](Self::form).
     pub fn groups(&self) -> usize {
         self.groups

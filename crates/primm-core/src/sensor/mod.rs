@@ -245,25 +245,20 @@ impl SensorSet {
     pub fn decide_points(&mut self, config: &crate::grouping::GroupingConfig) {
         let slots = || (0..self.mounted).chain(core::iter::once(UNMOUNTED));
         let auto = |sensor: &Sensor| sensor.detections == DetectionModel::Auto;
+        // The track scans of the radars with enough of their own, and the scans before each
+        // radar's first track scan, pooled over the `auto` radars (the latter each radar's own
+        // when they decide alone).
         let (mut multiples, mut scans) = (0.0, 0.0);
-        for slot in slots() {
-            let sensor = &self.sensors[slot];
-            if auto(sensor) && sensor.points.samples as f64 >= config.points_pool_scans {
+        let (mut detections, mut clustered) = (0.0, 0.0);
+        for sensor in slots().map(|slot| &self.sensors[slot]).filter(|sensor| auto(sensor)) {
+            if sensor.points.samples as f64 >= config.points_pool_scans {
                 multiples += sensor.points.multiples;
                 scans += sensor.points.track_scans;
             }
+            detections += f64::from(sensor.points.scan_detections);
+            clustered += f64::from(sensor.points.scan_clustered);
         }
         let pooled_share = (scans > 0.0).then(|| multiples / scans);
-        // The scans before each radar's first track scan, pooled over the `auto` radars (each
-        // radar's own when they decide alone).
-        let (mut detections, mut clustered) = (0.0, 0.0);
-        for slot in slots() {
-            let sensor = &self.sensors[slot];
-            if auto(sensor) {
-                detections += f64::from(sensor.points.scan_detections);
-                clustered += f64::from(sensor.points.scan_clustered);
-            }
-        }
         let alone = config.points_pool_scans == 0.0;
         let scan_points = |(detections, clustered): (f64, f64)| {
             clustered / (detections + config.points_scan_prior_detections) > config.points_scan_share

@@ -139,7 +139,7 @@ impl PointsEstimate {
         // Before the first track scan the prior alone speaks for the radar, and only when its
         // scans said points (a prior at share 0 leaves the decision to the pool, as before).
         let (own_scans, own_multiples) = match (self.samples, self.scan_points) {
-            (0, true) => (config.points_prior_scans, config.points_prior_scans),
+            (0, true) => (config.points_prior_scans, self.prior_multiples(config)),
             (0, false) => (0.0, 0.0),
             _ => (self.track_scans, self.multiples),
         };

@@ -11,8 +11,7 @@ use crate::predictor::DisplacementPredictor;
 use glam::DMat2;
 
 /// The most vehicle detections of one radar's scan that [`Tracker::scan_clusters`] links (the
-/// first in frame order): a point cloud's vehicles show within far fewer, and the pairwise
-/// links stay cheap.
+/// first in frame order): a point cloud's vehicles show within far fewer.
 const SCAN_EVIDENCE_DETECTIONS: usize = 128;
 
 impl<P: DisplacementPredictor> Tracker<P> {
@@ -330,56 +329,17 @@ impl<P: DisplacementPredictor> Tracker<P> {
     /// cluster of at least [`SCAN_CLUSTER_DETECTIONS`](crate::sensor::points::SCAN_CLUSTER_DETECTIONS)
     /// linked by the grouping's link rule: the scan's own evidence of a point cloud before the
     /// radar's first track scan.
-    fn scan_clusters(&self, slot: u8) -> (usize, usize) {
-        use crate::grouping::linkage::{LinkPoint, NO_OWNER};
+    fn scan_clusters(&mut self, slot: u8) -> (usize, usize) {
         let rule = self.config.frame.grouping.link_rule();
-        let mut points = arrayvec::ArrayVec::<LinkPoint, SCAN_EVIDENCE_DETECTIONS>::new();
-        let vehicles = self.frame_groups.detections().filter(|detection| {
-            detection.sensor_slot == slot
-                && self.config.classes.get(detection.measurement.class).extent.enabled
-        });
-        for detection in vehicles.take(SCAN_EVIDENCE_DETECTIONS) {
-            let position_m = detection.measurement.position();
-            points.push(LinkPoint {
-                position_m,
-                range_m: position_m.distance(detection.sensor_position_m),
-                radial_velocity_mps: detection.measurement.radial_velocity_mps,
-                sensor_slot: slot,
-                owner: NO_OWNER,
-                pedestrian: false,
-            });
-        }
-        // Union-find over the pairs that link (at most 128 points: 8,128 pairs, once per scan
-        // of a radar that has no track scan yet).
-        let mut parent = [0u8; SCAN_EVIDENCE_DETECTIONS];
-        for (index, entry) in parent.iter_mut().enumerate().take(points.len()) {
-            *entry = index as u8;
-        }
-        fn root(parent: &mut [u8], mut index: usize) -> usize {
-            while usize::from(parent[index]) != index {
-                parent[index] = parent[usize::from(parent[index])];
-                index = usize::from(parent[index]);
-            }
-            index
-        }
-        for a in 0..points.len() {
-            for b in a + 1..points.len() {
-                if rule.links(&points[a], &points[b]) {
-                    let (root_a, root_b) = (root(&mut parent, a), root(&mut parent, b));
-                    parent[root_a.max(root_b)] = root_a.min(root_b) as u8;
-                }
-            }
-        }
-        let mut sizes = [0u8; SCAN_EVIDENCE_DETECTIONS];
-        for index in 0..points.len() {
-            sizes[root(&mut parent, index)] += 1;
-        }
-        let clustered = (0..points.len())
-            .filter(|&index| {
-                usize::from(sizes[root(&mut parent, index)]) >= crate::sensor::points::SCAN_CLUSTER_DETECTIONS
-            })
-            .count();
-        (points.len(), clustered)
+        let classes = &self.config.classes;
+        self.frame_groups.clustered(
+            &rule,
+            |detection| {
+                detection.sensor_slot == slot && classes.get(detection.measurement.class).extent.enabled
+            },
+            SCAN_EVIDENCE_DETECTIONS,
+            crate::sensor::points::SCAN_CLUSTER_DETECTIONS,
+        )
     }
 
     /// Whether a confirmed track other than the one in `row`, and not following its object
