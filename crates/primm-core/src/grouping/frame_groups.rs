@@ -269,3 +269,53 @@ impl FrameGroups {
         summarise(&self.measurements[..self.count], &self.members[start..end], &mut self.scratch)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measurement::ObjectClass;
+
+    fn detection(x_m: f64, y_m: f64, sensor_slot: u8, class: ObjectClass) -> Detection {
+        Detection {
+            measurement: Measurement {
+                x_m,
+                y_m,
+                radial_velocity_mps: 1.0,
+                rcs_dbsm: 0.0,
+                class,
+                sensor_id: None,
+                ground_truth_id: None,
+            },
+            frame_index: 0,
+            sensor_slot,
+            sensor_position_m: DVec2::ZERO,
+            grouped: false,
+            owner: None,
+        }
+    }
+
+    #[test]
+    fn clustered_counts_the_kept_detections_in_groups_of_at_least_the_size_asked() {
+        let rule = LinkRule {
+            distance_m: 2.0,
+            distance_per_range: 0.0,
+            radial_velocity_gap_mps: 2.0,
+            pedestrian_distance_scale: 1.0,
+        };
+        let mut groups = FrameGroups::new();
+        // Radar 0: a chain of three 1.5 m apart, a pair, a single; radar 1 and a pedestrian
+        // beside the chain are not kept.
+        for (x_m, y_m) in [(10.0, 0.0), (11.5, 0.0), (13.0, 0.0), (30.0, 0.0), (31.0, 0.0), (50.0, 0.0)] {
+            groups.push(detection(x_m, y_m, 0, ObjectClass::Car));
+        }
+        groups.push(detection(12.0, 1.0, 1, ObjectClass::Car));
+        groups.push(detection(14.0, 0.0, 0, ObjectClass::Pedestrian));
+        let keep = |d: &Detection| d.sensor_slot == 0 && d.measurement.class == ObjectClass::Car;
+        assert_eq!(groups.clustered(&rule, keep, 128, 3), (6, 3));
+        assert_eq!(groups.clustered(&rule, keep, 128, 2), (6, 5));
+        // Only the first four kept detections: the chain and one of the pair.
+        assert_eq!(groups.clustered(&rule, keep, 4, 2), (4, 3));
+        // The frame's groups are formed afterwards as before.
+        assert_eq!(groups.form(&rule), 8);
+    }
+}
