@@ -119,6 +119,31 @@ fn a_point_cloud_radar_gives_one_track_per_car_where_each_detection_as_an_object
 }
 
 #[test]
+fn a_grouped_cars_track_weighs_its_groups_by_the_group_noise_scale() {
+    // The same point clouds tracked with the group's noise at its full share and at a tenth:
+    // the smaller share holds the tracks' positions tighter.
+    let frames = cars(100, 5);
+    let spread_m2 = |scale: f64| {
+        let mut config = config(DetectionModel::Points);
+        config.frame.grouping.group_noise_scale = scale;
+        let mut tracker = Tracker::new(config).unwrap();
+        let mut last = Vec::new();
+        for frame in &frames {
+            last = tracker.step(frame).unwrap().to_vec();
+        }
+        let confirmed: Vec<f64> = last
+            .iter()
+            .filter(|output| output.status.is_confirmed())
+            .map(|output| output.position_covariance_m2.x_axis.x + output.position_covariance_m2.y_axis.y)
+            .collect();
+        assert_eq!(confirmed.len(), 2, "{last:?}");
+        confirmed.iter().sum::<f64>()
+    };
+    let (full, tenth) = (spread_m2(1.0), spread_m2(0.1));
+    assert!(tenth < 0.9 * full, "position variance {tenth} m² at a tenth, {full} m² in full");
+}
+
+#[test]
 fn a_scan_that_labels_a_tracked_cars_points_pedestrian_still_updates_the_cars_track() {
     // Every fourth scan after the first second, all of the first car's detections carry the
     // pedestrian label (a radar's classifier is wrong a tenth of the time, now and then for a
@@ -482,6 +507,8 @@ fn bad_point_cloud_keys_are_refused_by_name() {
         refused(|c| c.frame.grouping.points_scan_prior_detections = f64::NAN),
         "frame.grouping.points_scan_prior_detections"
     );
+    assert_eq!(refused(|c| c.frame.grouping.group_noise_scale = 0.0), "frame.grouping.group_noise_scale");
+    assert_eq!(refused(|c| c.frame.grouping.group_noise_scale = 1.5), "frame.grouping.group_noise_scale");
     assert_eq!(
         refused(|c| c.frame.grouping.pedestrian_link_scale = 0.0),
         "frame.grouping.pedestrian_link_scale"

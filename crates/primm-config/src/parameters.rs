@@ -85,6 +85,7 @@ const PARAMETERS: &[Parameter] = &[
     p("frame.grouping.points_prior_scans", "(0, 1e9]", "Weight of the prior share 0 (objects), in track scans."),
     p("frame.grouping.points_window_scans", "(0, 1e9]", "Memory of the share, in track scans."),
     p("frame.grouping.detection_probability_factor", "(0, 1000]", "Factor on the detection probability of a radar that missed a track while it groups its detections (a group misses its object only when all its detections do)."),
+    p("frame.grouping.group_noise_scale", "(0, 1]", "Factor on the radar's noise and the contour's spread over the count in the noise of a group moved to its object's centre (1: the mean of independent points)."),
     p("frame.grouping.points_evidence_margin_m", "[0, 20] m", "How far beyond a confirmed vehicle track's box a detection still counts towards an auto radar's share of multiples, m."),
     p("frame.grouping.points_scan_share", "(0, 1]", "Before its first track scan, an auto radar starts as points when more than this share of the auto radars' vehicle detections so far lie in clusters of three or more linked ones (1: never)."),
     p("frame.grouping.points_scan_prior_detections", "[0, 1e9]", "Weight of the share 0 (no clusters) in that share, in vehicle detections."),

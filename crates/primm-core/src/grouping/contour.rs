@@ -93,12 +93,13 @@ pub fn visible_contour(
     }
 }
 
-/// The noise of a group's mean of `count` detections moved to the centre: each detection
+/// The noise of a group's mean of `count` detections moved to the centre, m²: each detection
 /// carries the radar's noise `radar_noise_m2` and falls on the contour with the contour's
 /// covariance of one point `contour_m2`, independently, so the mean carries
-/// `(R + Σ_c) / count`, m².
-pub fn group_noise_m2(radar_noise_m2: DMat2, contour_m2: DMat2, count: usize) -> DMat2 {
-    (radar_noise_m2 + contour_m2) * (1.0 / count.max(1) as f64)
+/// `(R + Σ_c) / count`; the tracker takes `scale` of it (the grouping's `group_noise_scale`,
+/// in (0, 1]).
+pub fn group_noise_m2(radar_noise_m2: DMat2, contour_m2: DMat2, count: usize, scale: f64) -> DMat2 {
+    (radar_noise_m2 + contour_m2) * (scale / count.max(1) as f64)
 }
 
 /// `v vᵀ`.
@@ -240,7 +241,7 @@ mod tests {
             second += outer(error);
         }
         let measured = second / trials as f64;
-        let expected = group_noise_m2(radar_noise, contour.covariance_m2, count);
+        let expected = group_noise_m2(radar_noise, contour.covariance_m2, count, 1.0);
         for (got, want) in measured.to_cols_array().iter().zip(expected.to_cols_array()) {
             assert!(
                 (got - want).abs() < 0.05 * expected.x_axis.x.max(expected.y_axis.y),
@@ -250,5 +251,18 @@ mod tests {
         // The radar's noise undivided would overstate it by far.
         let undivided = radar_noise + contour.covariance_m2 * (1.0 / count as f64);
         assert!(undivided.y_axis.y > 1.5 * measured.y_axis.y, "{undivided} {measured}");
+    }
+
+    #[test]
+    fn the_group_noise_scale_takes_its_share_of_the_means_spread() {
+        let radar_noise = DMat2::from_diagonal(DVec2::new(0.09, 1.0));
+        let contour = DMat2::from_cols(DVec2::new(1.2, 0.3), DVec2::new(0.3, 0.4));
+        let full = group_noise_m2(radar_noise, contour, 3, 1.0);
+        let scaled = group_noise_m2(radar_noise, contour, 3, 0.3);
+        for (got, want) in scaled.to_cols_array().iter().zip(full.to_cols_array()) {
+            assert!((got - 0.3 * want).abs() < 1e-12, "{scaled} {full}");
+        }
+        // A single detection's share: its own noise and the contour's spread.
+        assert_eq!(group_noise_m2(radar_noise, contour, 0, 1.0), radar_noise + contour);
     }
 }

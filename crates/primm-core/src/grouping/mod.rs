@@ -108,6 +108,13 @@ pub struct GroupingConfig {
     /// only when every one of the object's detections does. A detection keeps the configured
     /// probability, so that an echo seen scan after scan is confirmed no faster.
     pub detection_probability_factor: f64,
+    /// Factor on the noise of a group moved to its object's centre, dimensionless, in (0, 1]
+    /// (absent: 0.3): the update and the association take the group's mean with its class's
+    /// R plus this share of the radar's noise and the contour's spread over the count
+    /// (`contour::group_noise_m2`). 1 is the spread of the mean of independent points; a
+    /// smaller factor follows far vehicles, whose few points carry the wide azimuth noise, more
+    /// closely (ARCHITECTURE.md, "Point clouds").
+    pub group_noise_scale: f64,
 }
 
 impl Default for GroupingConfig {
@@ -127,6 +134,7 @@ impl Default for GroupingConfig {
             points_window_scans: 2000.0,
             points_pool_scans: 20.0,
             detection_probability_factor: 2.5,
+            group_noise_scale: 0.3,
         }
     }
 }
@@ -168,6 +176,9 @@ impl GroupingConfig {
         }
         if !(self.detection_probability_factor > 0.0 && self.detection_probability_factor <= 1e3) {
             return Some(("frame.grouping.detection_probability_factor", "must lie in (0, 1000]"));
+        }
+        if !(self.group_noise_scale > 0.0 && self.group_noise_scale <= 1.0) {
+            return Some(("frame.grouping.group_noise_scale", "must lie in (0, 1]"));
         }
         if !within(self.points_evidence_margin_m, 0.0, 20.0) {
             return Some(("frame.grouping.points_evidence_margin_m", "must lie in [0, 20] m"));

@@ -186,7 +186,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let centre_spread_m2 = if self.grouped_frame { self.group_centre_spread[index] } else { None };
             if let Some(spread_m2) = centre_spread_m2 {
                 let count = self.frame_groups.members(index).len();
-                noise_m2 = crate::grouping::contour::group_noise_m2(noise_m2, spread_m2, count);
+                let scale = self.config.frame.grouping.group_noise_scale;
+                noise_m2 = crate::grouping::contour::group_noise_m2(noise_m2, spread_m2, count, scale);
             }
             self.measurement_sensors[index] = MeasurementSensor {
                 position_m,
