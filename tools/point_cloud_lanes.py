@@ -3,8 +3,11 @@
 lanes 4 m apart in y (x along the lane, 8-12 m/s), seen from a sensor at the origin every 40 ms
 for 200 frames, each with POINTS detections over its box (1: one detection at its centre). A
 measurement CSV for `primm track --input` and `cargo bench --bench step_growth -- --sequence`.
+With `clutter` or `spot` instead of POINTS, the 200 frames are bad input (ARCHITECTURE.md, "Bad
+input"): 1,024 clutter points each, over 200 m x 200 m with any radial velocity, or 1,024
+detections at one spot.
 
-    python3 tools/point_cloud_lanes.py OUT.csv POINTS
+    python3 tools/point_cloud_lanes.py OUT.csv POINTS|clutter|spot
 """
 import csv
 import math
@@ -12,8 +15,31 @@ import random
 import sys
 
 
+def bad_frames(out: str, kind: str) -> None:
+    """200 frames of 1,024 detections each: clutter, or all at one spot."""
+    rng = random.Random(11)
+    with open(out, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y",
+                    "sensor_id", "ego_x", "ego_y", "ego_yaw"])
+        for k in range(200):
+            t = 0.04 * k
+            for i in range(1024):
+                if kind == "clutter":
+                    x, y, vr = rng.uniform(-100, 100), rng.uniform(-100, 100), rng.uniform(-15, 15)
+                    cls = "pedestrian" if i % 3 == 0 else "car"
+                else:
+                    x, y, vr, cls = 40.0, -20.0, 0.0, "car"
+                w.writerow([k, f"{t:.4f}", "", cls, f"{x:.3f}", f"{y:.3f}", f"{vr:.3f}", 10.0,
+                            "", "", "", 0.0, 0.0, 0.0])
+
+
 def main() -> None:
-    out, points = sys.argv[1], int(sys.argv[2])
+    out = sys.argv[1]
+    if sys.argv[2] in ("clutter", "spot"):
+        bad_frames(out, sys.argv[2])
+        return
+    points = int(sys.argv[2])
     rng = random.Random(7)
     cars = [(-60.0 + (i % 3) * 10.0, -126.0 + 4.0 * i, 8.0 + (i % 5)) for i in range(64)]
     with open(out, "w", newline="") as f:
