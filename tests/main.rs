@@ -43,6 +43,7 @@ mod learned_covariance;
 mod logging;
 mod motion_models;
 mod multipath_ghosts;
+mod point_cloud_faults;
 mod point_clouds;
 mod predictor_allocation;
 mod predictor_classes;
