@@ -262,7 +262,7 @@ mod tests {
         for (got, want) in scaled.to_cols_array().iter().zip(full.to_cols_array()) {
             assert!((got - 0.3 * want).abs() < 1e-12, "{scaled} {full}");
         }
-        // A single detection's share: its own noise and the contour's spread.
+        // A count below one counts as one detection: its own noise and the contour's spread.
         assert_eq!(group_noise_m2(radar_noise, contour, 0, 1.0), radar_noise + contour);
     }
 }
