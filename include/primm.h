@@ -137,6 +137,22 @@ typedef struct PrimmSensorEstimates {
   uint8_t groups_points;
 } PrimmSensorEstimates;
 
+// How a sensor's detections came to be grouped or not (`detections = "auto"`, primm-core's
+// `sensor::points`): what its scans before its first confirmed vehicle track showed, and how
+// often the decision changed since. Queried with [`primm_tracker_sensor_points_evidence`]; the
+// share of multiples and the decision itself are in [`PrimmSensorEstimates`].
+typedef struct PrimmSensorPointsEvidence {
+  // Vehicle detections in the sensor's scans before its first confirmed vehicle track scan.
+  uint32_t first_scans_vehicle_detections;
+  // Of those, the detections in a cluster of at least three linked ones.
+  uint32_t first_scans_clustered;
+  // 1 when the first scans' clusters (pooled over the `auto` radars) started the sensor as
+  // points, else 0.
+  uint8_t first_scans_showed_points;
+  // Times the decision (points or objects) changed.
+  uint64_t decision_changes;
+} PrimmSensorPointsEvidence;
+
 // A method code, one of the `PRIMM_METHOD_*` constants: which IMM modes the tracker runs.
 typedef uint32_t PrimmMethod;
 
@@ -523,6 +539,16 @@ enum PrimmStatus primm_tracker_sensor_estimates(struct PrimmTracker *tracker,
                                                 int32_t sensor_id,
                                                 PrimmObjectClass class_code,
                                                 struct PrimmSensorEstimates *out);
+
+// Writes what decided whether sensor `sensor_id` (a configured id, or
+// `PRIMM_UNMOUNTED_SENSOR`) groups its detections to `*out`. `PRIMM_STATUS_INVALID_ARGUMENT`
+// for an id that is not configured.
+//
+// # Safety
+// `tracker` is NULL or a live handle used by no other thread; `out` is NULL or writable.
+enum PrimmStatus primm_tracker_sensor_points_evidence(struct PrimmTracker *tracker,
+                                                      int32_t sensor_id,
+                                                      struct PrimmSensorPointsEvidence *out);
 
 // The default options: the built-in configuration (`config/primm.toml`) with its modes
 // (PR-IMM), the built-in PR model, inference inside `primm_tracker_step`.

@@ -147,7 +147,10 @@ pub use helpers::{
     primm_status_message,
 };
 pub use platform::{primm_tracker_platform, PrimmPlatformEstimate};
-pub use sensor_estimates::{primm_tracker_sensor_estimates, PrimmSensorEstimates, PRIMM_UNMOUNTED_SENSOR};
+pub use sensor_estimates::{
+    primm_tracker_sensor_estimates, primm_tracker_sensor_points_evidence, PrimmSensorEstimates,
+    PrimmSensorPointsEvidence, PRIMM_UNMOUNTED_SENSOR,
+};
 pub use status::PrimmStatus;
 pub use tracker::{
     primm_tracker_create, primm_tracker_destroy, primm_tracker_last_error, primm_tracker_newest_timestamp,

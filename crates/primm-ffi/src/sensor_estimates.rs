@@ -45,6 +45,49 @@ pub struct PrimmSensorEstimates {
     pub groups_points: u8,
 }
 
+/// How a sensor's detections came to be grouped or not (`detections = "auto"`, primm-core's
+/// `sensor::points`): what its scans before its first confirmed vehicle track showed, and how
+/// often the decision changed since. Queried with [`primm_tracker_sensor_points_evidence`]; the
+/// share of multiples and the decision itself are in [`PrimmSensorEstimates`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PrimmSensorPointsEvidence {
+    /// Vehicle detections in the sensor's scans before its first confirmed vehicle track scan.
+    pub first_scans_vehicle_detections: u32,
+    /// Of those, the detections in a cluster of at least three linked ones.
+    pub first_scans_clustered: u32,
+    /// 1 when the first scans' clusters (pooled over the `auto` radars) started the sensor as
+    /// points, else 0.
+    pub first_scans_showed_points: u8,
+    /// Times the decision (points or objects) changed.
+    pub decision_changes: u64,
+}
+
+/// The sensor `sensor_id` asks for: a configured id, or `PRIMM_UNMOUNTED_SENSOR`.
+fn sensor_of(sensors: &SensorSet, sensor_id: i32) -> Result<&primm_core::sensor::Sensor, Failure> {
+    if sensor_id == PRIMM_UNMOUNTED_SENSOR {
+        return Ok(sensors.get(primm_core::sensor::UNMOUNTED));
+    }
+    let id = u16::try_from(sensor_id).map_err(|_| Failure::UnknownSensor(sensor_id))?;
+    let slot = sensors.slot(Some(id));
+    if slot == primm_core::sensor::UNMOUNTED {
+        return Err(Failure::UnknownSensor(sensor_id));
+    }
+    Ok(sensors.get(slot))
+}
+
+impl PrimmSensorPointsEvidence {
+    fn of(sensors: &SensorSet, sensor_id: i32) -> Result<Self, Failure> {
+        let points = &sensor_of(sensors, sensor_id)?.points;
+        Ok(PrimmSensorPointsEvidence {
+            first_scans_vehicle_detections: points.scan_detections,
+            first_scans_clustered: points.scan_clustered,
+            first_scans_showed_points: u8::from(points.scan_points),
+            decision_changes: points.switches,
+        })
+    }
+}
+
 impl PrimmSensorEstimates {
     fn of(
         sensors: &SensorSet,
@@ -52,16 +95,7 @@ impl PrimmSensorEstimates {
         sensor_id: i32,
         class: ObjectClass,
     ) -> Result<Self, Failure> {
-        let sensor = if sensor_id == PRIMM_UNMOUNTED_SENSOR {
-            sensors.get(primm_core::sensor::UNMOUNTED)
-        } else {
-            let id = u16::try_from(sensor_id).map_err(|_| Failure::UnknownSensor(sensor_id))?;
-            let slot = sensors.slot(Some(id));
-            if slot == primm_core::sensor::UNMOUNTED {
-                return Err(Failure::UnknownSensor(sensor_id));
-            }
-            sensors.get(slot)
-        };
+        let sensor = sensor_of(sensors, sensor_id)?;
         let estimates = &sensor.estimates[class.index()];
         Ok(PrimmSensorEstimates {
             reflection: estimates.reflection.value,
@@ -101,6 +135,31 @@ pub unsafe extern "C" fn primm_tracker_sensor_estimates(
         let estimates = PrimmSensorEstimates::of(tracker.sensors(), tracker.config(), sensor_id, class)?;
         // SAFETY: writable (caller contract).
         unsafe { out.write(estimates) };
+        Ok(())
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { with_tracker(tracker, body) }
+}
+
+/// Writes what decided whether sensor `sensor_id` (a configured id, or
+/// `PRIMM_UNMOUNTED_SENSOR`) groups its detections to `*out`. `PRIMM_STATUS_INVALID_ARGUMENT`
+/// for an id that is not configured.
+///
+/// # Safety
+/// `tracker` is NULL or a live handle used by no other thread; `out` is NULL or writable.
+#[no_mangle]
+pub unsafe extern "C" fn primm_tracker_sensor_points_evidence(
+    tracker: *mut PrimmTracker,
+    sensor_id: i32,
+    out: *mut PrimmSensorPointsEvidence,
+) -> crate::status::PrimmStatus {
+    let body = |handle: &mut PrimmTracker| {
+        if out.is_null() {
+            return Err(Failure::NullArgument("out"));
+        }
+        let evidence = PrimmSensorPointsEvidence::of(handle.tracker.sensors(), sensor_id)?;
+        // SAFETY: writable (caller contract).
+        unsafe { out.write(evidence) };
         Ok(())
     };
     // SAFETY: forwarded caller contract.
@@ -156,6 +215,53 @@ mod tests {
         }
         let status =
             unsafe { primm_tracker_sensor_estimates(tracker, 1, PRIMM_OBJECT_CLASS_CAR, null_mut()) };
+        assert_eq!(status, PrimmStatus::NullArgument);
+        // SAFETY: the handle is live and not used again.
+        unsafe { primm_tracker_destroy(tracker) };
+    }
+
+    #[test]
+    fn a_sensor_reports_what_its_first_scans_showed_and_bad_arguments_are_refused() {
+        let mut tracker = null_mut();
+        // SAFETY: NULL options (the defaults) and a valid out-pointer.
+        assert_eq!(unsafe { primm_tracker_create(null(), &mut tracker) }, PrimmStatus::Ok);
+        // Sensor 1 sees four points of one car in each of its first scans, linked: a point
+        // cloud. Sensor 2 sees one detection of a car.
+        for k in 0..3 {
+            let point = |sensor_id: i32, x_m: f64, y_m: f64| PrimmMeasurement {
+                x_m,
+                y_m,
+                radial_velocity_mps: 0.0,
+                rcs_dbsm: 10.0,
+                ground_truth_id: 1,
+                sensor_id,
+                class_code: PRIMM_OBJECT_CLASS_CAR,
+            };
+            let measurements = [
+                point(1, 10.0, -20.0),
+                point(1, 11.0, -20.0),
+                point(1, 12.0, -20.0),
+                point(1, 13.0, -20.0),
+                point(2, 40.0, -5.0),
+            ];
+            let mut summary = PrimmStepSummary::default();
+            // SAFETY: a live tracker, five measurements, a writable summary.
+            let status = unsafe {
+                primm_tracker_step(tracker, 0.05 * k as f64, measurements.as_ptr(), 5, &mut summary)
+            };
+            assert_eq!(status, PrimmStatus::Ok);
+        }
+        let mut out = PrimmSensorPointsEvidence::default();
+        // SAFETY: a live tracker and a writable out-pointer, here and below.
+        let status = unsafe { primm_tracker_sensor_points_evidence(tracker, 1, &mut out) };
+        assert_eq!(status, PrimmStatus::Ok);
+        assert_eq!((out.first_scans_vehicle_detections, out.first_scans_clustered), (12, 12), "{out:?}");
+        let status = unsafe { primm_tracker_sensor_points_evidence(tracker, 2, &mut out) };
+        assert_eq!(status, PrimmStatus::Ok);
+        assert_eq!((out.first_scans_vehicle_detections, out.first_scans_clustered), (3, 0), "{out:?}");
+        let status = unsafe { primm_tracker_sensor_points_evidence(tracker, 99, &mut out) };
+        assert_eq!(status, PrimmStatus::InvalidArgument);
+        let status = unsafe { primm_tracker_sensor_points_evidence(tracker, 1, null_mut()) };
         assert_eq!(status, PrimmStatus::NullArgument);
         // SAFETY: the handle is live and not used again.
         unsafe { primm_tracker_destroy(tracker) };
