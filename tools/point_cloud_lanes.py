@@ -14,14 +14,16 @@ import math
 import random
 import sys
 
+HEADER = ["frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y", "sensor_id", "ego_x",
+          "ego_y", "ego_yaw"]
+
 
 def bad_frames(out: str, kind: str) -> None:
     """200 frames of 1,024 detections each: clutter, or all at one spot."""
     rng = random.Random(11)
     with open(out, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y",
-                    "sensor_id", "ego_x", "ego_y", "ego_yaw"])
+        w.writerow(HEADER)
         for k in range(200):
             t = 0.04 * k
             for i in range(1024):
@@ -44,8 +46,7 @@ def main() -> None:
     cars = [(-60.0 + (i % 3) * 10.0, -126.0 + 4.0 * i, 8.0 + (i % 5)) for i in range(64)]
     with open(out, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["frame", "t", "gt_id", "class", "x", "y", "vr", "rcs", "true_x", "true_y",
-                    "sensor_id", "ego_x", "ego_y", "ego_yaw"])
+        w.writerow(HEADER)
         for k in range(200):
             t = 0.04 * k
             for gid, (x0, y0, v) in enumerate(cars):

@@ -30,6 +30,20 @@ pub struct Detection {
     pub owner: Option<u16>,
 }
 
+/// `detection` as the linkage sees it: where it is, its range from its radar, its radial
+/// velocity, its radar, its owner and whether it is labelled a pedestrian.
+fn link_point(detection: &Detection) -> LinkPoint {
+    let position_m = detection.measurement.position();
+    LinkPoint {
+        position_m,
+        range_m: position_m.distance(detection.sensor_position_m),
+        radial_velocity_mps: detection.measurement.radial_velocity_mps,
+        sensor_slot: detection.sensor_slot,
+        owner: detection.owner.unwrap_or(NO_OWNER),
+        pedestrian: detection.measurement.class == crate::measurement::ObjectClass::Pedestrian,
+    }
+}
+
 /// The groups of one frame.
 #[derive(Debug, Clone)]
 pub struct FrameGroups {
@@ -154,15 +168,7 @@ impl FrameGroups {
         for index in 0..self.count {
             let detection = self.detections[index];
             if detection.grouped {
-                let position_m = detection.measurement.position();
-                self.points[points] = LinkPoint {
-                    position_m,
-                    range_m: position_m.distance(detection.sensor_position_m),
-                    radial_velocity_mps: detection.measurement.radial_velocity_mps,
-                    sensor_slot: detection.sensor_slot,
-                    owner: detection.owner.unwrap_or(NO_OWNER),
-                    pedestrian: detection.measurement.class == crate::measurement::ObjectClass::Pedestrian,
-                };
+                self.points[points] = link_point(&detection);
                 self.group_of[index] = points as u16;
                 points += 1;
             }
@@ -206,15 +212,7 @@ impl FrameGroups {
         let mut taken = 0;
         for detection in self.detections[..self.count].iter().filter(|detection| keep(detection)).take(limit)
         {
-            let position_m = detection.measurement.position();
-            self.points[taken] = LinkPoint {
-                position_m,
-                range_m: position_m.distance(detection.sensor_position_m),
-                radial_velocity_mps: detection.measurement.radial_velocity_mps,
-                sensor_slot: detection.sensor_slot,
-                owner: NO_OWNER,
-                pedestrian: false,
-            };
+            self.points[taken] = LinkPoint { owner: NO_OWNER, pedestrian: false, ..link_point(detection) };
             taken += 1;
         }
         let labels = self.linkage.cluster(&self.points[..taken], rule);
