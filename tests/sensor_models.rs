@@ -2,7 +2,7 @@
 //! ARCHITECTURE.md "Sensors and their estimates"): `reflection = "centre"` tracks an
 //! object-list radar's detections at the centre, `"auto"` moves from its prior towards the data,
 //! an estimate without evidence stays at its prior, the detection and clutter estimates count
-//! what they see, late frames leave every estimate as in-order arrival does, and bad keys are
+//! what they see (a car hidden behind another gives no misses), late frames leave every estimate as in-order arrival does, and bad keys are
 //! refused by name.
 
 use crate::common::invalid_key;
@@ -187,6 +187,53 @@ fn the_detection_estimate_follows_how_often_a_radar_reports_a_confirmed_car() {
     let value = detection.value();
     assert!(detection.samples > 1000, "{detection:?}");
     assert!((value - 0.75).abs() < 0.08, "{value} {detection:?}");
+}
+
+/// Radar 1's detection estimate for cars after two standing cars were tracked for 3,000 scans:
+/// one 20 m ahead of the radar reported in every scan, the other at `far_m` reported in every
+/// scan for the first 100 and then in one of four.
+fn detection_estimate_with_a_car_at(far_m: DVec2) -> f64 {
+    let mut config = config(ReflectionModel::Outline);
+    config.frame.estimation.detection_prior_samples = 20.0;
+    let mut tracker = Tracker::new(config).unwrap();
+    for k in 0..3000 {
+        let mut frame = Frame::new(k as f64 * 0.05);
+        frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
+        let far_reported = k < 100 || k % 4 == 0;
+        let cars = [(DVec2::new(20.0, -12.0), 1, true), (far_m, 2, far_reported)];
+        for (position, ground_truth_id, reported) in cars {
+            if reported {
+                frame.measurements.push(Measurement {
+                    x_m: position.x,
+                    y_m: position.y,
+                    radial_velocity_mps: 0.0,
+                    rcs_dbsm: 10.0,
+                    class: ObjectClass::Car,
+                    sensor_id: Some(1),
+                    ground_truth_id: Some(ground_truth_id),
+                });
+            }
+        }
+        tracker.step(&frame).unwrap();
+    }
+    let confirmed = tracker.tracks().iter().filter(|track| track.status.is_confirmed()).count();
+    assert_eq!(confirmed, 2, "both cars are tracked throughout");
+    let sensors = tracker.sensors();
+    let detection = sensors.get(sensors.slot(Some(1))).estimates[ObjectClass::Car.index()].detection;
+    assert!(detection.samples > 3000, "{detection:?}");
+    detection.value()
+}
+
+#[test]
+fn a_car_hidden_behind_another_confirmed_car_gives_no_misses_to_the_detection_estimate() {
+    // Radar 1 stands at (0, −12) and looks along x: a car 40 m ahead is behind the one 20 m
+    // ahead, and its misses are not the radar's; its detections still count.
+    let hidden = detection_estimate_with_a_car_at(DVec2::new(40.0, -12.0));
+    assert!(hidden > 0.95, "{hidden}");
+    // The same car in clear view, 12 m to the side: its misses count, and the estimate falls
+    // towards (1 + 1/4) / 2.
+    let in_clear_view = detection_estimate_with_a_car_at(DVec2::new(40.0, 0.0));
+    assert!((in_clear_view - 0.625).abs() < 0.08, "{in_clear_view}");
 }
 
 #[test]

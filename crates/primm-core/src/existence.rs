@@ -208,6 +208,11 @@ impl FieldOfView {
         Some(FieldOfView { origin_m, boresight, cos_half_angle, max_range_m: max_range_m + margin_m })
     }
 
+    /// The sensor's position in the tracking frame, m.
+    pub fn origin_m(&self) -> DVec2 {
+        self.origin_m
+    }
+
     /// Whether `position_m` (tracking frame) lies within range and opening angle.
     pub fn contains(&self, position_m: DVec2) -> bool {
         let relative = position_m - self.origin_m;

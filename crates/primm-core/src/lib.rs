@@ -68,6 +68,7 @@ mod math;
 pub mod measurement;
 pub mod mode;
 pub mod motion;
+pub mod occlusion;
 pub mod pose;
 pub mod prediction;
 pub mod predictor;

@@ -186,6 +186,9 @@ pub struct Tracker<P: DisplacementPredictor = NoPredictor> {
     confirmed: Box<confirmed_index::ConfirmedIndex>,
     /// Per track: its detections of one radar in the current frame (`learn_points`).
     owned_counts: Box<[u16; MAX_TRACKS]>,
+    /// The boxes of the tracks confirmed before the current frame's update, which may hide
+    /// other tracks from a sensor (`learn_sensors`).
+    occluders: Box<crate::occlusion::Occluders<MAX_TRACKS>>,
     /// The current frame as read once from the caller; validation reads only this copy.
     recorded: Box<RecordedFrame>,
     /// The current frame as validated; every later stage reads this copy.
@@ -255,6 +258,7 @@ impl<P: DisplacementPredictor> Tracker<P> {
             group_centre_spread: Box::new([None; MAX_MEASUREMENTS_PER_FRAME]),
             confirmed: Box::new(confirmed_index::ConfirmedIndex::new()),
             owned_counts: Box::new([0; MAX_TRACKS]),
+            occluders: Box::default(),
             shadowed: Box::new([false; MAX_TRACKS]),
             ending: Box::new([false; MAX_TRACKS]),
             recorded: Box::new(RecordedFrame::new()),

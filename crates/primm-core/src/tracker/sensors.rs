@@ -5,6 +5,7 @@
 
 use super::Tracker;
 use crate::measurement::{FrameView, Measurement, ObjectClass};
+use crate::occlusion::ObjectBox;
 use crate::predictor::DisplacementPredictor;
 use crate::sensor::platform::{PlatformModel, PLATFORM_MIN_TRACK_AGE_S};
 use crate::sensor::{ReflectionModel, UNMOUNTED};
@@ -86,9 +87,11 @@ impl<P: DisplacementPredictor> Tracker<P> {
     }
 
     /// The frame's scans (their fields of view's areas) and detection opportunities (each
-    /// confirmed track in view of a scanning sensor, detected by it or not) into the sensors'
-    /// clutter and detection estimates.
+    /// confirmed track in view of a scanning sensor: a detection if it detected the track, a
+    /// miss unless another confirmed track hid the track from it) into the sensors' clutter
+    /// and detection estimates.
     pub(super) fn learn_sensors(&mut self) {
+        self.collect_occluders();
         let config = self.config.frame.estimation;
         let unknown_view = self.unknown_sensor_view;
         let scanned = self
@@ -110,10 +113,43 @@ impl<P: DisplacementPredictor> Tracker<P> {
             let prior_m = self.priors[i].fused.mean;
             let detected_by = self.track_to_measurement[i]
                 .map(|index| usize::from(self.measurement_sensors[usize::from(index)].slot));
-            for (slot, _) in scanned.clone().filter(|(_, view)| view.contains(prior_m)) {
+            for (slot, view) in scanned.clone().filter(|(_, view)| view.contains(prior_m)) {
+                let detected = detected_by == Some(slot);
+                // A miss of an object hidden behind another says nothing of how well the sensor
+                // detects what it can see; a detection shows the object was seen.
+                if !detected && self.occluders.hide(i as u16, view.origin_m(), prior_m) {
+                    continue;
+                }
                 let estimate = &mut self.sensors.get_mut(slot).estimates[class.index()].detection;
-                estimate.observe(&config, detected_by == Some(slot));
+                estimate.observe(&config, detected);
             }
+        }
+    }
+
+    /// The boxes of the tracks confirmed before this frame's update, at their priors, into
+    /// `occluders`: heading along the velocity, the class's nominal extent (a square of the
+    /// extent's width below the class's `extent.min_heading_speed_mps`).
+    fn collect_occluders(&mut self) {
+        self.occluders.clear();
+        for (j, track) in self.table.tracks().iter().enumerate() {
+            if !self.was_confirmed[j] {
+                continue;
+            }
+            let extent = &self.config.classes.get(track.class).extent;
+            let velocity_mps = self.priors[j].fused_velocity_mps();
+            let (heading, half_length_m) = match velocity_mps.try_normalize() {
+                Some(heading) if velocity_mps.length() > extent.min_heading_speed_mps => {
+                    (heading, 0.5 * extent.length_m)
+                }
+                _ => (DVec2::X, 0.5 * extent.width_m),
+            };
+            let object = ObjectBox {
+                centre_m: self.priors[j].fused.mean,
+                heading,
+                half_extent_m: DVec2::new(half_length_m, 0.5 * extent.width_m),
+            };
+            // The capacity is the table's: every track fits.
+            let _ = self.occluders.push(j as u16, object);
         }
     }
 

@@ -4,7 +4,8 @@
 //! ([`primm_core::tracker::Tracker::sensors`]) are compared with that sequence's truth.
 //!
 //! * **Detection probability**: the estimate against the truth within the class's detection
-//!   range (the tracker only learns where it can hold a track).
+//!   range (the tracker only learns where it can hold a track) and in clear view of the sensor
+//!   (the tracker leaves out the tracks another confirmed track hides).
 //! * **Clutter density**: the estimate against the false detections of the class per scan and
 //!   m² of the field of view.
 //!
@@ -176,7 +177,7 @@ fn cells<P: primm_core::predictor::DisplacementPredictor>(
 ) -> impl Iterator<Item = (EstimatedQuantity, f64, f64, u64)> {
     let sensors = tracker.sensors();
     let estimates = sensors.get(sensors.slot(Some(row.sensor_id))).estimates[row.class.index()];
-    let detection = row.detection_probability_in_class_range.map(|truth| {
+    let detection = row.detection_probability_in_clear_view.map(|truth| {
         (
             EstimatedQuantity::DetectionProbability,
             truth,

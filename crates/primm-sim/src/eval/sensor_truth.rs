@@ -15,7 +15,11 @@
 //!   over the pairs within the class's detection range (`car_reflection.detection_range_m`,
 //!   `pedestrian_reflection.detection_range_m`; 70 m for pedestrians by default), beyond which
 //!   the generator never detects the class, so a tracker never holds a track there to learn
-//!   from.
+//!   from. And the same share over those of them in clear view, *the sensor's detection
+//!   probability*: the line of sight from the sensor to the object's centre crosses no other
+//!   object's box ([`primm_core::occlusion`]). Hidden objects are mostly missed (the generator's
+//!   `radar.occluded_point_probability`), but how often an object is hidden is the scene's, not
+//!   the sensor's: in a crowd it is half the time.
 //! * **Clutter density**: false detections (no ground-truth id) labelled with the class, per scan
 //!   and per m² of the field of view (the sector `half_fov_rad · max_range_m²`).
 //!
@@ -28,10 +32,11 @@ use std::collections::BTreeMap;
 use glam::DVec2;
 use serde::Serialize;
 
-use crate::scenario::{GeneratedSequence, ScenarioConfig, ScenarioGenerator, Split, TruthFrame};
+use crate::scenario::{GeneratedSequence, ObjectState, ScenarioConfig, ScenarioGenerator, Split, TruthFrame};
 use primm_core::config::Config;
 use primm_core::extent::{ExtentConfig, ObjectPrior};
 use primm_core::measurement::ObjectClass;
+use primm_core::occlusion::ObjectBox;
 use primm_core::pose::SensorMount;
 
 /// The true properties of one sensor for one class.
@@ -62,6 +67,13 @@ pub struct SensorClassTruth {
     pub objects_in_class_range: u64,
     /// Of those, the pairs with at least one detection.
     pub objects_detected_in_class_range: u64,
+    /// The detection probability over the in-view pairs within the class's detection range
+    /// whose object no other object hides from the sensor; `None` without such a pair.
+    pub detection_probability_in_clear_view: Option<f64>,
+    /// In-view pairs within the class's detection range in clear view of the sensor.
+    pub objects_in_clear_view: u64,
+    /// Of those, the pairs with at least one detection.
+    pub objects_detected_in_clear_view: u64,
     /// False detections of the class per scan per m² of the field of view; `None` without a
     /// scan of the sensor.
     pub clutter_density_per_m2: Option<f64>,
@@ -95,6 +107,8 @@ struct Sums {
     objects_detected: u64,
     objects_in_class_range: u64,
     objects_detected_in_class_range: u64,
+    objects_in_clear_view: u64,
+    objects_detected_in_clear_view: u64,
     false_detections: u64,
 }
 
@@ -162,6 +176,7 @@ impl SensorTruthAccumulator {
         frame: &crate::io::RecordedFrame,
         truth: &TruthFrame,
     ) {
+        let sensor_m = truth.ego.pose.point_to_world(mount.position());
         for object in &truth.objects {
             let centre = truth.ego.pose.world_to_car(object.position);
             if !in_view(mount, centre) {
@@ -171,11 +186,17 @@ impl SensorTruthAccumulator {
                 frame.measurements.iter().any(|m| m.measurement.ground_truth_id == Some(object.id));
             let in_class_range =
                 centre.distance(mount.position()) <= self.class_ranges_m[object.class as usize];
+            let in_clear_view = in_class_range
+                && !truth.objects.iter().any(|other| {
+                    other.id != object.id && object_box(other).crossed_by(sensor_m, object.position)
+                });
             let sums = self.sums.entry((mount.id, object.class as usize)).or_default();
             sums.objects_in_view += 1;
             sums.objects_detected += u64::from(detected);
             sums.objects_in_class_range += u64::from(in_class_range);
             sums.objects_detected_in_class_range += u64::from(in_class_range && detected);
+            sums.objects_in_clear_view += u64::from(in_clear_view);
+            sums.objects_detected_in_clear_view += u64::from(in_clear_view && detected);
         }
     }
 
@@ -208,6 +229,11 @@ impl SensorTruthAccumulator {
                     }),
                     objects_in_class_range: sums.objects_in_class_range,
                     objects_detected_in_class_range: sums.objects_detected_in_class_range,
+                    detection_probability_in_clear_view: (sums.objects_in_clear_view > 0).then(|| {
+                        sums.objects_detected_in_clear_view as f64 / sums.objects_in_clear_view as f64
+                    }),
+                    objects_in_clear_view: sums.objects_in_clear_view,
+                    objects_detected_in_clear_view: sums.objects_detected_in_clear_view,
                     clutter_density_per_m2: (scans > 0 && field_of_view_m2 > 0.0)
                         .then(|| sums.false_detections as f64 / (scans as f64 * field_of_view_m2)),
                     false_detections: sums.false_detections,
@@ -243,6 +269,15 @@ pub fn outline_offset(extent: &ExtentConfig, centre_m: DVec2, velocity_mps: DVec
     primm_core::extent::outline_reflection(extent, &object, sensor_m).offset_m
 }
 
+/// The true box of `object` (world frame).
+fn object_box(object: &ObjectState) -> ObjectBox {
+    ObjectBox {
+        centre_m: object.position,
+        heading: DVec2::from_angle(object.heading_rad),
+        half_extent_m: DVec2::new(0.5 * object.length_m, 0.5 * object.width_m),
+    }
+}
+
 /// Whether `point` (car frame) lies within `mount`'s range and field of view.
 fn in_view(mount: &SensorMount, point: DVec2) -> bool {
     let relative = point - mount.position();
@@ -253,11 +288,20 @@ fn in_view(mount: &SensorMount, point: DVec2) -> bool {
 }
 
 /// The table as plain text: one row per sensor and class (`P_D ranged`: the detection
-/// probability within the class's detection range).
+/// probability within the class's detection range; `P_D clear`: of those, in clear view).
 pub fn format_sensor_truth(rows: &[SensorClassTruth]) -> String {
     let mut text = format!(
-        "{:>6} {:<11} {:>10} {:>10} {:>9} {:>10} {:>11} {:>12} {:>8}\n",
-        "sensor", "class", "reflection", "detections", "P_D", "in view", "P_D ranged", "clutter/m2", "false"
+        "{:>6} {:<11} {:>10} {:>10} {:>9} {:>10} {:>11} {:>10} {:>12} {:>8}\n",
+        "sensor",
+        "class",
+        "reflection",
+        "detections",
+        "P_D",
+        "in view",
+        "P_D ranged",
+        "P_D clear",
+        "clutter/m2",
+        "false"
     );
     let number = |value: Option<f64>, digits: usize| match value {
         Some(value) => format!("{value:.digits$}"),
@@ -265,7 +309,7 @@ pub fn format_sensor_truth(rows: &[SensorClassTruth]) -> String {
     };
     for row in rows {
         text.push_str(&format!(
-            "{:>6} {:<11} {:>10} {:>10} {:>9} {:>10} {:>11} {:>12} {:>8}\n",
+            "{:>6} {:<11} {:>10} {:>10} {:>9} {:>10} {:>11} {:>10} {:>12} {:>8}\n",
             row.sensor_id,
             row.class.name(),
             number(row.reflection_offset_fraction, 3),
@@ -273,6 +317,7 @@ pub fn format_sensor_truth(rows: &[SensorClassTruth]) -> String {
             number(row.detection_probability, 3),
             row.objects_in_view,
             number(row.detection_probability_in_class_range, 3),
+            number(row.detection_probability_in_clear_view, 3),
             row.clutter_density_per_m2.map_or_else(|| "-".to_owned(), |v| format!("{v:.3e}")),
             row.false_detections,
         ));
@@ -338,6 +383,31 @@ mod tests {
         let per_scan = false_detections as f64 / scans as f64;
         assert!((1.2..2.0).contains(&per_scan), "{per_scan} false detections per scan");
         assert!(clutter.iter().all(|row| row.clutter_density_per_m2.unwrap() > 0.0));
+    }
+
+    #[test]
+    fn objects_in_clear_view_are_detected_more_often_and_in_a_crowd_much_more_often() {
+        let share = |rows: &[SensorClassTruth], class: ObjectClass| {
+            let rows: Vec<_> = rows.iter().filter(|row| row.class == class).collect();
+            let ranged = rows.iter().map(|row| row.objects_detected_in_class_range).sum::<u64>() as f64
+                / rows.iter().map(|row| row.objects_in_class_range).sum::<u64>() as f64;
+            let clear = rows.iter().map(|row| row.objects_detected_in_clear_view).sum::<u64>() as f64
+                / rows.iter().map(|row| row.objects_in_clear_view).sum::<u64>() as f64;
+            for row in rows {
+                assert!(row.objects_in_clear_view <= row.objects_in_class_range, "{row:?}");
+                assert!(row.objects_detected_in_clear_view <= row.objects_in_clear_view, "{row:?}");
+            }
+            (ranged, clear)
+        };
+        // A roadside sensor in a crowd: about half of the cars in range are hidden at any time,
+        // and a hidden car is mostly missed.
+        let (ranged, clear) = share(&truth_of(Preset::DenseStatic, 1), ObjectClass::Car);
+        assert!(clear > ranged + 0.15, "crowd: in range {ranged}, in clear view {clear}");
+        let (ranged, clear) = share(&truth_of(Preset::Default, 1), ObjectClass::Car);
+        assert!(
+            clear >= ranged && clear < ranged + 0.15,
+            "default: in range {ranged}, in clear view {clear}"
+        );
     }
 
     #[test]

@@ -33,6 +33,7 @@ use super::point_cloud::{PointScan, PointTarget};
 use super::world::{Agent, World};
 use crate::io::{EgoPose, MeasurementOrigin, RecordedMeasurement};
 use primm_core::measurement::{Measurement, ObjectClass, MAX_MEASUREMENTS_PER_FRAME};
+use primm_core::occlusion::ObjectBox;
 
 /// One scheduled scan: time since the start of recording and the index of the sensor in the
 /// configuration's sensor list.
@@ -83,38 +84,12 @@ pub(crate) fn sensor_pose(ego: &EgoPose, mount: &RadarMount) -> (DVec2, f64) {
 
 /// Whether the segment from `a` to `b` passes through the box of `agent`.
 pub(super) fn segment_hits_box(a: DVec2, b: DVec2, agent: &Agent) -> bool {
-    let dir = agent.kin.direction();
-    let to_local = |p: DVec2| {
-        let rel = p - agent.kin.position;
-        DVec2::new(rel.dot(dir), rel.dot(dir.perp()))
-    };
-    let la = to_local(a);
-    let lb = to_local(b);
-    let half = DVec2::new(agent.length / 2.0, agent.width / 2.0);
-    // Slab test.
-    let d = lb - la;
-    let mut t0: f64 = 0.0;
-    let mut t1: f64 = 1.0;
-    for axis in 0..2 {
-        let (start, delta, h) = (la[axis], d[axis], half[axis]);
-        if delta.abs() < 1e-12 {
-            if start.abs() > h {
-                return false;
-            }
-        } else {
-            let mut ta = (-h - start) / delta;
-            let mut tb = (h - start) / delta;
-            if ta > tb {
-                std::mem::swap(&mut ta, &mut tb);
-            }
-            t0 = t0.max(ta);
-            t1 = t1.min(tb);
-            if t0 > t1 {
-                return false;
-            }
-        }
+    ObjectBox {
+        centre_m: agent.kin.position,
+        heading: agent.kin.direction(),
+        half_extent_m: DVec2::new(agent.length / 2.0, agent.width / 2.0),
     }
-    true
+    .crossed_by(a, b)
 }
 
 /// One scan's sensor: its mount, pose and field of view, and the unit normal its noise is drawn
