@@ -40,7 +40,8 @@ pub struct EstimationConfig {
     #[cfg_attr(feature = "serde", serde(default = "default_reflection_window_samples"))]
     pub reflection_window_samples: f64,
     /// Weight of the configured detection probability, in opportunities: confirmed tracks in
-    /// the field of view of a scanning sensor (absent: 2; the configured value is the existence
+    /// the field of view of a scanning sensor, not hidden from it by another where it missed
+    /// them (absent: 2; the configured value is the existence
     /// model's, not the radar's rate, so the data take over at once).
     #[cfg_attr(feature = "serde", serde(default = "default_existence_prior_samples"))]
     pub detection_prior_samples: f64,
@@ -183,8 +184,9 @@ impl ReflectionEstimate {
     }
 }
 
-/// How often a sensor detects an object of a class in its field of view: detections of
-/// confirmed tracks over opportunities (confirmed tracks in view of the scanning sensor). The
+/// How often a sensor detects an object of a class in its field of view and in clear view:
+/// detections of confirmed tracks over opportunities (confirmed tracks in view of the scanning
+/// sensor, less the misses of those another confirmed track hides from it). The
 /// configured probability enters as `detection_prior_samples` pseudo-opportunities with that
 /// rate, `p = (n₀ p₀ + hits) / (n₀ + opportunities)`; beyond the window both counts, the prior's
 /// included, are scaled down together, so the prior is forgotten like any old sample.
