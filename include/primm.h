@@ -117,9 +117,10 @@ typedef struct PrimmSensorEstimates {
   double reflection_used;
   // Informative updates the reflection estimate has taken.
   uint64_t reflection_samples;
-  // The detection probability, dimensionless.
+  // The detection probability of objects in clear view of the sensor, dimensionless.
   double detection_probability;
-  // Opportunities (confirmed tracks in view) the detection estimate has taken.
+  // Opportunities the detection estimate has taken: confirmed tracks in view, less the
+  // misses of those another confirmed track hid from the sensor.
   uint64_t detection_samples;
   // The clutter density, 1/m² per scan.
   double clutter_density_per_m2;

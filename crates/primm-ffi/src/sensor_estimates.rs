@@ -25,9 +25,10 @@ pub struct PrimmSensorEstimates {
     pub reflection_used: f64,
     /// Informative updates the reflection estimate has taken.
     pub reflection_samples: u64,
-    /// The detection probability, dimensionless.
+    /// The detection probability of objects in clear view of the sensor, dimensionless.
     pub detection_probability: f64,
-    /// Opportunities (confirmed tracks in view) the detection estimate has taken.
+    /// Opportunities the detection estimate has taken: confirmed tracks in view, less the
+    /// misses of those another confirmed track hid from the sensor.
     pub detection_samples: u64,
     /// The clutter density, 1/m² per scan.
     pub clutter_density_per_m2: f64,
