@@ -122,6 +122,20 @@ fn an_auto_sensor_moves_from_its_prior_towards_the_centre_on_object_list_data() 
     assert!(estimate.value < 0.5 * prior, "{estimate:?}");
 }
 
+/// Radar 1's detection of a standing car at (`x_m`, `y_m`) with ground-truth id
+/// `ground_truth_id`.
+fn standing_car(x_m: f64, y_m: f64, ground_truth_id: u64) -> Measurement {
+    Measurement {
+        x_m,
+        y_m,
+        radial_velocity_mps: 0.0,
+        rcs_dbsm: 10.0,
+        class: ObjectClass::Car,
+        sensor_id: Some(1),
+        ground_truth_id: Some(ground_truth_id),
+    }
+}
+
 #[test]
 fn an_estimate_without_evidence_stays_at_its_prior() {
     // A standing car seen by one radar: the geometry never changes.
@@ -132,15 +146,7 @@ fn an_estimate_without_evidence_stays_at_its_prior() {
     for k in 0..400 {
         let mut frame = Frame::new(k as f64 * 0.05);
         frame.ego_pose = Some(EgoPose { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 });
-        frame.measurements.push(Measurement {
-            x_m: 20.0 + 0.1 * noise.next(),
-            y_m: -12.0 + 0.1 * noise.next(),
-            radial_velocity_mps: 0.0,
-            rcs_dbsm: 10.0,
-            class: ObjectClass::Car,
-            sensor_id: Some(1),
-            ground_truth_id: Some(1),
-        });
+        frame.measurements.push(standing_car(20.0 + 0.1 * noise.next(), -12.0 + 0.1 * noise.next(), 1));
         tracker.step(&frame).unwrap();
     }
     let sensors = tracker.sensors();
@@ -171,15 +177,7 @@ fn the_detection_estimate_follows_how_often_a_radar_reports_a_confirmed_car() {
         } else {
             (20.0, -5.0, 1)
         };
-        frame.measurements.push(Measurement {
-            x_m,
-            y_m,
-            radial_velocity_mps: 0.0,
-            rcs_dbsm: 10.0,
-            class: ObjectClass::Car,
-            sensor_id: Some(1),
-            ground_truth_id: Some(ground_truth_id),
-        });
+        frame.measurements.push(standing_car(x_m, y_m, ground_truth_id));
         tracker.step(&frame).unwrap();
     }
     let sensors = tracker.sensors();
@@ -203,15 +201,7 @@ fn detection_estimate_with_a_car_at(far_m: DVec2) -> f64 {
         let cars = [(DVec2::new(20.0, -12.0), 1, true), (far_m, 2, far_reported)];
         for (position, ground_truth_id, reported) in cars {
             if reported {
-                frame.measurements.push(Measurement {
-                    x_m: position.x,
-                    y_m: position.y,
-                    radial_velocity_mps: 0.0,
-                    rcs_dbsm: 10.0,
-                    class: ObjectClass::Car,
-                    sensor_id: Some(1),
-                    ground_truth_id: Some(ground_truth_id),
-                });
+                frame.measurements.push(standing_car(position.x, position.y, ground_truth_id));
             }
         }
         tracker.step(&frame).unwrap();

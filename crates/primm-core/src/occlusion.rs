@@ -4,6 +4,7 @@
 //! the sensor could see (`crate::sensor::estimates`); the simulator asks it of its true objects,
 //! for the same quantity's truth.
 
+use crate::extent::ExtentConfig;
 use arrayvec::ArrayVec;
 use glam::DVec2;
 
@@ -20,6 +21,19 @@ pub struct ObjectBox {
 }
 
 impl ObjectBox {
+    /// The nominal box of an object of `extent` centred at `centre_m` and moving with
+    /// `velocity_mps`: its length along the velocity, or, at speeds up to the extent's
+    /// `min_heading_speed_mps` (no heading), a square of the extent's width.
+    pub fn nominal(extent: &ExtentConfig, centre_m: DVec2, velocity_mps: DVec2) -> Self {
+        let (heading, half_length_m) = match velocity_mps.try_normalize() {
+            Some(heading) if velocity_mps.length() > extent.min_heading_speed_mps => {
+                (heading, 0.5 * extent.length_m)
+            }
+            _ => (DVec2::X, 0.5 * extent.width_m),
+        };
+        ObjectBox { centre_m, heading, half_extent_m: DVec2::new(half_length_m, 0.5 * extent.width_m) }
+    }
+
     /// Whether the segment from `from_m` to `to_m` passes through the box (its boundary
     /// included): the slab test in the box's own frame.
     pub fn crossed_by(&self, from_m: DVec2, to_m: DVec2) -> bool {
@@ -158,6 +172,23 @@ mod tests {
                 assert_eq!(occluders.hide(9, sensor, target), exact, "{target}");
             }
         }
+    }
+
+    #[test]
+    fn a_moving_object_lies_along_its_velocity_and_a_slow_one_is_a_square_of_its_width() {
+        let extent = ExtentConfig {
+            length_m: 4.5,
+            width_m: 1.8,
+            min_heading_speed_mps: 1.0,
+            ..ExtentConfig::default()
+        };
+        let moving = ObjectBox::nominal(&extent, DVec2::ONE, DVec2::new(0.0, 5.0));
+        assert_eq!(
+            (moving.centre_m, moving.heading, moving.half_extent_m),
+            (DVec2::ONE, DVec2::Y, DVec2::new(2.25, 0.9))
+        );
+        let slow = ObjectBox::nominal(&extent, DVec2::ONE, DVec2::new(0.0, 0.5));
+        assert_eq!(slow.half_extent_m, DVec2::new(0.9, 0.9));
     }
 
     #[test]

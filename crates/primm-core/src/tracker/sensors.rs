@@ -126,9 +126,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
         }
     }
 
-    /// The boxes of the tracks confirmed before this frame's update, at their priors, into
-    /// `occluders`: heading along the velocity, the class's nominal extent (a square of the
-    /// extent's width below the class's `extent.min_heading_speed_mps`).
+    /// The nominal boxes ([`ObjectBox::nominal`], the class's extent) of the tracks confirmed
+    /// before this frame's update, at their priors, into `occluders`.
     fn collect_occluders(&mut self) {
         self.occluders.clear();
         for (j, track) in self.table.tracks().iter().enumerate() {
@@ -136,18 +135,8 @@ impl<P: DisplacementPredictor> Tracker<P> {
                 continue;
             }
             let extent = &self.config.classes.get(track.class).extent;
-            let velocity_mps = self.priors[j].fused_velocity_mps();
-            let (heading, half_length_m) = match velocity_mps.try_normalize() {
-                Some(heading) if velocity_mps.length() > extent.min_heading_speed_mps => {
-                    (heading, 0.5 * extent.length_m)
-                }
-                _ => (DVec2::X, 0.5 * extent.width_m),
-            };
-            let object = ObjectBox {
-                centre_m: self.priors[j].fused.mean,
-                heading,
-                half_extent_m: DVec2::new(half_length_m, 0.5 * extent.width_m),
-            };
+            let prior = &self.priors[j];
+            let object = ObjectBox::nominal(extent, prior.fused.mean, prior.fused_velocity_mps());
             // The capacity is the table's: every track fits.
             let _ = self.occluders.push(j as u16, object);
         }
